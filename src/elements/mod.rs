@@ -1,0 +1,1 @@
+//! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.

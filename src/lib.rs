@@ -1,0 +1,13 @@
+//! segfem: finite element analysis of precast segmental concrete members with bonded and
+//! external (unbonded) prestressing, in plane stress, from service load to failure and over
+//! time. The method follows Ribeiro, Campos Filho & Pacheco, "Finite Element Model for
+//! Segmental Structures", Rev. IBRACON Estrut. 2(2), 2006.
+//!
+//! Data flows one way: input → validated [`model`] → mesh and dofs → analysis → results →
+//! writers.
+
+pub mod fem;
+pub mod elements;
+pub mod materials;
+pub mod mesh;
+pub mod prestress;

@@ -1,0 +1,2 @@
+//! Material laws: plane-stress continuum points and uniaxial steel, each keeping committed
+//! and trial state apart.

@@ -1,0 +1,1 @@
+//! Meshes: nodes, elements and regions; generators and readers.

@@ -1,0 +1,1 @@
+//! Prestressing: tendon geometry, friction losses and equivalent forces.
