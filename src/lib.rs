@@ -6,8 +6,17 @@
 //! Data flows one way: input → validated [`model`] → mesh and dofs → analysis → results →
 //! writers.
 
-pub mod fem;
+// Index loops mirror the formulas (Σ over nodes, components); iterator chains would hide them.
+#![allow(clippy::needless_range_loop)]
+
+pub mod analysis;
+pub mod bench;
 pub mod elements;
+pub mod fem;
+pub mod input;
 pub mod materials;
 pub mod mesh;
+pub mod model;
 pub mod prestress;
+pub mod results;
+pub mod run;

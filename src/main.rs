@@ -1,1 +1,285 @@
-fn main() {}
+//! The segfem command line: parses arguments, calls the library, shows progress.
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use segfem::fem::shape::QuadKind;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Bundled examples: (name, description, model file text).
+const EXAMPLES: &[(&str, &str, &str)] = &[
+    (
+        "cantilever",
+        "plane-stress cantilever under end shear, Q8, linear",
+        include_str!("../examples/cantilever.toml"),
+    ),
+    (
+        "box-beam",
+        "7.2 m box-section beam (banded), self weight then two point loads",
+        include_str!("../examples/box-beam.toml"),
+    ),
+];
+
+#[derive(Parser)]
+#[command(
+    name = "segfem",
+    version,
+    about = "Finite element analysis of precast segmental concrete members (plane stress)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a model file and write history.csv, summary.json and results.pvd/.vtu.
+    Run {
+        /// Model file (TOML).
+        model: PathBuf,
+        /// Output directory (default: the model file's name without extension, beside it).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Validate a model file and print a summary, without solving.
+    Check {
+        /// Model file (TOML).
+        model: PathBuf,
+    },
+    /// List bundled examples, or write one to stdout or a file.
+    Example {
+        /// Example name.
+        name: Option<String>,
+        /// Write to this file instead of stdout.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Build and solve banded beams of growing size; print phase times and peak memory.
+    Bench {
+        /// Target sizes in dofs, comma separated.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1e4, 1e5, 1e6])]
+        dofs: Vec<f64>,
+        /// Element kinds, comma separated (Q4, Q8, Q9).
+        #[arg(long, value_delimiter = ',', default_values_t = vec!["Q4".to_string(), "Q8".to_string()])]
+        element: Vec<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            model,
+            output,
+            quiet,
+        } => run(model, output, quiet),
+        Command::Check { model } => check(model),
+        Command::Example { name, output } => example(name, output),
+        Command::Bench { dofs, element } => bench(dofs, element),
+    }
+}
+
+fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool) -> ExitCode {
+    let out = output.unwrap_or_else(|| model.with_extension(""));
+    let tty = std::io::stderr().is_terminal() && !quiet;
+    let bar = if tty {
+        let b = ProgressBar::new_spinner();
+        b.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
+                .expect("valid template"),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let mut on_inc = |s: &segfem::analysis::steps::Snapshot| {
+        let msg = format!(
+            "step {} increment {} converged in {} iterations",
+            s.step + 1,
+            s.increment,
+            s.iterations
+        );
+        match &bar {
+            Some(b) => {
+                b.set_message(msg);
+                b.tick();
+            }
+            None if !quiet => eprintln!("{msg}"),
+            None => {}
+        }
+    };
+    let res = segfem::run::run_file(&model, &out, &mut on_inc);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    match res {
+        Ok(s) => {
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
+            if !quiet {
+                println!(
+                    "{}: {} nodes, {} elements, {} equations; {} increments, {} iterations in {:.3} s",
+                    model.display(),
+                    s.size.nodes,
+                    s.size.elements,
+                    s.size.equations,
+                    s.timings.increments,
+                    s.timings.iterations,
+                    s.wall_s
+                );
+                for (n, v) in &s.final_monitors {
+                    println!("  {n} = {v:.6e}");
+                }
+                println!("results in {}", out.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            if matches!(e, segfem::run::RunError::NotConverged(_)) {
+                eprintln!(
+                    "results up to the last converged increment are in {}",
+                    out.display()
+                );
+            }
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn check(model: PathBuf) -> ExitCode {
+    match segfem::input::load(&model) {
+        Ok(b) => {
+            for w in &b.warnings {
+                eprintln!("warning: {w}");
+            }
+            let m = &b.model;
+            println!("{}: valid", model.display());
+            println!("  title:     {}", m.title);
+            println!("  nodes:     {}", m.nodes.len());
+            println!("  elements:  {}", m.elements.len());
+            println!("  dofs:      {}", m.n_dofs());
+            println!(
+                "  regions:   {}",
+                m.regions
+                    .iter()
+                    .map(|r| format!("{} (t = {} m)", r.name, r.thickness))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!(
+                "  supports:  {}",
+                m.supports
+                    .iter()
+                    .map(|s| format!("{} ({} dofs)", s.name, s.dofs.len()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!(
+                "  loads:     {}",
+                m.load_cases
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!(
+                "  monitors:  {}",
+                m.monitors
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!(
+                "  steps:     {}",
+                m.steps
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
+    let Some(name) = name else {
+        for (n, d, _) in EXAMPLES {
+            println!("{n:12} {d}");
+        }
+        return ExitCode::SUCCESS;
+    };
+    let Some((_, _, text)) = EXAMPLES.iter().find(|(n, _, _)| *n == name) else {
+        eprintln!(
+            "error: no example named '{name}' (available: {})",
+            EXAMPLES.iter().map(|e| e.0).collect::<Vec<_>>().join(", ")
+        );
+        return ExitCode::from(2);
+    };
+    match output {
+        Some(p) => match std::fs::write(&p, text) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {}: {e}", p.display());
+                ExitCode::from(1)
+            }
+        },
+        None => {
+            print!("{text}");
+            ExitCode::SUCCESS
+        }
+    }
+}
+
+fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
+    println!(
+        "{:>4} {:>9} {:>7} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>12}",
+        "elem",
+        "dofs",
+        "mesh s",
+        "setup s",
+        "assemb s",
+        "order s",
+        "factor s",
+        "solve s",
+        "total s",
+        "peak MiB",
+        "tip uy [m]"
+    );
+    for e in &element {
+        let kind = match e.as_str() {
+            "Q4" => QuadKind::Q4,
+            "Q8" => QuadKind::Q8,
+            "Q9" => QuadKind::Q9,
+            o => {
+                eprintln!("error: --element: unknown element '{o}' (Q4, Q8, Q9)");
+                return ExitCode::from(2);
+            }
+        };
+        for &n in &dofs {
+            match segfem::bench::run_case(kind, n as usize) {
+                Ok(r) => println!(
+                    "{:>4} {:>9} {:>7.3} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>7.3} {:>8.3} {:>9.0} {:>12.5e}",
+                    r.kind, r.dofs, r.mesh_s, r.setup_s, r.assembly_s, r.ordering_s, r.factor_s, r.solve_s, r.total_s,
+                    r.peak_bytes as f64 / 1048576.0, r.tip_uy
+                ),
+                Err(err) => {
+                    eprintln!("error: {err}");
+                    return ExitCode::from(3);
+                }
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}

@@ -1,1 +1,3 @@
 //! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.
+
+pub mod continuum;

@@ -78,7 +78,11 @@ mod tests {
         for n in 1..=4 {
             let r = gauss(n);
             for k in 0..(2 * n) {
-                let exact = if k % 2 == 1 { 0.0 } else { 2.0 / (k as f64 + 1.0) };
+                let exact = if k % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (k as f64 + 1.0)
+                };
                 let num: f64 = r
                     .points
                     .iter()
@@ -95,7 +99,11 @@ mod tests {
     fn lobatto_3_is_exact_to_degree_3() {
         let r = lobatto(3);
         for k in 0..4 {
-            let exact = if k % 2 == 1 { 0.0 } else { 2.0 / (k as f64 + 1.0) };
+            let exact = if k % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (k as f64 + 1.0)
+            };
             let num: f64 = r
                 .points
                 .iter()

@@ -1,1 +1,3 @@
 //! Meshes: nodes, elements and regions; generators and readers.
+
+pub mod banded;

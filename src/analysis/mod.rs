@@ -1,0 +1,6 @@
+//! Analysis: steps, the Newton loop, and the linear-solver wrapper.
+
+pub mod loads;
+pub mod solver;
+pub mod steps;
+pub mod system;

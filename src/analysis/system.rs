@@ -1,0 +1,190 @@
+//! The discrete system: dof map, sparse pattern, displacements, material-point states
+//! (committed and trial), and the assembly of internal forces and tangent.
+
+use crate::elements::continuum::{self, GaussOutput};
+use crate::fem::assembly::Assembler;
+use crate::fem::dofs::{DofMap, CONSTRAINED};
+use crate::materials::point::{PointState, UpdateError};
+use crate::model::Model;
+use rayon::prelude::*;
+
+/// Elements per parallel chunk: large enough to amortise scheduling, small enough to keep the
+/// element-matrix buffer a few tens of MB.
+const CHUNK: usize = 4096;
+
+/// The state of the discretised model between and during increments.
+pub struct System<'m> {
+    /// The model.
+    pub model: &'m Model,
+    /// Equation numbering.
+    pub dofs: DofMap,
+    /// Pattern and scatter maps.
+    pub asm: Assembler,
+    /// Offset of each element's first Gauss point in the state arrays.
+    pub gp_offset: Vec<usize>,
+    /// Committed displacements (all dofs) [m].
+    pub u: Vec<f64>,
+    /// Committed point states.
+    pub committed: Vec<PointState>,
+    /// Trial point states (of the last assembly).
+    pub trial: Vec<PointState>,
+    /// Committed Gauss outputs (strain, stress).
+    pub gauss: Vec<GaussOutput>,
+    /// Trial Gauss outputs.
+    pub gauss_trial: Vec<GaussOutput>,
+    /// True if every material is linear (tangent constant).
+    pub linear: bool,
+}
+
+/// Element force and row-major tangent, or the failing element and why.
+type ElementResult = Result<(Vec<f64>, Vec<f64>), (usize, UpdateError)>;
+
+/// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
+pub struct Assembled {
+    /// Internal force vector over all dofs [N].
+    pub f_int: Vec<f64>,
+    /// Lower-triangle tangent values over free equations, if requested.
+    pub k_values: Option<Vec<f64>>,
+}
+
+impl<'m> System<'m> {
+    /// Build dof map, pattern and initial states.
+    pub fn new(model: &'m Model) -> Self {
+        let constrained: Vec<(usize, f64)> = model
+            .supports
+            .iter()
+            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+            .collect();
+        let dofs = DofMap::new(model.nodes.len(), &constrained);
+        let elem_nodes: Vec<Vec<usize>> = model.elements.iter().map(|e| e.nodes.clone()).collect();
+        let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
+        let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
+        let mut committed = Vec::new();
+        gp_offset.push(0);
+        for e in &model.elements {
+            let ngp = continuum::rule(e.kind, e.integration).len();
+            let mat = &model.materials[model.regions[e.region].material].law;
+            for _ in 0..ngp {
+                committed.push(mat.initial_state());
+            }
+            gp_offset.push(committed.len());
+        }
+        let linear = model.materials.iter().all(|m| m.law.is_linear());
+        let n_gp = committed.len();
+        Self {
+            model,
+            dofs,
+            asm,
+            gp_offset,
+            u: vec![0.0; model.n_dofs()],
+            trial: committed.clone(),
+            committed,
+            gauss: vec![GaussOutput::default(); n_gp],
+            gauss_trial: vec![GaussOutput::default(); n_gp],
+            linear,
+        }
+    }
+
+    /// Internal forces and (optionally) tangent at displacements `u` from the committed
+    /// states; trial states and Gauss outputs are stored in `self.trial` / `self.gauss_trial`.
+    /// Element work runs in parallel; the scatter is sequential in element order, so results
+    /// are bit-identical whatever the thread count.
+    pub fn assemble(
+        &mut self,
+        u: &[f64],
+        tangent: bool,
+    ) -> Result<Assembled, (usize, UpdateError)> {
+        let model = self.model;
+        let mut f_int = vec![0.0; u.len()];
+        let mut k_values = tangent.then(|| vec![0.0; self.asm.pattern.nnz()]);
+        let n_el = model.elements.len();
+        let mut start = 0;
+        // Split the state arrays per element once per chunk so that chunks can be filled in
+        // parallel without aliasing.
+        while start < n_el {
+            let end = (start + CHUNK).min(n_el);
+            let g0 = self.gp_offset[start];
+            let g1 = self.gp_offset[end];
+            let trial = &mut self.trial[g0..g1];
+            let gout = &mut self.gauss_trial[g0..g1];
+            let committed = &self.committed[g0..g1];
+            let gp_offset = &self.gp_offset;
+            // Per-element slices.
+            let mut pieces = Vec::with_capacity(end - start);
+            let (mut t_rest, mut o_rest) = (trial, gout);
+            for e in start..end {
+                let ngp = gp_offset[e + 1] - gp_offset[e];
+                let (t, tr) = t_rest.split_at_mut(ngp);
+                let (o, or) = o_rest.split_at_mut(ngp);
+                t_rest = tr;
+                o_rest = or;
+                pieces.push((e, t, o));
+            }
+            let results: Vec<ElementResult> = pieces
+                .into_par_iter()
+                .map(|(e, t, o)| {
+                    let el = &model.elements[e];
+                    let region = &model.regions[el.region];
+                    let mat = &model.materials[region.material].law;
+                    let coords = model.element_coords(el);
+                    let nd = 2 * el.nodes.len();
+                    let ue: Vec<f64> = el
+                        .nodes
+                        .iter()
+                        .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
+                        .collect();
+                    let mut fe = vec![0.0; nd];
+                    let mut ke = vec![0.0; nd * nd];
+                    let c0 = gp_offset[e] - g0;
+                    continuum::response(
+                        el.kind,
+                        el.integration,
+                        &coords,
+                        region.thickness,
+                        mat,
+                        &committed[c0..c0 + t.len()],
+                        &ue,
+                        &mut fe,
+                        &mut ke,
+                        t,
+                        o,
+                    )
+                    .map_err(|err| (e, err))?;
+                    Ok((fe, ke))
+                })
+                .collect();
+            for (i, r) in results.into_iter().enumerate() {
+                let e = start + i;
+                let (fe, ke) = r?;
+                for (a, &n) in model.elements[e].nodes.iter().enumerate() {
+                    f_int[2 * n] += fe[2 * a];
+                    f_int[2 * n + 1] += fe[2 * a + 1];
+                }
+                if let Some(k) = k_values.as_mut() {
+                    self.asm.add_matrix(e, &ke, k);
+                }
+            }
+            start = end;
+        }
+        Ok(Assembled { f_int, k_values })
+    }
+
+    /// Accept the trial states of the last assembly and the displacements `u`.
+    pub fn commit(&mut self, u: &[f64]) {
+        self.u.copy_from_slice(u);
+        std::mem::swap(&mut self.committed, &mut self.trial);
+        self.trial.clone_from(&self.committed);
+        std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
+    }
+
+    /// Gather the free-equation part of a full dof vector.
+    pub fn to_free(&self, full: &[f64]) -> Vec<f64> {
+        let mut r = vec![0.0; self.dofs.n_eq];
+        for (d, &q) in self.dofs.eq.iter().enumerate() {
+            if q != CONSTRAINED {
+                r[q] = full[d];
+            }
+        }
+        r
+    }
+}

@@ -1,0 +1,191 @@
+//! The `segfem bench` job: build and solve banded plane-stress beams of growing size and
+//! print the time of each phase and the peak memory.
+
+use crate::analysis::steps::{self, Observer, Snapshot};
+use crate::elements::continuum::Integration;
+use crate::fem::shape::QuadKind;
+use crate::materials::point::Material;
+use crate::mesh::banded::{generate, Band};
+use crate::model::*;
+use std::time::Instant;
+
+/// A simply supported-free cantilever-like banded beam (three bands: flange, web, flange)
+/// with about `target_dofs` degrees of freedom, clamped at x = 0, loaded at the free end.
+pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
+    // Mesh with nx = 4 ny: dofs ≈ 2 (nx+1)(ny+1) for Q4, ≈ 6 nx ny for Q8/Q9 (8 for Q9).
+    let per_cell = match kind {
+        QuadKind::Q4 => 2.0,
+        QuadKind::Q8 => 6.0,
+        QuadKind::Q9 => 8.0,
+    };
+    let ny = ((target_dofs as f64 / (4.0 * per_cell)).sqrt().round() as usize).max(3);
+    let nx = 4 * ny;
+    let r1 = ny / 5;
+    let r3 = ny / 5;
+    let bands = [
+        Band {
+            depth: 0.2,
+            rows: r1.max(1),
+            region: 0,
+        },
+        Band {
+            depth: 0.6,
+            rows: (ny - r1 - r3).max(1),
+            region: 1,
+        },
+        Band {
+            depth: 0.2,
+            rows: r3.max(1),
+            region: 2,
+        },
+    ];
+    let g = generate([0.0, 0.0], 4.0, nx, &bands, kind);
+    let elements = g
+        .elements
+        .into_iter()
+        .map(|(nodes, region)| Element {
+            kind,
+            nodes,
+            region,
+            integration: Integration::Full,
+        })
+        .collect();
+    let mut model = Model {
+        title: format!("bench {kind:?} {target_dofs}"),
+        nodes: g.nodes,
+        elements,
+        regions: vec![
+            Region {
+                name: "bottom".into(),
+                material: 0,
+                thickness: 0.7,
+            },
+            Region {
+                name: "web".into(),
+                material: 0,
+                thickness: 0.2,
+            },
+            Region {
+                name: "top".into(),
+                material: 0,
+                thickness: 1.2,
+            },
+        ],
+        materials: vec![NamedMaterial {
+            name: "concrete".into(),
+            law: Material::Elastic {
+                e: 35e9,
+                nu: 0.2,
+                density: 2500.0,
+            },
+        }],
+        supports: vec![],
+        load_cases: vec![],
+        monitors: vec![],
+        steps: vec![Step {
+            name: "load".into(),
+            kind: StepKind::Linear,
+            factors: vec![1.0],
+            increments: 1,
+            output_every_increment: false,
+        }],
+        controls: SolverControls::default(),
+    };
+    let wall: Vec<(usize, Dir, f64)> = model
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p[0] == 0.0)
+        .flat_map(|(i, _)| [(i, Dir::X, 0.0), (i, Dir::Y, 0.0)])
+        .collect();
+    model.supports.push(Support {
+        name: "wall".into(),
+        dofs: wall,
+    });
+    let tip = model
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| (p[0] - 4.0).abs() < 1e-9)
+        .min_by(|a, b| (a.1[1] - 0.5).abs().total_cmp(&(b.1[1] - 0.5).abs()))
+        .map(|(i, _)| i)
+        .expect("tip node");
+    model.load_cases.push(LoadCase {
+        name: "tip".into(),
+        point_forces: vec![(tip, [0.0, -1e5])],
+        ..Default::default()
+    });
+    model.monitors.push(Monitor {
+        name: "tip_uy".into(),
+        kind: MonitorKind::Displacement {
+            node: tip,
+            dir: Dir::Y,
+        },
+    });
+    model
+}
+
+struct TipOnly {
+    node: usize,
+    value: f64,
+}
+
+impl Observer for TipOnly {
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        self.value = snap.system.u[2 * self.node + 1];
+        Ok(())
+    }
+}
+
+/// One benchmark line.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BenchRow {
+    /// Element kind.
+    pub kind: String,
+    /// Equations.
+    pub dofs: usize,
+    /// Mesh generation [s].
+    pub mesh_s: f64,
+    /// Dof map, pattern, states [s].
+    pub setup_s: f64,
+    /// Element loops and scatter [s].
+    pub assembly_s: f64,
+    /// Ordering and symbolic factorisation [s].
+    pub ordering_s: f64,
+    /// Numeric factorisation [s].
+    pub factor_s: f64,
+    /// Triangular solves [s].
+    pub solve_s: f64,
+    /// Whole run [s].
+    pub total_s: f64,
+    /// Peak resident memory so far [bytes].
+    pub peak_bytes: u64,
+    /// Tip deflection [m] (a check that the run solved something).
+    pub tip_uy: f64,
+}
+
+/// Run one benchmark case.
+pub fn run_case(kind: QuadKind, target_dofs: usize) -> Result<BenchRow, steps::AnalysisError> {
+    let t0 = Instant::now();
+    let model = banded_beam(kind, target_dofs);
+    let mesh_s = t0.elapsed().as_secs_f64();
+    let node = match model.monitors[0].kind {
+        MonitorKind::Displacement { node, .. } => node,
+        _ => unreachable!("bench monitor is a displacement"),
+    };
+    let mut obs = TipOnly { node, value: 0.0 };
+    let t = steps::run(&model, &mut obs)?;
+    Ok(BenchRow {
+        kind: format!("{kind:?}"),
+        dofs: model.n_dofs(),
+        mesh_s,
+        setup_s: t.setup_s - t.solver.symbolic_s,
+        assembly_s: t.assembly_s,
+        ordering_s: t.solver.symbolic_s,
+        factor_s: t.solver.numeric_s,
+        solve_s: t.solver.solve_s,
+        total_s: t0.elapsed().as_secs_f64(),
+        peak_bytes: crate::run::peak_memory().unwrap_or(0),
+        tip_uy: obs.value,
+    })
+}

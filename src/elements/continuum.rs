@@ -1,0 +1,206 @@
+//! Isoparametric plane-stress continuum elements (Q4, Q8, Q9): internal force and tangent
+//! stiffness from the trial displacements, consistent body and edge loads.
+
+use crate::fem::quadrature::{gauss, gauss_square, Point2};
+use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, QuadKind, MAX_NODES};
+use crate::materials::point::{update, Material, PointState, UpdateError};
+use serde::{Deserialize, Serialize};
+
+/// Integration rule of a continuum element.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Integration {
+    /// 2×2 Gauss for Q4, 3×3 for Q8 and Q9.
+    #[default]
+    Full,
+    /// 2×2 Gauss for Q8 and Q9 (Q4 stays 2×2).
+    Reduced,
+}
+
+/// The Gauss points of an element kind under a rule.
+pub fn rule(kind: QuadKind, integration: Integration) -> Vec<Point2> {
+    match (kind, integration) {
+        (QuadKind::Q4, _) | (_, Integration::Reduced) => gauss_square(2),
+        _ => gauss_square(3),
+    }
+}
+
+/// Values computed at one Gauss point for output.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GaussOutput {
+    /// Strain (εx, εy, γxy) [-].
+    pub strain: [f64; 3],
+    /// Stress (σx, σy, τxy) [Pa].
+    pub stress: [f64; 3],
+}
+
+/// Strain–displacement matrix rows at one point: (∂N/∂x, ∂N/∂y) per node, and the
+/// integration factor w·det J [m²].
+fn point_derivatives(
+    kind: QuadKind,
+    coords: &[[f64; 2]],
+    p: &Point2,
+) -> ([[f64; 2]; MAX_NODES], f64) {
+    let s = kind.eval(p.0, p.1);
+    let (_, det, inv) = jacobian(&s, coords);
+    (cartesian_derivatives(&s, &inv), det * p.2)
+}
+
+/// Smallest det J over the Gauss points and the corners (negative or zero means inverted or
+/// degenerate). Corners are included because a Q4 can fold without any Gauss point seeing it.
+pub fn min_jacobian(kind: QuadKind, coords: &[[f64; 2]], integration: Integration) -> f64 {
+    let mut pts: Vec<(f64, f64)> = rule(kind, integration).iter().map(|p| (p.0, p.1)).collect();
+    pts.extend([(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]);
+    pts.iter()
+        .map(|(x, e)| jacobian(&kind.eval(*x, *e), coords).1)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Element area [m²].
+pub fn area(kind: QuadKind, coords: &[[f64; 2]]) -> f64 {
+    gauss_square(3)
+        .iter()
+        .map(|p| jacobian(&kind.eval(p.0, p.1), coords).1 * p.2)
+        .sum()
+}
+
+/// Internal force `f` (2n) and row-major tangent `k` (2n × 2n) of one element, with the trial
+/// states and Gauss outputs written to `trial` and `out`. `u` holds the element's nodal
+/// displacements (ux, uy per node) [m]; `thickness` [m].
+#[allow(clippy::too_many_arguments)]
+pub fn response(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
+    k: &mut [f64],
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+) -> Result<(), UpdateError> {
+    let n = kind.n_nodes();
+    let nd = 2 * n;
+    f[..nd].iter_mut().for_each(|v| *v = 0.0);
+    k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
+    let h = area(kind, coords).sqrt();
+    for (g, p) in rule(kind, integration).iter().enumerate() {
+        let (dn, wdet) = point_derivatives(kind, coords, p);
+        let mut eps = [0.0; 3];
+        for a in 0..n {
+            let (ux, uy) = (u[2 * a], u[2 * a + 1]);
+            eps[0] += dn[a][0] * ux;
+            eps[1] += dn[a][1] * uy;
+            eps[2] += dn[a][1] * ux + dn[a][0] * uy;
+        }
+        let (st, sig, d) = update(mat, &committed[g], &eps, h)?;
+        trial[g] = st;
+        out[g] = GaussOutput {
+            strain: eps,
+            stress: sig,
+        };
+        let w = wdet * thickness;
+        // B_a = [[dx, 0], [0, dy], [dy, dx]]; f_a = Bᵀσ; K_ab = B_aᵀ D B_b.
+        for a in 0..n {
+            let (ax, ay) = (dn[a][0], dn[a][1]);
+            f[2 * a] += w * (ax * sig[0] + ay * sig[2]);
+            f[2 * a + 1] += w * (ay * sig[1] + ax * sig[2]);
+            // Rows of B_aᵀ D (2×3).
+            let r0 = [
+                ax * d[0][0] + ay * d[2][0],
+                ax * d[0][1] + ay * d[2][1],
+                ax * d[0][2] + ay * d[2][2],
+            ];
+            let r1 = [
+                ay * d[1][0] + ax * d[2][0],
+                ay * d[1][1] + ax * d[2][1],
+                ay * d[1][2] + ax * d[2][2],
+            ];
+            for b in 0..n {
+                let (bx, by) = (dn[b][0], dn[b][1]);
+                let row0 = 2 * a * nd;
+                let row1 = (2 * a + 1) * nd;
+                k[row0 + 2 * b] += w * (r0[0] * bx + r0[2] * by);
+                k[row0 + 2 * b + 1] += w * (r0[1] * by + r0[2] * bx);
+                k[row1 + 2 * b] += w * (r1[0] * bx + r1[2] * by);
+                k[row1 + 2 * b + 1] += w * (r1[1] * by + r1[2] * bx);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Consistent nodal forces [N] of a body force b [N/m³] (e.g. ρ g) over the element.
+pub fn body_force(kind: QuadKind, coords: &[[f64; 2]], thickness: f64, b: [f64; 2]) -> Vec<f64> {
+    let n = kind.n_nodes();
+    let mut f = vec![0.0; 2 * n];
+    for p in gauss_square(3) {
+        let s = kind.eval(p.0, p.1);
+        let (_, det, _) = jacobian(&s, coords);
+        let w = det * p.2 * thickness;
+        for a in 0..n {
+            f[2 * a] += w * s.n_val[a] * b[0];
+            f[2 * a + 1] += w * s.n_val[a] * b[1];
+        }
+    }
+    f
+}
+
+/// Consistent nodal forces [N] of a uniform line load q [N/m] (per unit length of edge,
+/// thickness already included) on an edge with node coordinates ordered (start, end, [mid]).
+pub fn edge_force(edge_coords: &[[f64; 2]], q: [f64; 2]) -> Vec<f64> {
+    let m = edge_coords.len();
+    let mut f = vec![0.0; 2 * m];
+    let r = gauss(3);
+    for (x, w) in r.points.iter().zip(&r.weights) {
+        let (nv, dn) = line_shape(m, *x);
+        let (mut dx, mut dy) = (0.0, 0.0);
+        for a in 0..m {
+            dx += dn[a] * edge_coords[a][0];
+            dy += dn[a] * edge_coords[a][1];
+        }
+        let j = (dx * dx + dy * dy).sqrt();
+        for a in 0..m {
+            f[2 * a] += w * j * nv[a] * q[0];
+            f[2 * a + 1] += w * j * nv[a] * q[1];
+        }
+    }
+    f
+}
+
+/// Gauss-point values extrapolated to the element's nodes: the tensor-product Lagrange
+/// interpolant through the Gauss points (2×2 or 3×3) evaluated at each node.
+pub fn extrapolate_to_nodes(
+    kind: QuadKind,
+    integration: Integration,
+    gp_values: &[[f64; 3]],
+) -> Vec<[f64; 3]> {
+    let pts = rule(kind, integration);
+    let order = if pts.len() == 4 { 2 } else { 3 };
+    let r = gauss(order);
+    let lag = |x: f64, i: usize| -> f64 {
+        let mut v = 1.0;
+        for (j, pj) in r.points.iter().enumerate() {
+            if j != i {
+                v *= (x - pj) / (r.points[i] - pj);
+            }
+        }
+        v
+    };
+    (0..kind.n_nodes())
+        .map(|a| {
+            let [xi, eta] = crate::fem::shape::NODE_XI[a];
+            let mut v = [0.0; 3];
+            for (g, val) in gp_values.iter().enumerate() {
+                let (i, j) = (g % order, g / order);
+                let w = lag(xi, i) * lag(eta, j);
+                for c in 0..3 {
+                    v[c] += w * val[c];
+                }
+            }
+            v
+        })
+        .collect()
+}

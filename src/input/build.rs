@@ -1,0 +1,702 @@
+//! From the parsed file to a validated [`Model`]: names resolved, values checked, locations
+//! found in the mesh. Every problem is an [`InputError`] naming the key.
+
+use super::error::{Ctx, InputError};
+use super::locate;
+use super::schema::*;
+use crate::elements::continuum::{min_jacobian, Integration};
+use crate::fem::shape::QuadKind;
+use crate::materials::point::Material;
+use crate::mesh::banded::{self, Band};
+use crate::model::*;
+use std::collections::HashMap;
+
+/// A validated model and the warnings met on the way (suspicious but legal values).
+pub struct Built {
+    /// The model.
+    pub model: Model,
+    /// Warnings, one line each.
+    pub warnings: Vec<String>,
+}
+
+type R<T> = Result<T, InputError>;
+
+fn positive(ctx: &Ctx, key: &str, v: f64) -> R<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ctx.err(key, format!("must be a positive number (got {v})")))
+    }
+}
+
+fn index_by_name<'a>(
+    ctx: &Ctx,
+    key: &str,
+    what: &str,
+    names: impl Iterator<Item = &'a str> + Clone,
+    wanted: &str,
+) -> R<usize> {
+    names.clone().position(|n| n == wanted).ok_or_else(|| {
+        let known: Vec<&str> = names.collect();
+        ctx.err(
+            key,
+            format!("no {what} named '{wanted}' (defined: {})", known.join(", ")),
+        )
+    })
+}
+
+fn unique_names<'a>(ctx: &Ctx, list: &str, names: impl Iterator<Item = &'a str>) -> R<()> {
+    let mut seen = HashMap::new();
+    for (i, n) in names.enumerate() {
+        if n.trim().is_empty() {
+            return Err(ctx.err(format!("{list}[{i}].name"), "must not be empty"));
+        }
+        if let Some(j) = seen.insert(n, i) {
+            return Err(ctx.err(
+                format!("{list}[{i}].name"),
+                format!("'{n}' is already used by {list}[{j}]"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn quad_kind(ctx: &Ctx, key: &str, s: &str) -> R<QuadKind> {
+    match s {
+        "Q4" | "q4" => Ok(QuadKind::Q4),
+        "Q8" | "q8" => Ok(QuadKind::Q8),
+        "Q9" | "q9" => Ok(QuadKind::Q9),
+        _ => Err(ctx.err(
+            key,
+            format!("unknown element type '{s}' (expected Q4, Q8 or Q9)"),
+        )),
+    }
+}
+
+fn integration(ctx: &Ctx, key: &str, s: Option<&str>) -> R<Integration> {
+    match s {
+        None | Some("full") => Ok(Integration::Full),
+        Some("reduced") => Ok(Integration::Reduced),
+        Some(o) => Err(ctx.err(
+            key,
+            format!("unknown integration '{o}' (expected full or reduced)"),
+        )),
+    }
+}
+
+fn dir(ctx: &Ctx, key: &str, s: Option<&str>) -> R<Dir> {
+    match s {
+        Some("x") => Ok(Dir::X),
+        Some("y") => Ok(Dir::Y),
+        Some(o) => Err(ctx.err(key, format!("unknown component '{o}' (expected x or y)"))),
+        None => Err(ctx.err(key, "missing (expected x or y)")),
+    }
+}
+
+/// Validate a parsed file into a model.
+pub fn build(file: File, ctx: &Ctx) -> R<Built> {
+    let mut warnings = Vec::new();
+    // Materials.
+    unique_names(
+        ctx,
+        "materials",
+        file.materials.iter().map(|m| m.name.as_str()),
+    )?;
+    let mut materials = Vec::new();
+    for (i, m) in file.materials.iter().enumerate() {
+        let k = |f: &str| format!("materials[{i}].{f}");
+        let law = match m.kind.as_str() {
+            "elastic" => {
+                let e = positive(ctx, &k("E"), m.e.ok_or_else(|| ctx.err(k("E"), "missing"))?)?;
+                let nu = m.nu.ok_or_else(|| ctx.err(k("nu"), "missing"))?;
+                if !(nu > -1.0 && nu < 0.5) {
+                    return Err(ctx.err(
+                        k("nu"),
+                        format!("Poisson ratio must lie in (-1, 0.5) (got {nu})"),
+                    ));
+                }
+                let density = m.density.unwrap_or(0.0);
+                if !(density.is_finite() && density >= 0.0) {
+                    return Err(ctx.err(
+                        k("density"),
+                        format!("must be zero or positive (got {density})"),
+                    ));
+                }
+                if e < 1e6 {
+                    warnings.push(format!(
+                        "{}: {}: E = {e} Pa looks like MPa or GPa; segfem works in Pa",
+                        ctx.file,
+                        k("E")
+                    ));
+                }
+                if density > 0.0 && !(100.0..=20000.0).contains(&density) {
+                    warnings.push(format!(
+                        "{}: {}: density {density} kg/m³ is unusual; segfem works in kg/m³",
+                        ctx.file,
+                        k("density")
+                    ));
+                }
+                Material::Elastic { e, nu, density }
+            }
+            other => {
+                return Err(ctx.err(
+                    k("kind"),
+                    format!("unknown material kind '{other}' (expected elastic)"),
+                ))
+            }
+        };
+        materials.push(NamedMaterial {
+            name: m.name.clone(),
+            law,
+        });
+    }
+    // Regions.
+    unique_names(ctx, "regions", file.regions.iter().map(|r| r.name.as_str()))?;
+    let mut regions = Vec::new();
+    for (i, r) in file.regions.iter().enumerate() {
+        let material = index_by_name(
+            ctx,
+            &format!("regions[{i}].material"),
+            "material",
+            materials.iter().map(|m| m.name.as_str()),
+            &r.material,
+        )?;
+        let thickness = positive(ctx, &format!("regions[{i}].thickness"), r.thickness)?;
+        if thickness > 20.0 {
+            warnings.push(format!(
+                "{}: regions[{i}].thickness: {thickness} m is very large; thickness is in metres",
+                ctx.file
+            ));
+        }
+        regions.push(Region {
+            name: r.name.clone(),
+            material,
+            thickness,
+        });
+    }
+    let region_names = || regions.iter().map(|r| r.name.as_str());
+    // Mesh.
+    let mesh = file
+        .mesh
+        .as_ref()
+        .ok_or_else(|| ctx.err("mesh", "missing: give a [mesh] table"))?;
+    let (nodes, elements) = build_mesh(mesh, ctx, &region_names)?;
+    let mut model = Model {
+        title: file.title.clone().unwrap_or_default(),
+        nodes,
+        elements,
+        regions,
+        materials,
+        supports: Vec::new(),
+        load_cases: Vec::new(),
+        monitors: Vec::new(),
+        steps: Vec::new(),
+        controls: SolverControls::default(),
+    };
+    let mut used = vec![false; model.nodes.len()];
+    for e in &model.elements {
+        for &n in &e.nodes {
+            used[n] = true;
+        }
+    }
+    let unused = used.iter().filter(|u| !**u).count();
+    if unused > 0 {
+        warnings.push(format!(
+            "{}: mesh.nodes: {unused} node(s) belong to no element and are ignored (fixed)",
+            ctx.file
+        ));
+    }
+    // Supports.
+    unique_names(
+        ctx,
+        "supports",
+        file.supports.iter().map(|s| s.name.as_str()),
+    )?;
+    if file.supports.is_empty() {
+        return Err(ctx.err(
+            "supports",
+            "no supports given: the structure would be a mechanism",
+        ));
+    }
+    for (i, s) in file.supports.iter().enumerate() {
+        let key = format!("supports[{i}]");
+        let nodes = locate_nodes(ctx, &key, &model, &used, s.node, s.point, s.line)?;
+        let mut dofs = Vec::new();
+        for n in nodes {
+            if let Some(v) = s.ux {
+                dofs.push((n, Dir::X, v));
+            }
+            if let Some(v) = s.uy {
+                dofs.push((n, Dir::Y, v));
+            }
+        }
+        if s.ux.is_none() && s.uy.is_none() {
+            return Err(ctx.err(&key, "restrains nothing: give ux and/or uy (0.0 = fixed)"));
+        }
+        model.supports.push(Support {
+            name: s.name.clone(),
+            dofs,
+        });
+    }
+    // Unused nodes are held so that they add no zero pivots.
+    let held: Vec<(usize, Dir, f64)> = (0..model.nodes.len())
+        .filter(|&n| !used[n])
+        .flat_map(|n| [(n, Dir::X, 0.0), (n, Dir::Y, 0.0)])
+        .collect();
+    if !held.is_empty() {
+        model.supports.push(Support {
+            name: "(unused nodes)".into(),
+            dofs: held,
+        });
+    }
+    check_rigid_body(ctx, &model, &used)?;
+    // Load cases.
+    unique_names(
+        ctx,
+        "load_cases",
+        file.load_cases.iter().map(|c| c.name.as_str()),
+    )?;
+    for (i, c) in file.load_cases.iter().enumerate() {
+        let mut case = LoadCase {
+            name: c.name.clone(),
+            gravity: c.gravity,
+            ..Default::default()
+        };
+        for (j, p) in c.point_loads.iter().enumerate() {
+            let key = format!("load_cases[{i}].point_loads[{j}]");
+            if p.force.iter().any(|f| !f.is_finite()) {
+                return Err(ctx.err(format!("{key}.force"), "must be finite numbers"));
+            }
+            let n = locate_nodes(ctx, &key, &model, &used, p.node, p.point, None)?[0];
+            case.point_forces.push((n, p.force));
+        }
+        for (j, l) in c.line_loads.iter().enumerate() {
+            let key = format!("load_cases[{i}].line_loads[{j}]");
+            let edges = locate::edges_on_segment(&model, l.line[0], l.line[1]);
+            if edges.is_empty() {
+                return Err(ctx.err(
+                    format!("{key}.line"),
+                    format!(
+                        "no element edge lies on the segment {:?}–{:?}",
+                        l.line[0], l.line[1]
+                    ),
+                ));
+            }
+            for nodes in edges {
+                case.edge_loads.push(EdgeLoad { nodes, q: l.q });
+            }
+        }
+        model.load_cases.push(case);
+    }
+    // Monitors.
+    unique_names(
+        ctx,
+        "monitors",
+        file.monitors.iter().map(|m| m.name.as_str()),
+    )?;
+    for (i, m) in file.monitors.iter().enumerate() {
+        let key = format!("monitors[{i}]");
+        let kind = match m.kind.as_str() {
+            "displacement" => {
+                let node = locate_nodes(ctx, &key, &model, &used, m.node, m.point, None)?[0];
+                MonitorKind::Displacement {
+                    node,
+                    dir: dir(ctx, &format!("{key}.component"), m.component.as_deref())?,
+                }
+            }
+            "reaction" => {
+                let name = m
+                    .support
+                    .as_deref()
+                    .ok_or_else(|| ctx.err(format!("{key}.support"), "missing"))?;
+                let support = index_by_name(
+                    ctx,
+                    &format!("{key}.support"),
+                    "support",
+                    model.supports.iter().map(|s| s.name.as_str()),
+                    name,
+                )?;
+                MonitorKind::Reaction {
+                    support,
+                    dir: dir(ctx, &format!("{key}.component"), m.component.as_deref())?,
+                }
+            }
+            "load_factor" => {
+                let name = m
+                    .case
+                    .as_deref()
+                    .ok_or_else(|| ctx.err(format!("{key}.case"), "missing"))?;
+                MonitorKind::LoadFactor {
+                    case: index_by_name(
+                        ctx,
+                        &format!("{key}.case"),
+                        "load case",
+                        model.load_cases.iter().map(|c| c.name.as_str()),
+                        name,
+                    )?,
+                }
+            }
+            o => {
+                return Err(ctx.err(
+                    format!("{key}.kind"),
+                    format!(
+                    "unknown monitor kind '{o}' (expected displacement, reaction or load_factor)"
+                ),
+                ))
+            }
+        };
+        model.monitors.push(Monitor {
+            name: m.name.clone(),
+            kind,
+        });
+    }
+    // Steps.
+    if file.steps.is_empty() {
+        return Err(ctx.err("steps", "no steps given: add at least one [[steps]] table"));
+    }
+    unique_names(ctx, "steps", file.steps.iter().map(|s| s.name.as_str()))?;
+    let linear = model.materials.iter().all(|m| m.law.is_linear());
+    let mut factors = vec![0.0; model.load_cases.len()];
+    for (i, s) in file.steps.iter().enumerate() {
+        let key = format!("steps[{i}]");
+        let kind = match s.kind.as_str() {
+            "linear" => {
+                if !linear {
+                    return Err(ctx.err(
+                        format!("{key}.kind"),
+                        "a linear step needs linear materials; use kind = \"load\"",
+                    ));
+                }
+                StepKind::Linear
+            }
+            "load" => StepKind::Load,
+            o => {
+                return Err(ctx.err(
+                    format!("{key}.kind"),
+                    format!("unknown step kind '{o}' (expected linear or load)"),
+                ))
+            }
+        };
+        for (name, f) in &s.loads {
+            let c = index_by_name(
+                ctx,
+                &format!("{key}.loads.{name}"),
+                "load case",
+                model.load_cases.iter().map(|c| c.name.as_str()),
+                name,
+            )?;
+            if !f.is_finite() {
+                return Err(ctx.err(format!("{key}.loads.{name}"), "must be a finite number"));
+            }
+            factors[c] = *f;
+        }
+        let increments = s.increments.unwrap_or(1);
+        if increments == 0 || (kind == StepKind::Linear && increments != 1) {
+            return Err(ctx.err(
+                format!("{key}.increments"),
+                "must be at least 1 (and exactly 1 for a linear step)",
+            ));
+        }
+        let output_every_increment = match s.output.as_deref() {
+            None | Some("end") => false,
+            Some("increments") => true,
+            Some(o) => {
+                return Err(ctx.err(
+                    format!("{key}.output"),
+                    format!("unknown value '{o}' (expected end or increments)"),
+                ))
+            }
+        };
+        model.steps.push(Step {
+            name: s.name.clone(),
+            kind,
+            factors: factors.clone(),
+            increments,
+            output_every_increment,
+        });
+    }
+    if let Some(sv) = &file.solver {
+        let c = &mut model.controls;
+        if let Some(v) = sv.force_tolerance {
+            c.force_tolerance = positive(ctx, "solver.force_tolerance", v)?;
+        }
+        if let Some(v) = sv.energy_tolerance {
+            c.energy_tolerance = positive(ctx, "solver.energy_tolerance", v)?;
+        }
+        if let Some(v) = sv.max_iterations {
+            c.max_iterations = v.max(1);
+        }
+        if let Some(v) = sv.max_cuts {
+            c.max_cuts = v;
+        }
+    }
+    Ok(Built { model, warnings })
+}
+
+type Mesh = (Vec<[f64; 2]>, Vec<Element>);
+
+fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Mesh> {
+    match mesh.kind.as_str() {
+        "banded" => {
+            let length = positive(
+                ctx,
+                "mesh.length",
+                mesh.length
+                    .ok_or_else(|| ctx.err("mesh.length", "missing"))?,
+            )?;
+            let nx = mesh.nx.ok_or_else(|| ctx.err("mesh.nx", "missing"))?;
+            if nx == 0 {
+                return Err(ctx.err("mesh.nx", "must be at least 1"));
+            }
+            let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q4"))?;
+            let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
+            if mesh.bands.is_empty() {
+                return Err(ctx.err(
+                    "mesh.bands",
+                    "a banded mesh needs at least one [[mesh.bands]]",
+                ));
+            }
+            if !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
+                return Err(ctx.err("mesh", "a banded mesh takes no nodes or blocks"));
+            }
+            let mut bands = Vec::new();
+            for (i, b) in mesh.bands.iter().enumerate() {
+                let region = index_by_name(
+                    ctx,
+                    &format!("mesh.bands[{i}].region"),
+                    "region",
+                    region_names(),
+                    &b.region,
+                )?;
+                let depth = positive(ctx, &format!("mesh.bands[{i}].depth"), b.depth)?;
+                if b.rows == 0 {
+                    return Err(ctx.err(format!("mesh.bands[{i}].rows"), "must be at least 1"));
+                }
+                bands.push(Band {
+                    depth,
+                    rows: b.rows,
+                    region,
+                });
+            }
+            let origin = mesh.origin.unwrap_or([0.0, 0.0]);
+            let g = banded::generate(origin, length, nx, &bands, kind);
+            let elements = g
+                .elements
+                .into_iter()
+                .map(|(nodes, region)| Element {
+                    kind,
+                    nodes,
+                    region,
+                    integration: integ,
+                })
+                .collect();
+            Ok((g.nodes, elements))
+        }
+        "explicit" => {
+            if mesh.nodes.is_empty() {
+                return Err(ctx.err("mesh.nodes", "an explicit mesh needs nodes"));
+            }
+            if mesh.blocks.is_empty() {
+                return Err(ctx.err(
+                    "mesh.blocks",
+                    "an explicit mesh needs at least one [[mesh.blocks]]",
+                ));
+            }
+            for (i, p) in mesh.nodes.iter().enumerate() {
+                if !(p[0].is_finite() && p[1].is_finite()) {
+                    return Err(ctx.err(format!("mesh.nodes[{i}]"), "coordinates must be finite"));
+                }
+            }
+            let nn = mesh.nodes.len();
+            let mut elements = Vec::new();
+            for (b, blk) in mesh.blocks.iter().enumerate() {
+                let region = index_by_name(
+                    ctx,
+                    &format!("mesh.blocks[{b}].region"),
+                    "region",
+                    region_names(),
+                    &blk.region,
+                )?;
+                let kind = quad_kind(ctx, &format!("mesh.blocks[{b}].element"), &blk.element)?;
+                let integ = integration(
+                    ctx,
+                    &format!("mesh.blocks[{b}].integration"),
+                    blk.integration.as_deref(),
+                )?;
+                for (j, conn) in blk.elements.iter().enumerate() {
+                    let key = format!("mesh.blocks[{b}].elements[{j}]");
+                    if conn.len() != kind.n_nodes() {
+                        return Err(ctx.err(
+                            &key,
+                            format!(
+                                "a {kind:?} element needs {} nodes, got {}",
+                                kind.n_nodes(),
+                                conn.len()
+                            ),
+                        ));
+                    }
+                    let mut nodes = Vec::with_capacity(conn.len());
+                    for &id in conn {
+                        if id < 1 || id as usize > nn {
+                            return Err(ctx.err(
+                                &key,
+                                format!("unknown node {id} (nodes are numbered 1..={nn})"),
+                            ));
+                        }
+                        let n = id as usize - 1;
+                        if nodes.contains(&n) {
+                            return Err(ctx.err(&key, format!("node {id} is repeated")));
+                        }
+                        nodes.push(n);
+                    }
+                    let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.nodes[n]).collect();
+                    let detj = min_jacobian(kind, &coords, integ);
+                    if detj.is_nan() || detj <= 0.0 {
+                        return Err(ctx.err(
+                            &key,
+                            format!("element is inverted or degenerate (smallest det J = {detj:.3e}); list nodes counter-clockwise, corners first"),
+                        ));
+                    }
+                    elements.push(Element {
+                        kind,
+                        nodes,
+                        region,
+                        integration: integ,
+                    });
+                }
+            }
+            Ok((mesh.nodes.clone(), elements))
+        }
+        o => Err(ctx.err(
+            "mesh.type",
+            format!("unknown mesh type '{o}' (expected banded or explicit)"),
+        )),
+    }
+}
+
+/// Resolve exactly one of node / point / line to a non-empty node list.
+fn locate_nodes(
+    ctx: &Ctx,
+    key: &str,
+    model: &Model,
+    used: &[bool],
+    node: Option<i64>,
+    point: Option<[f64; 2]>,
+    line: Option<[[f64; 2]; 2]>,
+) -> R<Vec<usize>> {
+    let given = node.is_some() as u8 + point.is_some() as u8 + line.is_some() as u8;
+    if given != 1 {
+        return Err(ctx.err(key, "give exactly one of node, point or line"));
+    }
+    if let Some(id) = node {
+        let nn = model.nodes.len() as i64;
+        if id < 1 || id > nn || !used[id as usize - 1] {
+            return Err(ctx.err(
+                format!("{key}.node"),
+                format!("node {id} is not a node of an element (1..={nn})"),
+            ));
+        }
+        return Ok(vec![id as usize - 1]);
+    }
+    if let Some(p) = point {
+        if !locate::inside_mesh(model, p) {
+            return Err(ctx.err(
+                format!("{key}.point"),
+                format!("point {p:?} lies outside the mesh"),
+            ));
+        }
+        return Ok(vec![locate::nearest_node(model, used, p)]);
+    }
+    let [a, b] = line.expect("one location given");
+    let nodes = locate::nodes_on_segment(model, used, a, b);
+    if nodes.is_empty() {
+        return Err(ctx.err(
+            format!("{key}.line"),
+            format!("no node lies on the segment {a:?}–{b:?}"),
+        ));
+    }
+    Ok(nodes)
+}
+
+/// Each connected part of the mesh must be held against its three rigid-body motions: the
+/// constrained dofs must give rank 3 on the modes (1,0), (0,1), (−y, x).
+fn check_rigid_body(ctx: &Ctx, model: &Model, used: &[bool]) -> R<()> {
+    // Union–find over nodes through elements.
+    let mut parent: Vec<usize> = (0..model.nodes.len()).collect();
+    fn find(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for e in &model.elements {
+        let r0 = find(&mut parent, e.nodes[0]);
+        for &n in &e.nodes[1..] {
+            let r = find(&mut parent, n);
+            parent[r] = r0;
+        }
+    }
+    let mut rows: HashMap<usize, Vec<[f64; 3]>> = HashMap::new();
+    for s in &model.supports {
+        for &(n, d, _) in &s.dofs {
+            if !used[n] {
+                continue;
+            }
+            let [x, y] = model.nodes[n];
+            let row = match d {
+                Dir::X => [1.0, 0.0, -y],
+                Dir::Y => [0.0, 1.0, x],
+            };
+            rows.entry(find(&mut parent, n)).or_default().push(row);
+        }
+    }
+    let size = locate::model_size(model);
+    let mut checked = HashMap::new();
+    for e in &model.elements {
+        let root = find(&mut parent, e.nodes[0]);
+        if checked.contains_key(&root) {
+            continue;
+        }
+        let r = rows.get(&root).map(|v| rank3(v, size)).unwrap_or(0);
+        checked.insert(root, r);
+        if r < 3 {
+            let region = &model.regions[e.region].name;
+            return Err(ctx.err(
+                "supports",
+                format!(
+                    "the part of the mesh containing region '{region}' can move as a rigid body (supports restrain {r} of its 3 rigid-body motions)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Numerical rank of a set of 3-vectors (rotation column scaled by the model size).
+fn rank3(rows: &[[f64; 3]], size: f64) -> usize {
+    let mut m: Vec<[f64; 3]> = rows.iter().map(|r| [r[0], r[1], r[2] / size]).collect();
+    let mut rank = 0;
+    for c in 0..3 {
+        let piv = (rank..m.len()).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()));
+        let Some(p) = piv else { break };
+        if m[p][c].abs() < 1e-9 {
+            continue;
+        }
+        m.swap(rank, p);
+        for i in 0..m.len() {
+            if i != rank {
+                let f = m[i][c] / m[rank][c];
+                for k in 0..3 {
+                    m[i][k] -= f * m[rank][k];
+                }
+            }
+        }
+        rank += 1;
+    }
+    rank
+}

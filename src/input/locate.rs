@@ -1,0 +1,96 @@
+//! Geometric queries used while validating a model: which element contains a point, the
+//! nearest node, nodes and element edges on a line segment.
+
+use crate::model::Model;
+
+/// Length scale of the model (bounding-box diagonal) [m], for relative tolerances.
+pub fn model_size(model: &Model) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &model.nodes {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2))
+        .sqrt()
+        .max(f64::MIN_POSITIVE)
+}
+
+/// True if `p` lies inside or on the boundary (within `tol` [m]) of the straight-edged polygon
+/// of an element's corners.
+fn in_corners(corners: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
+    let n = corners.len();
+    (0..n).all(|i| {
+        let a = corners[i];
+        let b = corners[(i + 1) % n];
+        let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+        let len = (ex * ex + ey * ey).sqrt();
+        // Counter-clockwise element: inside is to the left of every edge.
+        (ex * (p[1] - a[1]) - ey * (p[0] - a[0])) / len >= -tol
+    })
+}
+
+/// True if `p` lies in some element of the mesh (within a tolerance of 1e-6 × model size).
+pub fn inside_mesh(model: &Model, p: [f64; 2]) -> bool {
+    let tol = 1e-6 * model_size(model);
+    model.elements.iter().any(|e| {
+        let c: Vec<[f64; 2]> = e.nodes[..4].iter().map(|&n| model.nodes[n]).collect();
+        in_corners(&c, p, tol)
+    })
+}
+
+/// The node nearest to `p`, among nodes used by elements.
+pub fn nearest_node(model: &Model, used: &[bool], p: [f64; 2]) -> usize {
+    let mut best = (f64::INFINITY, 0);
+    for (i, q) in model.nodes.iter().enumerate() {
+        if !used[i] {
+            continue;
+        }
+        let d = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+        if d < best.0 {
+            best = (d, i);
+        }
+    }
+    best.1
+}
+
+/// Distance from `p` to the segment a–b [m].
+pub fn dist_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = ex * ex + ey * ey;
+    let t = if l2 == 0.0 {
+        0.0
+    } else {
+        (((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / l2).clamp(0.0, 1.0)
+    };
+    let (cx, cy) = (a[0] + t * ex, a[1] + t * ey);
+    ((p[0] - cx).powi(2) + (p[1] - cy).powi(2)).sqrt()
+}
+
+/// Used nodes lying on the segment a–b (within 1e-6 × model size).
+pub fn nodes_on_segment(model: &Model, used: &[bool], a: [f64; 2], b: [f64; 2]) -> Vec<usize> {
+    let tol = 1e-6 * model_size(model);
+    (0..model.nodes.len())
+        .filter(|&i| used[i] && dist_to_segment(model.nodes[i], a, b) <= tol)
+        .collect()
+}
+
+/// Element edges (node lists start, end, [mid]) whose nodes all lie on the segment a–b.
+pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> Vec<Vec<usize>> {
+    let tol = 1e-6 * model_size(model);
+    let mut out = Vec::new();
+    for e in &model.elements {
+        for k in 0..4 {
+            let local = e.kind.edge_nodes(k);
+            let nodes: Vec<usize> = local.iter().map(|&l| e.nodes[l]).collect();
+            if nodes
+                .iter()
+                .all(|&n| dist_to_segment(model.nodes[n], a, b) <= tol)
+            {
+                out.push(nodes);
+            }
+        }
+    }
+    out
+}

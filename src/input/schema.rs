@@ -1,0 +1,152 @@
+//! The model-file schema (TOML), as read by serde. Every table rejects unknown keys so that a
+//! misspelt key is an error, not a silent default. Documented key by key in docs/input.md.
+
+#![allow(missing_docs)]
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct File {
+    pub title: Option<String>,
+    #[serde(default)]
+    pub materials: Vec<MaterialIn>,
+    #[serde(default)]
+    pub regions: Vec<RegionIn>,
+    pub mesh: Option<MeshIn>,
+    #[serde(default)]
+    pub supports: Vec<SupportIn>,
+    #[serde(default)]
+    pub load_cases: Vec<LoadCaseIn>,
+    #[serde(default)]
+    pub monitors: Vec<MonitorIn>,
+    #[serde(default)]
+    pub steps: Vec<StepIn>,
+    pub solver: Option<SolverIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialIn {
+    pub name: String,
+    pub kind: String,
+    #[serde(rename = "E")]
+    pub e: Option<f64>,
+    pub nu: Option<f64>,
+    pub density: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionIn {
+    pub name: String,
+    pub material: String,
+    pub thickness: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshIn {
+    #[serde(rename = "type")]
+    pub kind: String,
+    // banded
+    pub length: Option<f64>,
+    pub origin: Option<[f64; 2]>,
+    pub nx: Option<usize>,
+    pub element: Option<String>,
+    pub integration: Option<String>,
+    #[serde(default)]
+    pub bands: Vec<BandIn>,
+    // explicit
+    #[serde(default)]
+    pub nodes: Vec<[f64; 2]>,
+    #[serde(default)]
+    pub blocks: Vec<BlockIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BandIn {
+    pub region: String,
+    pub depth: f64,
+    pub rows: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockIn {
+    pub region: String,
+    pub element: String,
+    pub integration: Option<String>,
+    pub elements: Vec<Vec<i64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportIn {
+    pub name: String,
+    pub node: Option<i64>,
+    pub point: Option<[f64; 2]>,
+    pub line: Option<[[f64; 2]; 2]>,
+    pub ux: Option<f64>,
+    pub uy: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadCaseIn {
+    pub name: String,
+    pub gravity: Option<[f64; 2]>,
+    #[serde(default)]
+    pub point_loads: Vec<PointLoadIn>,
+    #[serde(default)]
+    pub line_loads: Vec<LineLoadIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoadIn {
+    pub node: Option<i64>,
+    pub point: Option<[f64; 2]>,
+    pub force: [f64; 2],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineLoadIn {
+    pub line: [[f64; 2]; 2],
+    pub q: [f64; 2],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorIn {
+    pub name: String,
+    pub kind: String,
+    pub node: Option<i64>,
+    pub point: Option<[f64; 2]>,
+    pub component: Option<String>,
+    pub support: Option<String>,
+    pub case: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepIn {
+    pub name: String,
+    pub kind: String,
+    #[serde(default)]
+    pub loads: BTreeMap<String, f64>,
+    pub increments: Option<usize>,
+    pub output: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverIn {
+    pub force_tolerance: Option<f64>,
+    pub energy_tolerance: Option<f64>,
+    pub max_iterations: Option<usize>,
+    pub max_cuts: Option<usize>,
+}

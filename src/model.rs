@@ -1,0 +1,220 @@
+//! The validated model as plain data: what input produces and the analysis consumes, so that
+//! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
+
+use crate::elements::continuum::Integration;
+use crate::fem::shape::QuadKind;
+use crate::materials::point::Material;
+use serde::Serialize;
+
+/// A continuum element.
+#[derive(Debug, Clone, Serialize)]
+pub struct Element {
+    /// Element kind.
+    pub kind: QuadKind,
+    /// Node indices (0-based), VTK order.
+    pub nodes: Vec<usize>,
+    /// Region index.
+    pub region: usize,
+    /// Integration rule.
+    pub integration: Integration,
+}
+
+/// A region: a set of elements sharing a material and a thickness.
+#[derive(Debug, Clone, Serialize)]
+pub struct Region {
+    /// User name.
+    pub name: String,
+    /// Material index.
+    pub material: usize,
+    /// Out-of-plane thickness [m].
+    pub thickness: f64,
+}
+
+/// A named material.
+#[derive(Debug, Clone, Serialize)]
+pub struct NamedMaterial {
+    /// User name.
+    pub name: String,
+    /// The law and its parameters.
+    pub law: Material,
+}
+
+/// Direction of a degree of freedom.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Dir {
+    /// Horizontal (x).
+    X,
+    /// Vertical (y).
+    Y,
+}
+
+impl Dir {
+    /// 0 for x, 1 for y.
+    pub fn index(self) -> usize {
+        match self {
+            Dir::X => 0,
+            Dir::Y => 1,
+        }
+    }
+}
+
+/// A named support: a set of constrained dofs with prescribed values.
+#[derive(Debug, Clone, Serialize)]
+pub struct Support {
+    /// User name (used by reaction monitors).
+    pub name: String,
+    /// Constrained (node, direction, prescribed displacement [m]).
+    pub dofs: Vec<(usize, Dir, f64)>,
+}
+
+/// A uniform line load on one element edge.
+#[derive(Debug, Clone, Serialize)]
+pub struct EdgeLoad {
+    /// Node indices of the edge (start, end, [mid]).
+    pub nodes: Vec<usize>,
+    /// Force per unit length of edge [N/m].
+    pub q: [f64; 2],
+}
+
+/// A named load case; steps scale load cases by factors.
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct LoadCase {
+    /// User name.
+    pub name: String,
+    /// Nodal point forces: (node, [Fx, Fy] [N]).
+    pub point_forces: Vec<(usize, [f64; 2])>,
+    /// Edge loads.
+    pub edge_loads: Vec<EdgeLoad>,
+    /// Gravity acceleration [m/s²] applied to all regions' density, if any.
+    pub gravity: Option<[f64; 2]>,
+}
+
+/// What a monitor records.
+#[derive(Debug, Clone, Serialize)]
+pub enum MonitorKind {
+    /// Displacement component of a node [m].
+    Displacement {
+        /// Node index.
+        node: usize,
+        /// Component.
+        dir: Dir,
+    },
+    /// Sum of the reactions of a support in one direction [N].
+    Reaction {
+        /// Support index.
+        support: usize,
+        /// Component.
+        dir: Dir,
+    },
+    /// Current factor of a load case [-].
+    LoadFactor {
+        /// Load case index.
+        case: usize,
+    },
+}
+
+/// A named monitor: one column of `history.csv`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Monitor {
+    /// User name.
+    pub name: String,
+    /// What it records.
+    pub kind: MonitorKind,
+}
+
+impl Monitor {
+    /// Unit of the recorded quantity.
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            MonitorKind::Displacement { .. } => "m",
+            MonitorKind::Reaction { .. } => "N",
+            MonitorKind::LoadFactor { .. } => "-",
+        }
+    }
+}
+
+/// The kind of an analysis step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum StepKind {
+    /// One linear solve with the initial stiffness (the material must be linear).
+    Linear,
+    /// Incremental load control with Newton–Raphson.
+    Load,
+}
+
+/// An analysis step: load factors are the totals reached at the end of the step, reached
+/// linearly from those at the end of the previous step.
+#[derive(Debug, Clone, Serialize)]
+pub struct Step {
+    /// User name.
+    pub name: String,
+    /// Kind.
+    pub kind: StepKind,
+    /// Target factor per load case (index = load case).
+    pub factors: Vec<f64>,
+    /// Number of equal increments.
+    pub increments: usize,
+    /// Write field output (VTU) at every increment, not only at the end of the step.
+    pub output_every_increment: bool,
+}
+
+/// Newton and step-cutting controls.
+#[derive(Debug, Clone, Serialize)]
+pub struct SolverControls {
+    /// Relative force-residual tolerance.
+    pub force_tolerance: f64,
+    /// Relative energy tolerance.
+    pub energy_tolerance: f64,
+    /// Maximum Newton iterations per increment.
+    pub max_iterations: usize,
+    /// Maximum number of times an increment may be halved.
+    pub max_cuts: usize,
+}
+
+impl Default for SolverControls {
+    fn default() -> Self {
+        Self {
+            force_tolerance: 1e-6,
+            energy_tolerance: 1e-12,
+            max_iterations: 25,
+            max_cuts: 6,
+        }
+    }
+}
+
+/// The complete validated model.
+#[derive(Debug, Clone, Serialize)]
+pub struct Model {
+    /// Title.
+    pub title: String,
+    /// Node coordinates [m].
+    pub nodes: Vec<[f64; 2]>,
+    /// Continuum elements.
+    pub elements: Vec<Element>,
+    /// Regions.
+    pub regions: Vec<Region>,
+    /// Materials.
+    pub materials: Vec<NamedMaterial>,
+    /// Supports.
+    pub supports: Vec<Support>,
+    /// Load cases.
+    pub load_cases: Vec<LoadCase>,
+    /// Monitors.
+    pub monitors: Vec<Monitor>,
+    /// Steps, in order.
+    pub steps: Vec<Step>,
+    /// Solver controls.
+    pub controls: SolverControls,
+}
+
+impl Model {
+    /// Node coordinates of an element, in its node order.
+    pub fn element_coords(&self, e: &Element) -> Vec<[f64; 2]> {
+        e.nodes.iter().map(|&n| self.nodes[n]).collect()
+    }
+
+    /// Number of degrees of freedom (2 per node).
+    pub fn n_dofs(&self) -> usize {
+        2 * self.nodes.len()
+    }
+}
