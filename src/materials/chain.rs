@@ -14,7 +14,7 @@
 //!   ΔR_0 = E_ci(t') at loading).
 //! * E_μ(t') by least squares on R over durations 0.1 … 1e4 d (§4.4); the moduli are cached
 //!   per age. A negative modulus (bad τ set) is removed by an active-set step (the unit is
-//!   set to zero and the others refitted) **[DECISION]**.
+//!   set to zero and the others refitted) **\[DECISION\]**.
 //! * Exponential algorithm (§4.5) with E_μ at the mid-step age; plane stress acts on the
 //!   unit-modulus elastic matrix D1(ν) (isotropic, constant ν).
 //!
@@ -31,17 +31,17 @@ pub const DEFAULT_UNITS: usize = 5;
 /// Numerical settings of the chain identification.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainSettings {
-    /// Relaxation times τ_μ [days], increasing; `f64::INFINITY` = pure spring unit.
+    /// Relaxation times τ_μ \[days\], increasing; `f64::INFINITY` = pure spring unit.
     pub taus: Vec<f64>,
-    /// First duration t − t' of the step-by-step grid for R [days] (default 1e-3).
+    /// First duration t − t' of the step-by-step grid for R \[days\] (default 1e-3).
     pub r_grid_start: f64,
     /// Grid points per decade of the step-by-step grid (default 10).
     pub points_per_decade: usize,
-    /// Shortest duration used in the least-squares fit [days] (default 0.1).
+    /// Shortest duration used in the least-squares fit \[days\] (default 0.1).
     pub fit_min: f64,
-    /// Longest duration used in the least-squares fit and of the R grid [days] (default 1e4).
+    /// Longest duration used in the least-squares fit and of the R grid \[days\] (default 1e4).
     pub fit_max: f64,
-    /// Ages below this are clamped before fitting [days] (default 1; MC90 is not meant for
+    /// Ages below this are clamped before fitting \[days\] (default 1; MC90 is not meant for
     /// younger concrete and E_ci(t) → 0 as t → 0).
     pub min_age: f64,
 }
@@ -161,7 +161,7 @@ impl MaxwellChain {
         &self.settings
     }
 
-    /// Relaxation times τ_μ [days] (last one may be infinite).
+    /// Relaxation times τ_μ \[days\] (last one may be infinite).
     pub fn taus(&self) -> &[f64] {
         &self.settings.taus
     }
@@ -171,7 +171,7 @@ impl MaxwellChain {
         self.settings.taus.len()
     }
 
-    /// Unit moduli E_μ(t') [Pa] at concrete age `age` [days] (clamped to
+    /// Unit moduli E_μ(t') \[Pa\] at concrete age `age` \[days\] (clamped to
     /// `settings.min_age`), from the cache or a new least-squares fit.
     ///
     /// Panics only if the identification fails at that age, which the check in
@@ -200,7 +200,7 @@ impl MaxwellChain {
         Ok(e)
     }
 
-    /// Chain relaxation function Σ E_μ(t') exp(−(t − t')/τ_μ) [Pa] (ages in days).
+    /// Chain relaxation function Σ E_μ(t') exp(−(t − t')/τ_μ) \[Pa\] (ages in days).
     pub fn chain_relaxation(&self, t: f64, t_prime: f64) -> f64 {
         let e = self.unit_moduli(t_prime);
         let d = (t - t_prime).max(0.0);
@@ -258,8 +258,8 @@ fn geometric_grid(start: f64, end: f64, per_decade: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Relaxation function R(t' + d_k, t') [Pa] of the MC90 compliance for loading age
-/// `t_prime` [days], at the increasing durations `durations` [days] (all > 0), by the
+/// Relaxation function R(t' + d_k, t') \[Pa\] of the MC90 compliance for loading age
+/// `t_prime` \[days\], at the increasing durations `durations` \[days\] (all > 0), by the
 /// step-by-step midpoint method of MODEL.md §4.3 (jump ΔR_0 = 1/J(t', t') = E_ci(t') at
 /// loading, then the grid given by `durations`; accuracy depends on that grid — about
 /// 0.3 % with 30 points per decade from 1e-3 d).
@@ -390,11 +390,11 @@ fn gauss_solve(a: &mut [Vec<f64>], b: &mut [f64]) -> Option<Vec<f64>> {
 // ---------------------------------------------------------------------------------------
 
 /// Hidden state of a chain at one Gauss point: the stress of every unit, plane-stress Voigt
-/// (σx, σy, τxy) [Pa]. The total stress is the sum over units. An empty vector means a
+/// (σx, σy, τxy) \[Pa\]. The total stress is the sum over units. An empty vector means a
 /// virgin (stress-free) point.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ChainState {
-    /// Unit stresses σ_μ [Pa], one 3-vector per unit.
+    /// Unit stresses σ_μ \[Pa\], one 3-vector per unit.
     pub hidden: Vec<[f64; 3]>,
 }
 
@@ -406,7 +406,7 @@ impl ChainState {
         }
     }
 
-    /// Total stress Σ_μ σ_μ [Pa].
+    /// Total stress Σ_μ σ_μ \[Pa\].
     pub fn stress(&self) -> [f64; 3] {
         self.hidden
             .iter()
@@ -417,11 +417,11 @@ impl ChainState {
 /// Result of one time step of the chain.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainStep {
-    /// Stress increment Δσ [Pa] (Voigt, engineering shear).
+    /// Stress increment Δσ \[Pa\] (Voigt, engineering shear).
     pub d_stress: [f64; 3],
-    /// Incremental modulus E'' [Pa]; the step tangent is E'' D1(ν).
+    /// Incremental modulus E'' \[Pa\]; the step tangent is E'' D1(ν).
     pub e_incr: f64,
-    /// Stress-independent creep strain increment Δε'' [-] (the initial strain of the step;
+    /// Stress-independent creep strain increment Δε'' \[-\] (the initial strain of the step;
     /// its pseudo-load is ∫ Bᵀ E'' D1 Δε'' dΩ).
     pub d_creep_strain: [f64; 3],
     /// Updated hidden state.
@@ -431,19 +431,19 @@ pub struct ChainStep {
 /// Step quantities known at the start of a step (before the strain increment is known).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainPredictor {
-    /// Incremental modulus E'' [Pa].
+    /// Incremental modulus E'' \[Pa\].
     pub e_incr: f64,
-    /// Creep strain increment Δε'' [-].
+    /// Creep strain increment Δε'' \[-\].
     pub d_creep_strain: [f64; 3],
-    /// Decay factors β_μ = exp(−Δt/τ_μ) [-].
+    /// Decay factors β_μ = exp(−Δt/τ_μ) \[-\].
     pub beta: Vec<f64>,
-    /// Factors λ_μ = (1 − β_μ)/(Δt/τ_μ) [-].
+    /// Factors λ_μ = (1 − β_μ)/(Δt/τ_μ) \[-\].
     pub lambda: Vec<f64>,
-    /// Unit moduli at the mid-step age [Pa].
+    /// Unit moduli at the mid-step age \[Pa\].
     pub moduli: Vec<f64>,
 }
 
-/// Plane-stress elastic matrix for unit modulus, D1(ν) = 1/(1−ν²)[[1,ν,0],[ν,1,0],[0,0,(1−ν)/2]].
+/// Plane-stress elastic matrix for unit modulus, D1(ν) = `1/(1−ν²) [[1,ν,0],[ν,1,0],[0,0,(1−ν)/2]]`.
 pub fn plane_stress_d1(nu: f64) -> [[f64; 3]; 3] {
     let c = 1.0 / (1.0 - nu * nu);
     [
@@ -453,7 +453,7 @@ pub fn plane_stress_d1(nu: f64) -> [[f64; 3]; 3] {
     ]
 }
 
-/// Inverse of [`plane_stress_d1`]: [[1,−ν,0],[−ν,1,0],[0,0,2(1+ν)]].
+/// Inverse of [`plane_stress_d1`]: `[[1,−ν,0],[−ν,1,0],[0,0,2(1+ν)]]`.
 pub fn plane_stress_d1_inv(nu: f64) -> [[f64; 3]; 3] {
     [
         [1.0, -nu, 0.0],
@@ -480,7 +480,7 @@ fn beta_lambda(dt: f64, tau: f64) -> (f64, f64) {
     (1.0 + em1, -em1 / y)
 }
 
-/// Quantities of the step from concrete age `t_from` to `t_to` [days] that do not depend on
+/// Quantities of the step from concrete age `t_from` to `t_to` \[days\] that do not depend on
 /// the strain increment: E'' and Δε'' (MODEL.md §4.5), with the unit moduli at the mid-step
 /// age ½(t_from + t_to). `nu` = Poisson ratio (constant). Panics if `t_to < t_from`.
 pub fn chain_predictor(
@@ -514,9 +514,9 @@ pub fn chain_predictor(
     }
 }
 
-/// One exponential-algorithm step (MODEL.md §4.5) from age `t_from` to `t_to` [days] for a
-/// total-strain increment `d_strain` [-] (Voigt, engineering shear) with an imposed
-/// stress-free strain increment `d_imposed` [-] (shrinkage, temperature, …):
+/// One exponential-algorithm step (MODEL.md §4.5) from age `t_from` to `t_to` \[days\] for a
+/// total-strain increment `d_strain` \[-\] (Voigt, engineering shear) with an imposed
+/// stress-free strain increment `d_imposed` \[-\] (shrinkage, temperature, …):
 ///
 /// Δσ = E'' D1 (Δε − Δε'' − Δε_imp),  σ_μ ← β_μ σ_μ + λ_μ E_μ D1 (Δε − Δε_imp).
 pub fn chain_step_imposed(
@@ -566,7 +566,7 @@ pub fn chain_step_imposed(
 }
 
 /// One chain step with shrinkage as the imposed strain: Δε_imp = Δε_sh (1, 1, 0), where
-/// `d_shrinkage` = ε_cs(t_to) − ε_cs(t_from) [-] (negative = shortening). Ages in days,
+/// `d_shrinkage` = ε_cs(t_to) − ε_cs(t_from) \[-\] (negative = shortening). Ages in days,
 /// `nu` the Poisson ratio. See [`chain_step_imposed`].
 pub fn chain_step(
     chain: &MaxwellChain,
@@ -597,35 +597,35 @@ pub fn chain_step(
 /// initial stress ratio (the paper: "the same rheological model … for the prestressing
 /// steel relaxation"). Linear: under a varying strain the loss follows by superposition.
 ///
-/// **[DECISION]** MODEL.md §4.6 notes that five units represent the power law poorly
+/// **\[DECISION\]** MODEL.md §4.6 notes that five units represent the power law poorly
 /// (≈ 35 % error on the 1000 h loss). Since the chain is uniaxial and cheap, the default uses
 /// two units per decade, τ = 10^(k/2) × 1e-3 d up to 1e5 d, plus a spring, and fits the loss
 /// with relative weights on 1e-3 … 2e4 d (≈ 1.4 min … 5·10⁵ h) under the constraint
 /// R(0) = E_p.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SteelRelaxationChain {
-    /// Elastic modulus E_p [Pa].
+    /// Elastic modulus E_p \[Pa\].
     pub ep: f64,
-    /// Relaxation times [days]; the last is `f64::INFINITY`.
+    /// Relaxation times \[days\]; the last is `f64::INFINITY`.
     pub taus: Vec<f64>,
-    /// Unit moduli as fractions a_μ of E_p (Σ a_μ = 1) [-].
+    /// Unit moduli as fractions a_μ of E_p (Σ a_μ = 1) \[-\].
     pub fractions: Vec<f64>,
 }
 
 /// Result of a uniaxial chain step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UniaxialChainStep {
-    /// Stress increment [Pa].
+    /// Stress increment \[Pa\].
     pub d_stress: f64,
-    /// Incremental modulus E'' [Pa].
+    /// Incremental modulus E'' \[Pa\].
     pub e_incr: f64,
-    /// Updated unit stresses [Pa].
+    /// Updated unit stresses \[Pa\].
     pub new_hidden: Vec<f64>,
 }
 
 impl SteelRelaxationChain {
-    /// Chain fitted to the MC90 loss of `class` at initial stress ratio σ_pi/f_ptk [-], with
-    /// modulus `ep` [Pa] and the default relaxation times (see the type documentation).
+    /// Chain fitted to the MC90 loss of `class` at initial stress ratio σ_pi/f_ptk \[-\], with
+    /// modulus `ep` \[Pa\] and the default relaxation times (see the type documentation).
     /// Below 0.5 f_ptk (no relaxation) the chain is a single spring.
     pub fn fit(
         class: RelaxationClass,
@@ -646,7 +646,7 @@ impl SteelRelaxationChain {
         Self::fit_to_loss(ep, Self::default_taus(), loss, 1e-3, 2e4)
     }
 
-    /// Default relaxation times [days]: 1e-3 · 10^(k/2), k = 0 … 16 (1e-3 … 1e5 d), then ∞.
+    /// Default relaxation times \[days\]: 1e-3 · 10^(k/2), k = 0 … 16 (1e-3 … 1e5 d), then ∞.
     pub fn default_taus() -> Vec<f64> {
         let mut t: Vec<f64> = (0..=16)
             .map(|k| 1e-3 * 10f64.powf(k as f64 / 2.0))
@@ -656,7 +656,7 @@ impl SteelRelaxationChain {
     }
 
     /// Fit the unit fractions to a loss function `loss(t_days)` (fraction of the initial
-    /// stress) on durations `t_min … t_max` [days] (10 points per decade), minimising the
+    /// stress) on durations `t_min … t_max` \[days\] (10 points per decade), minimising the
     /// relative error of the loss; the last τ must be infinite (it takes 1 − Σ a_finite).
     pub fn fit_to_loss(
         ep: f64,
@@ -713,7 +713,7 @@ impl SteelRelaxationChain {
         self.taus.len()
     }
 
-    /// Relative chain loss 1 − R(t)/E_p after `t_days` [days] at constant strain [-].
+    /// Relative chain loss 1 − R(t)/E_p after `t_days` \[days\] at constant strain \[-\].
     pub fn loss(&self, t_days: f64) -> f64 {
         1.0 - self
             .fractions
@@ -723,8 +723,8 @@ impl SteelRelaxationChain {
             .sum::<f64>()
     }
 
-    /// One exponential step of length `dt` [days] with strain increment `d_strain` [-]
-    /// (stress-free strain already removed); `hidden` = unit stresses [Pa] (empty = virgin).
+    /// One exponential step of length `dt` \[days\] with strain increment `d_strain` \[-\]
+    /// (stress-free strain already removed); `hidden` = unit stresses \[Pa\] (empty = virgin).
     pub fn step(&self, hidden: &[f64], dt: f64, d_strain: f64) -> UniaxialChainStep {
         assert!(dt >= 0.0, "chain step backwards in time");
         let mut e_incr = 0.0;
@@ -946,6 +946,43 @@ mod tests {
             .unwrap();
         assert!(rel(ef, eff) < rel(ec, ef).max(1e-6));
         assert!(rel(ef, eff) < 0.005, "fine {ef} finer {eff}");
+    }
+
+    /// The step is linear in the strain increment with tangent E'' D1(ν) (what the FE core
+    /// assembles), and the returned stress increment equals the change of Σ σ_μ.
+    /// Tolerance 1e-9 relative: pure round-off of an exactly linear map.
+    #[test]
+    fn step_tangent_and_state_consistency() {
+        let p = params();
+        let chain = MaxwellChain::fit(&p, 5).unwrap();
+        let nu = 0.18;
+        let mut st = ChainState::new(5);
+        st = chain_step(&chain, nu, &st, 28.0, 28.0, &[-3e-5, 1e-5, 2e-5], 0.0).new_state;
+        let base = chain_step(&chain, nu, &st, 28.0, 40.0, &[1e-6, -2e-6, 3e-6], -1e-6);
+        let d1 = plane_stress_d1(nu);
+        for j in 0..3 {
+            let mut de = [1e-6, -2e-6, 3e-6];
+            de[j] += 1e-7;
+            let s = chain_step(&chain, nu, &st, 28.0, 40.0, &de, -1e-6);
+            for (i, d1row) in d1.iter().enumerate() {
+                let k = (s.d_stress[i] - base.d_stress[i]) / 1e-7;
+                let expect = base.e_incr * d1row[j];
+                assert!((k - expect).abs() <= 1e-6 * base.e_incr, "K[{i}][{j}]");
+            }
+        }
+        let before = st.stress();
+        let after = base.new_state.stress();
+        for i in 0..3 {
+            assert!((after[i] - before[i] - base.d_stress[i]).abs() <= 1e-9 * before[0].abs());
+        }
+        // E'' lies between the spring-only modulus and Σ E_μ; Δt = 0 gives Σ E_μ.
+        let e = chain.unit_moduli(34.0);
+        assert!(base.e_incr < e.iter().sum::<f64>() && base.e_incr > e[4]);
+        let z = chain_step(&chain, nu, &st, 40.0, 40.0, &[0.0; 3], 0.0);
+        assert!(rel(z.e_incr, chain.unit_moduli(40.0).iter().sum()) < 1e-12);
+        assert!(z.d_stress.iter().all(|v| *v == 0.0));
+        // Ages below min_age are clamped (MC90 is not meant for < 1 d).
+        assert_eq!(chain.unit_moduli(0.2), chain.unit_moduli(1.0));
     }
 
     /// Free shrinkage of an unrestrained point produces no stress; fully restrained

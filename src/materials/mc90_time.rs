@@ -23,7 +23,7 @@ const H_REF: f64 = 0.1;
 const FCMO: f64 = 10.0e6;
 /// Reference time t1 = 1 day.
 const T1: f64 = 1.0;
-/// MC90 age at which the 28-day values apply [days].
+/// MC90 age at which the 28-day values apply \[days\].
 const T28: f64 = 28.0;
 
 /// Errors from invalid time-model input.
@@ -52,7 +52,7 @@ pub enum CementClass {
 }
 
 impl CementClass {
-    /// Strength-development coefficient s of β_cc(t) [-] (MODEL.md §2.1).
+    /// Strength-development coefficient s of β_cc(t) \[-\] (MODEL.md §2.1).
     pub fn s(self) -> f64 {
         match self {
             CementClass::SL => 0.38,
@@ -60,7 +60,7 @@ impl CementClass {
             CementClass::RS => 0.20,
         }
     }
-    /// Shrinkage coefficient β_sc [-] (MODEL.md §3.2).
+    /// Shrinkage coefficient β_sc \[-\] (MODEL.md §3.2).
     pub fn beta_sc(self) -> f64 {
         match self {
             CementClass::SL => 4.0,
@@ -68,7 +68,7 @@ impl CementClass {
             CementClass::RS => 8.0,
         }
     }
-    /// Exponent α of the cement-type adjustment of the loading age [-] (MODEL.md §3.1).
+    /// Exponent α of the cement-type adjustment of the loading age \[-\] (MODEL.md §3.1).
     pub fn alpha(self) -> f64 {
         match self {
             CementClass::SL => -1.0,
@@ -81,16 +81,16 @@ impl CementClass {
 /// Input of the MC90 creep and shrinkage functions for one concrete.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CreepShrinkageParams {
-    /// Mean 28-day compressive strength f_cm [Pa].
+    /// Mean 28-day compressive strength f_cm \[Pa\].
     pub fcm: f64,
     /// Ambient relative humidity as a fraction, 0 < rh ≤ 1 (0.7 = 70 %). MC90 covers
     /// 0.4 … 1.0; values below 0.4 are extrapolated with the same formulas.
     pub rh: f64,
-    /// Notional size h = 2 A_c / u [m] (A_c cross-section area, u perimeter exposed to drying).
+    /// Notional size h = 2 A_c / u \[m\] (A_c cross-section area, u perimeter exposed to drying).
     pub h0: f64,
     /// Cement class.
     pub cement: CementClass,
-    /// Age at the start of drying t_s [days]; shrinkage is zero before it.
+    /// Age at the start of drying t_s \[days\]; shrinkage is zero before it.
     pub t_shrinkage_start: f64,
     /// Apply the MC90 cement-type adjustment of the loading age in β(t0) (default off).
     #[serde(default)]
@@ -141,12 +141,12 @@ impl CreepShrinkageParams {
         Ok(())
     }
 
-    /// 28-day tangent modulus E_ci = 21500 (fcm/10 MPa)^(1/3) MPa [Pa] (MODEL.md §2.1).
+    /// 28-day tangent modulus E_ci = 21500 (fcm/10 MPa)^(1/3) MPa \[Pa\] (MODEL.md §2.1).
     pub fn eci(&self) -> f64 {
         21_500.0e6 * (self.fcm / FCMO).cbrt()
     }
 
-    /// Age [days] after the temperature adjustment (identity when `temperature` is `None`):
+    /// Age \[days\] after the temperature adjustment (identity when `temperature` is `None`):
     /// t_T = t · exp[13.65 − 4000/(273 + T)] for a constant temperature T.
     pub fn temperature_adjusted_age(&self, t: f64) -> f64 {
         match self.temperature {
@@ -155,29 +155,29 @@ impl CreepShrinkageParams {
         }
     }
 
-    /// Strength-development function β_cc(t) = exp{s [1 − (28/t)^½]} [-], t = age in days
+    /// Strength-development function β_cc(t) = exp{s [1 − (28/t)^½]} \[-\], t = age in days
     /// (temperature-adjusted if enabled).
     pub fn beta_cc(&self, t: f64) -> f64 {
         let t = self.temperature_adjusted_age(t);
         (self.cement.s() * (1.0 - (T28 / t).sqrt())).exp()
     }
 
-    /// Mean compressive strength at age t [days]: f_cm(t) = β_cc(t) f_cm [Pa].
+    /// Mean compressive strength at age t \[days\]: f_cm(t) = β_cc(t) f_cm \[Pa\].
     pub fn fcm_at(&self, t: f64) -> f64 {
         self.beta_cc(t) * self.fcm
     }
 
-    /// Tangent modulus at age t [days]: E_ci(t) = β_cc(t)^½ E_ci [Pa].
+    /// Tangent modulus at age t \[days\]: E_ci(t) = β_cc(t)^½ E_ci \[Pa\].
     pub fn eci_at(&self, t: f64) -> f64 {
         self.beta_cc(t).sqrt() * self.eci()
     }
 
-    /// Ratio h/h_ref with h_ref = 100 mm [-].
+    /// Ratio h/h_ref with h_ref = 100 mm \[-\].
     fn h_ratio(&self) -> f64 {
         self.h0 / H_REF
     }
 
-    /// Relative-humidity factor φ_RH = 1 + (1 − RH/RH0)/(0.46 (h/h0)^⅓) [-]
+    /// Relative-humidity factor φ_RH = 1 + (1 − RH/RH0)/(0.46 (h/h0)^⅓) \[-\]
     /// (with the temperature correction φ_RH,T when `temperature` is set).
     pub fn phi_rh(&self) -> f64 {
         let phi = 1.0 + (1.0 - self.rh / RH0) / (0.46 * self.h_ratio().cbrt());
@@ -190,12 +190,12 @@ impl CreepShrinkageParams {
         }
     }
 
-    /// Strength factor β(fcm) = 5.3/(fcm/fcmo)^½ [-].
+    /// Strength factor β(fcm) = 5.3/(fcm/fcmo)^½ \[-\].
     pub fn beta_fcm(&self) -> f64 {
         5.3 / (self.fcm / FCMO).sqrt()
     }
 
-    /// Loading age [days] entering β(t0): temperature-adjusted and, if enabled,
+    /// Loading age \[days\] entering β(t0): temperature-adjusted and, if enabled,
     /// cement-adjusted t0 = t0,T [9/(2 + t0,T^1.2) + 1]^α ≥ 0.5 d.
     pub fn effective_loading_age(&self, t0: f64) -> f64 {
         let t0t = self.temperature_adjusted_age(t0);
@@ -207,17 +207,17 @@ impl CreepShrinkageParams {
         }
     }
 
-    /// Loading-age factor β(t0) = 1/(0.1 + (t0/t1)^0.2) [-], t0 in days.
+    /// Loading-age factor β(t0) = 1/(0.1 + (t0/t1)^0.2) \[-\], t0 in days.
     pub fn beta_t0(&self, t0: f64) -> f64 {
         1.0 / (0.1 + (self.effective_loading_age(t0) / T1).powf(0.2))
     }
 
-    /// Notional creep coefficient φ0(t0) = φ_RH β(fcm) β(t0) [-].
+    /// Notional creep coefficient φ0(t0) = φ_RH β(fcm) β(t0) \[-\].
     pub fn phi0(&self, t0: f64) -> f64 {
         self.phi_rh() * self.beta_fcm() * self.beta_t0(t0)
     }
 
-    /// Humidity/size coefficient β_H = 150 [1 + (1.2 RH/RH0)^18] (h/h0) + 250 ≤ 1500 [days]
+    /// Humidity/size coefficient β_H = 150 [1 + (1.2 RH/RH0)^18] (h/h0) + 250 ≤ 1500 \[days\]
     /// (times exp[1500/(273 + T) − 5.12] when `temperature` is set).
     pub fn beta_h(&self) -> f64 {
         let bh =
@@ -228,7 +228,7 @@ impl CreepShrinkageParams {
         }
     }
 
-    /// Time development of creep β_c(t − t0) = [(t − t0)/(β_H + t − t0)]^0.3 [-];
+    /// Time development of creep β_c(t − t0) = [(t − t0)/(β_H + t − t0)]^0.3 \[-\];
     /// zero for t ≤ t0 (durations in days).
     pub fn beta_c(&self, duration: f64) -> f64 {
         if duration <= 0.0 {
@@ -237,12 +237,12 @@ impl CreepShrinkageParams {
         (duration / (self.beta_h() + duration)).powf(0.3)
     }
 
-    /// Notional shrinkage ε_s(fcm) = [160 + 10 β_sc (9 − fcm/fcmo)]·1e-6 [-].
+    /// Notional shrinkage ε_s(fcm) = [160 + 10 β_sc (9 − fcm/fcmo)]·1e-6 \[-\].
     pub fn eps_s(&self) -> f64 {
         (160.0 + 10.0 * self.cement.beta_sc() * (9.0 - self.fcm / FCMO)) * 1e-6
     }
 
-    /// Humidity factor of shrinkage β_RH [-]: −1.55 [1 − (RH/RH0)³] for RH < 99 %,
+    /// Humidity factor of shrinkage β_RH \[-\]: −1.55 [1 − (RH/RH0)³] for RH < 99 %,
     /// +0.25 for RH ≥ 99 % (swelling under water).
     pub fn beta_rh(&self) -> f64 {
         if self.rh >= 0.99 {
@@ -252,12 +252,12 @@ impl CreepShrinkageParams {
         }
     }
 
-    /// Notional shrinkage coefficient ε_cso = ε_s(fcm) β_RH [-].
+    /// Notional shrinkage coefficient ε_cso = ε_s(fcm) β_RH \[-\].
     pub fn eps_cso(&self) -> f64 {
         self.eps_s() * self.beta_rh()
     }
 
-    /// Time development of shrinkage β_s(t − ts) = [(t − ts)/(350 (h/h0)² + t − ts)]^½ [-];
+    /// Time development of shrinkage β_s(t − ts) = [(t − ts)/(350 (h/h0)² + t − ts)]^½ \[-\];
     /// zero for t ≤ ts (durations in days).
     pub fn beta_s(&self, duration: f64) -> f64 {
         if duration <= 0.0 {
@@ -268,26 +268,26 @@ impl CreepShrinkageParams {
     }
 }
 
-/// MC90 creep coefficient φ(t, t0) = φ0(t0) β_c(t − t0) [-] for loading at age `t0` and
+/// MC90 creep coefficient φ(t, t0) = φ0(t0) β_c(t − t0) \[-\] for loading at age `t0` and
 /// observation at age `t` (both days; 0 for t ≤ t0). Linear creep, |σ| ≤ 0.4 f_cm(t0).
 pub fn creep_coefficient(p: &CreepShrinkageParams, t: f64, t0: f64) -> f64 {
     p.phi0(t0) * p.beta_c(t - t0)
 }
 
-/// MC90 creep compliance J(t, t0) = 1/E_ci(t0) + φ(t, t0)/E_ci [1/Pa] (ages in days).
+/// MC90 creep compliance J(t, t0) = 1/E_ci(t0) + φ(t, t0)/E_ci \[1/Pa\] (ages in days).
 /// For t ≤ t0 returns the instantaneous value 1/E_ci(t0).
 pub fn compliance(p: &CreepShrinkageParams, t: f64, t0: f64) -> f64 {
     1.0 / p.eci_at(t0) + creep_coefficient(p, t, t0) / p.eci()
 }
 
-/// MC90 total shrinkage strain ε_cs(t, ts) = ε_cso β_s(t − ts) [-] at age `t` [days], with
+/// MC90 total shrinkage strain ε_cs(t, ts) = ε_cso β_s(t − ts) \[-\] at age `t` \[days\], with
 /// ts = `p.t_shrinkage_start`. Negative = shortening; zero before the start of drying.
 pub fn shrinkage_strain(p: &CreepShrinkageParams, t: f64) -> f64 {
     p.eps_cso() * p.beta_s(t - p.t_shrinkage_start)
 }
 
 /// MC90 non-linear creep amplification for 0.4 < |σ|/f_cm(t0) ≤ 0.6:
-/// exp[1.5 (|σ|/f_cm(t0) − 0.4)] [-] (1 below 0.4). Multiply φ0 by it if wanted; the chain
+/// exp[1.5 (|σ|/f_cm(t0) − 0.4)] \[-\] (1 below 0.4). Multiply φ0 by it if wanted; the chain
 /// of [`crate::materials::chain`] is linear and does not apply it.
 pub fn high_stress_creep_factor(stress_ratio: f64) -> f64 {
     let r = stress_ratio.abs();
@@ -324,8 +324,8 @@ impl RelaxationClass {
         }
     }
 
-    /// Default time exponent k of ρ(t) = ρ1000 (t/1000 h)^k [-]: 0.12 (class 1), 0.19
-    /// (class 2) from MC90; class 3 (bars) has no MC90 default — **[DECISION]** 0.19 as for
+    /// Default time exponent k of ρ(t) = ρ1000 (t/1000 h)^k \[-\]: 0.12 (class 1), 0.19
+    /// (class 2) from MC90; class 3 (bars) has no MC90 default — **\[DECISION\]** 0.19 as for
     /// low-relaxation strands (pass a measured k to [`relaxation_loss_with_exponent`]).
     pub fn default_exponent(self) -> f64 {
         match self {
@@ -345,9 +345,9 @@ impl RelaxationClass {
     }
 }
 
-/// 1000-hour relaxation ρ1000 [fraction] for an initial stress ratio σ_pi/f_ptk [-]:
+/// 1000-hour relaxation ρ1000 \[fraction\] for an initial stress ratio σ_pi/f_ptk \[-\]:
 /// 0 up to 0.5, linear between the table points (0.5, 0), (0.6, ·), (0.7, ·), (0.8, ·),
-/// linear extrapolation with the last slope above 0.8 (**[DECISION]**).
+/// linear extrapolation with the last slope above 0.8 (**\[DECISION\]**).
 pub fn rho1000(class: RelaxationClass, sigma_pi_over_fptk: f64) -> f64 {
     let tab = class.rho1000_table();
     let xs = [0.5, 0.6, 0.7, 0.8];
@@ -367,7 +367,7 @@ pub fn rho1000(class: RelaxationClass, sigma_pi_over_fptk: f64) -> f64 {
 }
 
 /// MC90 relaxation loss ρ(t) = Δσ/σ_pi [fraction of the initial stress] after a time
-/// `t_days` [days] at constant strain, for an initial stress ratio σ_pi/f_ptk [-]:
+/// `t_days` \[days\] at constant strain, for an initial stress ratio σ_pi/f_ptk \[-\]:
 /// ρ(t) = ρ1000 (t/1000 h)^k with the class default k (see
 /// [`RelaxationClass::default_exponent`]). Time is in **days** like the rest of the
 /// module (converted internally to hours; 1000 h = 41.667 d). Zero for t ≤ 0.
@@ -375,7 +375,7 @@ pub fn relaxation_loss(class: RelaxationClass, sigma_pi_over_fptk: f64, t_days: 
     relaxation_loss_with_exponent(class, sigma_pi_over_fptk, t_days, class.default_exponent())
 }
 
-/// As [`relaxation_loss`] with an explicit time exponent k [-] (MC90: k ≈ log10(ρ1000/ρ100)).
+/// As [`relaxation_loss`] with an explicit time exponent k \[-\] (MC90: k ≈ log10(ρ1000/ρ100)).
 /// `t_days` in days; result a fraction of the initial stress.
 pub fn relaxation_loss_with_exponent(
     class: RelaxationClass,

@@ -27,7 +27,7 @@ pub fn macaulay(x: f64) -> f64 {
     x.max(0.0)
 }
 
-/// Perzyna overstress ⟨Φ(F)⟩ [-] for yield-function value `f` and yield stress `f0` > 0
+/// Perzyna overstress ⟨Φ(F)⟩ \[-\] for yield-function value `f` and yield stress `f0` > 0
 /// (same unit); zero inside the surface (F ≤ F0).
 pub fn overstress(law: OverstressFunction, f: f64, f0: f64) -> f64 {
     debug_assert!(f0 > 0.0, "yield stress must be positive");
@@ -42,8 +42,8 @@ pub fn overstress(law: OverstressFunction, f: f64, f0: f64) -> f64 {
     }
 }
 
-/// Viscoplastic strain rate ε̇_vp = γ ⟨Φ(F)⟩ a [1/time] (MODEL.md §5.1) for fluidity `gamma`
-/// [1/time], yield-function value `f`, yield stress `f0` and flow vector `flow` = ∂Q/∂σ
+/// Viscoplastic strain rate ε̇_vp = γ ⟨Φ(F)⟩ a \[1/time\] (MODEL.md §5.1) for fluidity `gamma`
+/// \[1/time\], yield-function value `f`, yield stress `f0` and flow vector `flow` = ∂Q/∂σ
 /// [per unit of F/stress; dimensionless when F is a stress].
 pub fn viscoplastic_strain_rate(
     law: OverstressFunction,
@@ -56,13 +56,13 @@ pub fn viscoplastic_strain_rate(
     [g * flow[0], g * flow[1], g * flow[2]]
 }
 
-/// Explicit (Euler, Θ = 0) viscoplastic strain increment Δε_vp = Δt ε̇_vp [-] for a time
-/// step `dt` [time].
+/// Explicit (Euler, Θ = 0) viscoplastic strain increment Δε_vp = Δt ε̇_vp \[-\] for a time
+/// step `dt` \[time\].
 pub fn explicit_strain_increment(rate: &[f64; 3], dt: f64) -> [f64; 3] {
     [dt * rate[0], dt * rate[1], dt * rate[2]]
 }
 
-/// Θ-method strain increment Δε_vp = Δt [(1 − Θ) ε̇_n + Θ ε̇_{n+1}] [-] (MODEL.md §5.3),
+/// Θ-method strain increment Δε_vp = Δt [(1 − Θ) ε̇_n + Θ ε̇_{n+1}] \[-\] (MODEL.md §5.3),
 /// `theta` ∈ [0, 1].
 pub fn theta_strain_increment(
     rate_n: &[f64; 3],
@@ -73,7 +73,7 @@ pub fn theta_strain_increment(
     std::array::from_fn(|i| dt * ((1.0 - theta) * rate_n[i] + theta * rate_np1[i]))
 }
 
-/// Work-hardening increment Δκ = σ · Δε_vp / σ_c [-] (effective plastic strain from plastic
+/// Work-hardening increment Δκ = σ · Δε_vp / σ_c \[-\] (effective plastic strain from plastic
 /// work equivalence, MODEL.md §2.2/§5.2), engineering shear in the dot product; `sigma_c` =
 /// current uniaxial yield stress (> 0, same unit as σ). Returns 0 for non-positive work.
 pub fn hardening_increment(stress: &[f64; 3], d_eps_vp: &[f64; 3], sigma_c: f64) -> f64 {
@@ -81,7 +81,7 @@ pub fn hardening_increment(stress: &[f64; 3], d_eps_vp: &[f64; 3], sigma_c: f64)
     macaulay(w) / sigma_c
 }
 
-/// Plane-stress elastic stress correction −D Δε_vp [stress]: the initial-stress "pseudo-load"
+/// Plane-stress elastic stress correction −D Δε_vp \[stress\]: the initial-stress "pseudo-load"
 /// of one Gauss point is ∫ Bᵀ D Δε_vp dΩ. `e` = Young's modulus, `nu` = Poisson ratio.
 pub fn elastic_stress_of_strain(e: f64, nu: f64, d_eps: &[f64; 3]) -> [f64; 3] {
     let c = e / (1.0 - nu * nu);
@@ -93,31 +93,31 @@ pub fn elastic_stress_of_strain(e: f64, nu: f64, d_eps: &[f64; 3]) -> [f64; 3] {
 }
 
 /// Cormeau critical time step for the Tresca surface and Φ = (F − F0)/F0:
-/// Δt ≤ (1 + ν) F0/(γ E) [time]. `f0` and `e` in the same stress unit, `gamma` in 1/time.
+/// Δt ≤ (1 + ν) F0/(γ E) \[time\]. `f0` and `e` in the same stress unit, `gamma` in 1/time.
 pub fn critical_dt_tresca(e: f64, nu: f64, gamma: f64, f0: f64) -> f64 {
     (1.0 + nu) * f0 / (gamma * e)
 }
 
 /// Cormeau critical time step for von Mises and Φ = (F − F0)/F0:
-/// Δt ≤ 4(1 + ν) F0/(3 γ E) [time].
+/// Δt ≤ 4(1 + ν) F0/(3 γ E) \[time\].
 pub fn critical_dt_von_mises(e: f64, nu: f64, gamma: f64, f0: f64) -> f64 {
     4.0 * (1.0 + nu) * f0 / (3.0 * gamma * e)
 }
 
 /// Cormeau critical time step for Mohr–Coulomb (friction angle `phi` in radians) and
-/// Φ = (F − F0)/F0: Δt ≤ 4(1 + ν)(1 − 2ν) F0/[γ E (1 − 2ν + sin²φ)] [time].
+/// Φ = (F − F0)/F0: Δt ≤ 4(1 + ν)(1 − 2ν) F0/[γ E (1 − 2ν + sin²φ)] \[time\].
 pub fn critical_dt_mohr_coulomb(e: f64, nu: f64, gamma: f64, f0: f64, phi: f64) -> f64 {
     let s = phi.sin();
     4.0 * (1.0 + nu) * (1.0 - 2.0 * nu) * f0 / (gamma * e * (1.0 - 2.0 * nu + s * s))
 }
 
-/// Critical time step for the Ottosen surface **[DECISION]**: no closed form is known
-/// (MODEL.md §5.2); use the von Mises value times `safety` (recommended 0.5) [time].
+/// Critical time step for the Ottosen surface **\[DECISION\]**: no closed form is known
+/// (MODEL.md §5.2); use the von Mises value times `safety` (recommended 0.5) \[time\].
 pub fn critical_dt_ottosen_estimate(e: f64, nu: f64, gamma: f64, f0: f64, safety: f64) -> f64 {
     safety * critical_dt_von_mises(e, nu, gamma, f0)
 }
 
-/// Owen–Hinton time-step control (MODEL.md §5.2) [time]: the next step is the smallest of
+/// Owen–Hinton time-step control (MODEL.md §5.2) \[time\]: the next step is the smallest of
 /// `growth` × `dt_prev` (k ≈ 1.5), `tau` × ε̄/‖ε̇_vp‖ (τ ≈ 0.01–0.15; ignored if the rate is
 /// zero) and `dt_crit`.
 pub fn next_time_step(
@@ -145,7 +145,7 @@ pub fn is_stationary(sum_step_increment_norm: f64, sum_total_vp_norm: f64, tol: 
 }
 
 /// Owen–Hinton number of forward-Euler sub-increments m = int[8 (σ̄_trial − F0)/F0] + 1 for
-/// the elastoplastic return (MODEL.md §5.4) [-]; 1 inside the surface.
+/// the elastoplastic return (MODEL.md §5.4) \[-\]; 1 inside the surface.
 pub fn owen_hinton_substeps(sigma_trial: f64, f0: f64) -> usize {
     let x = 8.0 * (sigma_trial - f0) / f0;
     if x <= 0.0 {
