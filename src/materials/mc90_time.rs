@@ -546,6 +546,16 @@ mod tests {
     }
 
     #[test]
+    fn params_deserialize_with_defaults() {
+        // Optional adjustments may be omitted in input files and default to off.
+        let p: CreepShrinkageParams = serde_json::from_str(
+            r#"{"fcm":45e6,"rh":0.7,"h0":0.2,"cement":"N","t_shrinkage_start":7}"#,
+        )
+        .unwrap();
+        assert_eq!(p, check_params(7.0));
+    }
+
+    #[test]
     fn relaxation_mc90_values() {
         // MODEL.md §4.6 check values, class 2 at 0.7 fptk, k = 0.19; 4 digits → 5e-4 rel.
         let c = RelaxationClass::Class2;
