@@ -6,9 +6,6 @@
 //! Data flows one way: input → validated [`model`] → mesh and dofs → analysis → results →
 //! writers.
 
-// Index loops mirror the formulas (Σ over nodes, components); iterator chains would hide them.
-#![allow(clippy::needless_range_loop)]
-
 pub mod analysis;
 pub mod bench;
 pub mod elements;

@@ -1,3 +1,4 @@
 //! Meshes: nodes, elements and regions; generators and readers.
 
 pub mod banded;
+pub mod segmental;

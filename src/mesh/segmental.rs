@@ -1,0 +1,134 @@
+//! Segmental-beam generator: a line of precast segments, each meshed as a banded block with
+//! its own nodes; neighbouring segments touch at joints, and a joint is the list of facing
+//! element-edge pairs between them.
+
+use super::banded::{generate, Band};
+use crate::fem::shape::QuadKind;
+
+/// One joint face pair: the nodes of the left segment's edge and the right segment's edge at
+/// the same height, both ordered bottom to top as (start, end, [mid]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointFace {
+    /// Left segment's edge nodes (face A).
+    pub a: Vec<usize>,
+    /// Right segment's edge nodes (face B).
+    pub b: Vec<usize>,
+    /// Region index of the band the face lies in (gives the joint's thickness).
+    pub region: usize,
+}
+
+/// A joint between segment `left` and segment `left + 1` at abscissa `x` [m].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Index of the segment on the left.
+    pub left: usize,
+    /// Abscissa of the joint [m].
+    pub x: f64,
+    /// Facing edge pairs, bottom to top.
+    pub faces: Vec<JointFace>,
+}
+
+/// A generated segmental mesh.
+#[derive(Debug, Clone, Default)]
+pub struct SegmentalMesh {
+    /// Node coordinates [m].
+    pub nodes: Vec<[f64; 2]>,
+    /// Elements: node lists (VTK order), region index, segment index.
+    pub elements: Vec<(Vec<usize>, usize, usize)>,
+    /// Joints, left to right.
+    pub joints: Vec<Joint>,
+}
+
+/// Generate segments of the given lengths [m] placed end to end from `x0`, each with
+/// `nx[i]` element columns, sharing the band layout (bottom up).
+pub fn generate_segments(
+    x0: f64,
+    y0: f64,
+    lengths: &[f64],
+    nx: &[usize],
+    bands: &[Band],
+    kind: QuadKind,
+) -> SegmentalMesh {
+    let mut out = SegmentalMesh::default();
+    let mut x = x0;
+    let rows: usize = bands.iter().map(|b| b.rows).sum();
+    let mut prev_right: Option<Vec<JointFace>> = None;
+    for (s, (&len, &n)) in lengths.iter().zip(nx).enumerate() {
+        let g = generate([x, y0], len, n, bands, kind);
+        let off = out.nodes.len();
+        out.nodes.extend(g.nodes);
+        let first = out.elements.len();
+        for (el, region) in g.elements {
+            out.elements.push((el.iter().map(|v| v + off).collect(), region, s));
+        }
+        // Element (row r, column c) is first + r·n + c; edge 1 is the right edge (nodes 1→2),
+        // edge 3 the left edge (nodes 3→0, top to bottom, so reversed here to go upward).
+        let edge = |r: usize, c: usize, right: bool| -> (Vec<usize>, usize) {
+            let (el, region, _) = &out.elements[first + r * n + c];
+            let v = if right {
+                let mut v = vec![el[1], el[2]];
+                if kind != QuadKind::Q4 {
+                    v.push(el[5]);
+                }
+                v
+            } else {
+                let mut v = vec![el[0], el[3]];
+                if kind != QuadKind::Q4 {
+                    v.push(el[7]);
+                }
+                v
+            };
+            (v, *region)
+        };
+        if let Some(left_faces) = prev_right.take() {
+            let faces = (0..rows)
+                .map(|r| {
+                    let (b, _) = edge(r, 0, false);
+                    JointFace { a: left_faces[r].a.clone(), b, region: left_faces[r].region }
+                })
+                .collect();
+            out.joints.push(Joint { left: s - 1, x, faces });
+        }
+        prev_right = Some(
+            (0..rows)
+                .map(|r| {
+                    let (a, region) = edge(r, n - 1, true);
+                    JointFace { a, b: vec![], region }
+                })
+                .collect(),
+        );
+        x += len;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three segments: two joints, each with one face pair per element row, the two faces at
+    /// the same coordinates but with distinct nodes.
+    #[test]
+    fn joints_pair_coincident_distinct_nodes() {
+        let bands = [Band { depth: 0.2, rows: 1, region: 0 }, Band { depth: 0.4, rows: 2, region: 1 }];
+        for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+            let m = generate_segments(0.0, 0.0, &[1.0, 1.0, 1.5], &[2, 2, 3], &bands, kind);
+            assert_eq!(m.joints.len(), 2);
+            assert!((m.joints[1].x - 2.0).abs() < 1e-12);
+            for j in &m.joints {
+                assert_eq!(j.faces.len(), 3);
+                assert_eq!(j.faces[2].region, 1);
+                for f in &j.faces {
+                    assert_eq!(f.a.len(), f.b.len());
+                    for (a, b) in f.a.iter().zip(&f.b) {
+                        assert_ne!(a, b);
+                        let (pa, pb) = (m.nodes[*a], m.nodes[*b]);
+                        assert!((pa[0] - j.x).abs() < 1e-12 && (pa[0] - pb[0]).abs() < 1e-12 && (pa[1] - pb[1]).abs() < 1e-12);
+                    }
+                    // Bottom to top.
+                    assert!(m.nodes[f.a[1]][1] > m.nodes[f.a[0]][1]);
+                }
+            }
+        }
+    }
+}
