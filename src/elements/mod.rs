@@ -1,1 +1,4 @@
 //! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.
+
+pub mod interface;
+pub mod tendon;
