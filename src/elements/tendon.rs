@@ -344,7 +344,7 @@ impl ExternalTendon {
     /// Override the deviation angles Δα_j [rad] (one per deviator), e.g. for a curved
     /// saddle whose angle differs from the chord geometry.
     pub fn with_deviation_angles(mut self, a: Vec<f64>) -> Result<Self, TendonError> {
-        if a.len() != self.deviation.len() || a.iter().any(|x| !(*x >= 0.0)) {
+        if a.len() != self.deviation.len() || a.iter().any(|x| x.is_nan() || *x < 0.0) {
             return Err(TendonError::Invalid(
                 "one non-negative deviation angle per deviator expected".into(),
             ));

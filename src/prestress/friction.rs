@@ -99,7 +99,7 @@ impl TendonPath {
                 "arc lengths must start at 0 and increase".into(),
             ));
         }
-        if turn.iter().any(|t| !(*t >= 0.0)) {
+        if turn.iter().any(|t| t.is_nan() || *t < 0.0) {
             return Err(FrictionError::Invalid("turn angles must be ≥ 0".into()));
         }
         Ok(Self { s, turn })
@@ -227,8 +227,8 @@ pub fn jacking_profile(
     let total_turn = a_start[n - 1];
     let len = path.length();
     let mut pieces = Vec::new();
-    for i in 0..n - 1 {
-        let (s0, s1) = (path.s[i], path.s[i + 1]);
+    for (i, w) in path.s.windows(2).enumerate() {
+        let (s0, s1) = (w[0], w[1]);
         // From the start: value just after point i, decaying.
         let fs = Piece {
             s0,
