@@ -1025,4 +1025,54 @@ mod tests {
         assert!((r.f_int[1] - n * 0.03 / l).abs() < 1e-9 * n);
         assert!((r.f_int[3] + 2.0 * n * 0.03 / l).abs() < 1e-9 * n);
     }
+
+    /// Stick/slip history: after slipping and committing, a small unloading sticks (slip kept,
+    /// forces change like a held tendon) and a large unloading slips back the other way with
+    /// the inverse capstan ratio. Tolerance 1e-9 rel.
+    #[test]
+    fn friction_history_stick_after_slip_and_reverse_slip() {
+        let pts = vec![[0.0, 0.0], [3.0, -0.4], [6.0, 0.0]];
+        let mu = 0.25;
+        let t = ExternalTendon::new(
+            &pts,
+            AP,
+            EP,
+            S0,
+            TendonLaw::Elastic,
+            DeviatorMode::Friction { mu },
+        )
+        .unwrap();
+        let ratio = (mu * t.deviation_angles()[0]).exp();
+        let mut u = zeros(3);
+        u[2][0] = 5e-3;
+        let c1 = t.response(&u, &t.initial_state()).state;
+        assert!(c1.slips[0] < 0.0);
+        u[2][0] = 4.9e-3;
+        let r = t.response(&u, &c1);
+        assert_eq!(r.state.slipping[0], 0);
+        assert_eq!(r.state.slips[0], c1.slips[0]);
+        let dn = r.state.forces()[1] - c1.spans[1].force;
+        let l1 = t.reference_lengths()[1];
+        let dl = r.state.spans[1].length - c1.spans[1].length;
+        assert!((dn - EP * AP * dl / l1).abs() < 1e-9 * AP * S0);
+        u[2][0] = -5e-3;
+        let r = t.response(&u, &c1);
+        assert_eq!(r.state.slipping[0], 1);
+        let n = r.state.forces();
+        assert!((n[0] / n[1] - ratio).abs() < 1e-9);
+    }
+
+    /// A user closure law (here linear, σ = 1.1 E ε) is used as given, and the prestrain is
+    /// found from it: tolerance 1e-12 rel (Newton on a linear function).
+    #[test]
+    fn custom_closure_law() {
+        let law = TendonLaw::Custom(Arc::new(|e: f64| (1.1 * EP * e, 1.1 * EP)));
+        let pts = vec![[0.0, 0.0], [5.0, 0.0]];
+        let t = ExternalTendon::new(&pts, AP, EP, S0, law, DeviatorMode::Held).unwrap();
+        let mut u = zeros(2);
+        u[1][0] = 1e-3;
+        let r = t.response(&u, &t.initial_state());
+        let expect = AP * (S0 + 1.1 * EP * 1e-3 / 5.0);
+        assert!((r.state.forces()[0] - expect).abs() < 1e-12 * expect);
+    }
 }
