@@ -3,7 +3,7 @@
 //! with the small-displacement kinematics and penalty/Coulomb law of MODEL.md §7.
 //!
 //! * Face A: 2 or 3 nodes (an edge of a Q4 or Q8/Q9 element of segment A), given in the
-//!   counter-clockwise edge order of its element (start, end, [middle]), so that body A lies to
+//!   counter-clockwise edge order of its element (start, end, \[middle\]), so that body A lies to
 //!   the **left** of the face and the normal `n_A = (−t_y, t_x)` points **into body A**.
 //! * Face B: 2 or 3 nodes (an edge of the opposite segment), any orientation.
 //! * At every integration point ξ_g of face A the opposite point on B is found once, in the
@@ -21,17 +21,17 @@ use crate::fem::shape::line_shape;
 /// Constitutive and integration parameters of a joint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterfaceParams {
-    /// Normal penalty stiffness K_n [Pa/m] (normal stress per unit penetration), > 0.
+    /// Normal penalty stiffness K_n \[Pa/m\] (normal stress per unit penetration), > 0.
     pub kn: f64,
-    /// Tangential (shear) penalty stiffness K_t [Pa/m], ≥ 0.
+    /// Tangential (shear) penalty stiffness K_t \[Pa/m\], ≥ 0.
     pub kt: f64,
-    /// Coulomb friction coefficient μ [-], ≥ 0.
+    /// Coulomb friction coefficient μ \[-\], ≥ 0.
     pub friction: f64,
-    /// Cohesion c [Pa]: shear strength at zero normal stress, ≥ 0. For a joint with
+    /// Cohesion c \[Pa\]: shear strength at zero normal stress, ≥ 0. For a joint with
     /// `tensile_strength > 0` (epoxy) it is lost together with the bond; otherwise (dry keyed
     /// joint, key shear term) it is kept while the point is closed.
     pub cohesion: f64,
-    /// Tensile strength f_t [Pa] of a bonded (epoxy) joint, ≥ 0; 0 = dry joint. While the bond
+    /// Tensile strength f_t \[Pa\] of a bonded (epoxy) joint, ≥ 0; 0 = dry joint. While the bond
     /// is intact the normal law is linear in tension too; when the tensile stress exceeds f_t
     /// the point debonds for good and behaves as a dry joint (no tension, no cohesion).
     pub tensile_strength: f64,
@@ -40,13 +40,13 @@ pub struct InterfaceParams {
     /// `true`: Gauss–Lobatto (nodal) integration; `false`: Gauss–Legendre. Both use as many
     /// points as face A has nodes.
     pub lobatto: bool,
-    /// Residual stiffness ratio r [-] of an open point (tractions r·K·(λ, g_t − s_p)), 0 ≤ r < 1;
+    /// Residual stiffness ratio r \[-\] of an open point (tractions r·K·(λ, g_t − s_p)), 0 ≤ r < 1;
     /// e.g. 1e-6 keeps the global matrix non-singular when a joint is fully open.
     pub residual_ratio: f64,
 }
 
 impl InterfaceParams {
-    /// Dry joint with Coulomb friction μ and penalties `kn`, `kt` [Pa/m]; Gauss integration,
+    /// Dry joint with Coulomb friction μ and penalties `kn`, `kt` \[Pa/m\]; Gauss integration,
     /// no cohesion, no tensile strength, no residual stiffness.
     pub fn dry(kn: f64, kt: f64, friction: f64) -> Self {
         Self {
@@ -69,7 +69,7 @@ impl InterfaceParams {
         }
     }
 
-    /// Epoxy joint: bonded with tensile strength `ft` [Pa] and cohesion `c` [Pa] until the
+    /// Epoxy joint: bonded with tensile strength `ft` \[Pa\] and cohesion `c` \[Pa\] until the
     /// tensile strength is exceeded, then dry with friction μ.
     pub fn epoxy(kn: f64, kt: f64, friction: f64, cohesion: f64, ft: f64) -> Self {
         Self {
@@ -143,21 +143,21 @@ pub enum InterfaceError {
 /// Geometry of one integration point (fixed after the reference-configuration search).
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterfacePoint {
-    /// Natural coordinate ξ_g on face A [-].
+    /// Natural coordinate ξ_g on face A \[-\].
     pub xi_a: f64,
-    /// Natural coordinate ζ_B of the projected point on face B [-].
+    /// Natural coordinate ζ_B of the projected point on face B \[-\].
     pub zeta_b: f64,
-    /// Initial signed normal distance λ0 [m] (> 0 overlap, < 0 initial gap, 0 match-cast).
+    /// Initial signed normal distance λ0 \[m\] (> 0 overlap, < 0 initial gap, 0 match-cast).
     pub lambda0: f64,
     /// Unit normal of face A, pointing into body A.
     pub normal: [f64; 2],
     /// Unit tangent of face A (direction of increasing ξ).
     pub tangent: [f64; 2],
-    /// Quadrature weight × line Jacobian |dx_A/dξ| [m].
+    /// Quadrature weight × line Jacobian |dx_A/dξ| \[m\].
     pub weight: f64,
-    /// Global position of the point on face A [m].
+    /// Global position of the point on face A \[m\].
     pub position: [f64; 2],
-    /// Arc length from the first node of face A to the point [m].
+    /// Arc length from the first node of face A to the point \[m\].
     pub arc: f64,
     /// Shape function values of face A at ξ_g (first `n_a` used).
     pub n_a: [f64; 3],
@@ -176,7 +176,7 @@ pub struct InterfaceElement {
 /// Committed or trial state of one integration point, with its output quantities.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InterfacePointState {
-    /// Tangential plastic slip s_p [m] (history variable).
+    /// Tangential plastic slip s_p \[m\] (history variable).
     pub plastic_slip: f64,
     /// Epoxy bond intact (history variable; always `false` for dry joints).
     pub bonded: bool,
@@ -184,47 +184,47 @@ pub struct InterfacePointState {
     pub closed: bool,
     /// Sliding (Coulomb limit reached) in this state.
     pub sliding: bool,
-    /// Signed normal relative displacement λ [m] (penetration if > 0, gap if < 0).
+    /// Signed normal relative displacement λ \[m\] (penetration if > 0, gap if < 0).
     pub lambda: f64,
-    /// Tangential relative displacement g_t = Δu·t_A [m].
+    /// Tangential relative displacement g_t = Δu·t_A \[m\].
     pub slip: f64,
-    /// Normal stress σ_n [Pa], compression positive.
+    /// Normal stress σ_n \[Pa\], compression positive.
     pub normal_stress: f64,
-    /// Shear stress τ = K_t (g_t − s_p) [Pa] (stick), positive when B has moved along +t_A
+    /// Shear stress τ = K_t (g_t − s_p) \[Pa\] (stick), positive when B has moved along +t_A
     /// relative to A.
     pub shear_stress: f64,
-    /// Global position of the point on face A [m].
+    /// Global position of the point on face A \[m\].
     pub position: [f64; 2],
-    /// Arc-length position along face A from its first node [m].
+    /// Arc-length position along face A from its first node \[m\].
     pub arc: f64,
 }
 
 impl InterfacePointState {
-    /// Joint opening [m]: the gap −λ when open, 0 when closed.
+    /// Joint opening \[m\]: the gap −λ when open, 0 when closed.
     pub fn opening(&self) -> f64 {
         (-self.lambda).max(0.0)
     }
-    /// Penetration [m]: λ when closed, 0 when open.
+    /// Penetration \[m\]: λ when closed, 0 when open.
     pub fn penetration(&self) -> f64 {
         self.lambda.max(0.0)
     }
-    /// Total tangential relative displacement (slip) [m].
+    /// Total tangential relative displacement (slip) \[m\].
     pub fn slip(&self) -> f64 {
         self.slip
     }
-    /// Normal stress [Pa], compression positive.
+    /// Normal stress \[Pa\], compression positive.
     pub fn normal_stress(&self) -> f64 {
         self.normal_stress
     }
-    /// Shear stress [Pa].
+    /// Shear stress \[Pa\].
     pub fn shear_stress(&self) -> f64 {
         self.shear_stress
     }
-    /// Arc-length position along face A [m].
+    /// Arc-length position along face A \[m\].
     pub fn position_along_face(&self) -> f64 {
         self.arc
     }
-    /// Global coordinates of the point on face A [m].
+    /// Global coordinates of the point on face A \[m\].
     pub fn position(&self) -> [f64; 2] {
         self.position
     }
@@ -233,9 +233,9 @@ impl InterfacePointState {
 /// Internal forces, tangent and updated (trial) states of an interface element.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterfaceResponse {
-    /// Internal nodal forces [N], ordered like `u` (face A nodes then face B nodes, (x, y)).
+    /// Internal nodal forces \[N\], ordered like `u` (face A nodes then face B nodes, (x, y)).
     pub f_int: Vec<f64>,
-    /// Tangent ∂f_int/∂u [N/m], dense row-major ndof × ndof.
+    /// Tangent ∂f_int/∂u \[N/m\], dense row-major ndof × ndof.
     pub k: Vec<f64>,
     /// `false` when a sliding point contributes the non-symmetric friction coupling.
     pub symmetric: bool,
@@ -246,11 +246,11 @@ pub struct InterfaceResponse {
 /// Result of the point constitutive law: tractions, tangent and new state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointLawResult {
-    /// Shear stress τ [Pa].
+    /// Shear stress τ \[Pa\].
     pub tau: f64,
-    /// Normal stress σ_n [Pa], compression positive.
+    /// Normal stress σ_n \[Pa\], compression positive.
     pub sigma_n: f64,
-    /// Tangent [[∂τ/∂g_t, ∂τ/∂λ], [∂σ_n/∂g_t, ∂σ_n/∂λ]] [Pa/m].
+    /// Tangent [\[∂τ/∂g_t, ∂τ/∂λ\], \[∂σ_n/∂g_t, ∂σ_n/∂λ\]] \[Pa/m\].
     pub tangent: [[f64; 2]; 2],
     /// New (trial) history: plastic slip, bond, flags.
     pub plastic_slip: f64,
@@ -262,8 +262,8 @@ pub struct JointLawResult {
     pub sliding: bool,
 }
 
-/// Penalty/Coulomb joint law (MODEL.md §7.2) for one point: `lambda` [m] (penetration
-/// positive), `g_t` [m], committed plastic slip `sp_c` [m] and bond flag `bonded_c`.
+/// Penalty/Coulomb joint law (MODEL.md §7.2) for one point: `lambda` \[m\] (penetration
+/// positive), `g_t` \[m\], committed plastic slip `sp_c` \[m\] and bond flag `bonded_c`.
 ///
 /// * bonded (epoxy intact): σ_n = K_n λ in compression and tension; if −σ_n > f_t the point
 ///   debonds and is evaluated as dry in the same call;
@@ -349,7 +349,7 @@ fn line_geom(coords: &[[f64; 2]], r: f64) -> ([f64; 3], [f64; 2], [f64; 2]) {
     (n, x, dx)
 }
 
-/// Arc length of a line element from r = −1 to r (4-point Gauss on [−1, r]; exact for
+/// Arc length of a line element from r = −1 to r (4-point Gauss on \[−1, r\]; exact for
 /// straight faces).
 fn arc_length(coords: &[[f64; 2]], r: f64) -> f64 {
     let g = gauss(4);
@@ -369,8 +369,8 @@ fn arc_length(coords: &[[f64; 2]], r: f64) -> f64 {
 const ZETA_TOL: f64 = 1e-8;
 
 impl InterfaceElement {
-    /// Build the element from the reference coordinates [m] of face A (2 or 3 nodes, order
-    /// start, end, [middle], body A on the left) and face B (2 or 3 nodes). Performs the
+    /// Build the element from the reference coordinates \[m\] of face A (2 or 3 nodes, order
+    /// start, end, \[middle\], body A on the left) and face B (2 or 3 nodes). Performs the
     /// contact search once; fails if a point of A does not project onto B.
     pub fn new(
         face_a: &[[f64; 2]],
@@ -513,8 +513,8 @@ impl InterfaceElement {
     }
 
     /// Internal forces f_int = Σ_g w_g j_g b Bᵀ(τ, σ_n), tangent K = Σ_g w_g j_g b Bᵀ C B and
-    /// trial states for displacements `u` [m] (face-A nodes then face-B nodes, (ux, uy) per
-    /// node), thickness `thickness` [m] and the committed point states.
+    /// trial states for displacements `u` \[m\] (face-A nodes then face-B nodes, (ux, uy) per
+    /// node), thickness `thickness` \[m\] and the committed point states.
     ///
     /// Panics if `u` or `committed` have the wrong length.
     pub fn response(
@@ -601,11 +601,11 @@ impl InterfaceElement {
 /// One neighbouring element layer for [`suggest_normal_stiffness`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointNeighbour {
-    /// Young's modulus of the neighbouring concrete element [Pa].
+    /// Young's modulus of the neighbouring concrete element \[Pa\].
     pub e: f64,
-    /// Its size normal to the joint [m].
+    /// Its size normal to the joint \[m\].
     pub h: f64,
-    /// Its thickness [m].
+    /// Its thickness \[m\].
     pub thickness: f64,
 }
 
@@ -613,7 +613,7 @@ pub struct JointNeighbour {
 /// the elastic shortening of the two adjacent element layers (MODEL.md §7.2: 10…1000).
 pub const DEFAULT_PENALTY_FACTOR: f64 = 100.0;
 
-/// Suggested normal penalty K_n [Pa/m] for a joint of thickness `joint_thickness` [m] between
+/// Suggested normal penalty K_n \[Pa/m\] for a joint of thickness `joint_thickness` \[m\] between
 /// the element layers `a` and `b`.
 ///
 /// Guideline: the two adjacent layers act as springs in series with line stiffness E·b/h per

@@ -35,14 +35,14 @@ pub enum DeviatorMode {
     Held,
     /// Free sliding: one strain and one force for the whole tendon.
     Frictionless,
-    /// Stick/slip with capstan friction coefficient `mu` [-] over each deviator's angle.
+    /// Stick/slip with capstan friction coefficient `mu` \[-\] over each deviator's angle.
     Friction {
-        /// Friction coefficient μ between tendon and deviator saddle [-].
+        /// Friction coefficient μ between tendon and deviator saddle \[-\].
         mu: f64,
     },
 }
 
-/// Uniaxial stress–strain function σ(ε) → (σ [Pa], dσ/dε [Pa]) of total mechanical strain.
+/// Uniaxial stress–strain function σ(ε) → (σ \[Pa\], dσ/dε \[Pa\]) of total mechanical strain.
 pub type StressFn = Arc<dyn Fn(f64) -> (f64, f64) + Send + Sync>;
 
 /// Uniaxial law of the tendon steel. Small and self-contained so that it can later be replaced
@@ -52,12 +52,12 @@ pub type StressFn = Arc<dyn Fn(f64) -> (f64, f64) + Send + Sync>;
 pub enum TendonLaw {
     /// Linear elastic, σ = E_p ε.
     Elastic,
-    /// Elastic–plastic with yield stress `yield_stress` [Pa] (e.g. 0.9 f_ptk) and linear
-    /// isotropic hardening modulus `hardening` [Pa] (0 = perfectly plastic).
+    /// Elastic–plastic with yield stress `yield_stress` \[Pa\] (e.g. 0.9 f_ptk) and linear
+    /// isotropic hardening modulus `hardening` \[Pa\] (0 = perfectly plastic).
     ElasticPlastic {
-        /// Yield stress f_y [Pa].
+        /// Yield stress f_y \[Pa\].
         yield_stress: f64,
-        /// Plastic hardening modulus H [Pa] (dσ/dε_p).
+        /// Plastic hardening modulus H \[Pa\] (dσ/dε_p).
         hardening: f64,
     },
     /// User-supplied nonlinear-elastic (path-independent) law σ(ε), dσ/dε.
@@ -83,9 +83,9 @@ impl fmt::Debug for TendonLaw {
 /// History of the steel law at one span.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LawState {
-    /// Plastic strain ε_p [-].
+    /// Plastic strain ε_p \[-\].
     pub plastic_strain: f64,
-    /// Accumulated plastic strain (hardening variable) [-].
+    /// Accumulated plastic strain (hardening variable) \[-\].
     pub hardening_var: f64,
 }
 
@@ -99,7 +99,7 @@ impl TendonLaw {
         }
     }
 
-    /// Stress [Pa], tangent [Pa] and new history for total strain `eps` [-], modulus `e` [Pa]
+    /// Stress \[Pa\], tangent \[Pa\] and new history for total strain `eps` \[-\], modulus `e` \[Pa\]
     /// and committed history `c`.
     pub fn update(&self, e: f64, eps: f64, c: &LawState) -> (f64, f64, LawState) {
         let (sig, et, st) = match self {
@@ -134,7 +134,7 @@ impl TendonLaw {
         }
     }
 
-    /// Strain giving stress `sigma` [Pa] on a virgin law (Newton for `Custom`).
+    /// Strain giving stress `sigma` \[Pa\] on a virgin law (Newton for `Custom`).
     fn strain_for(&self, e: f64, sigma: f64) -> Result<f64, TendonError> {
         match self {
             TendonLaw::Custom(fun) => {
@@ -175,13 +175,13 @@ pub enum TendonError {
 /// State of one span.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpanState {
-    /// Total mechanical strain ε [-] (includes the prestrain).
+    /// Total mechanical strain ε \[-\] (includes the prestrain).
     pub strain: f64,
-    /// Stress σ [Pa].
+    /// Stress σ \[Pa\].
     pub stress: f64,
-    /// Force N = A_p σ [N].
+    /// Force N = A_p σ \[N\].
     pub force: f64,
-    /// Current chord length ℓ [m].
+    /// Current chord length ℓ \[m\].
     pub length: f64,
     /// Steel-law history.
     pub law: LawState,
@@ -192,7 +192,7 @@ pub struct SpanState {
 pub struct TendonState {
     /// One entry per span (P_i → P_{i+1}).
     pub spans: Vec<SpanState>,
-    /// Slip s_j [m] of tendon material through deviator j from span j into span j−1
+    /// Slip s_j \[m\] of tendon material through deviator j from span j into span j−1
     /// (index 0 ↔ deviator P_1). Zero for `Held`; not tracked (zero) for `Frictionless`.
     pub slips: Vec<f64>,
     /// Per deviator: 0 stick, +1 slipping towards span j−1 (N_{j−1} = e^{μΔα} N_j),
@@ -201,11 +201,11 @@ pub struct TendonState {
 }
 
 impl TendonState {
-    /// Span forces [N].
+    /// Span forces \[N\].
     pub fn forces(&self) -> Vec<f64> {
         self.spans.iter().map(|s| s.force).collect()
     }
-    /// Span stresses [Pa].
+    /// Span stresses \[Pa\].
     pub fn stresses(&self) -> Vec<f64> {
         self.spans.iter().map(|s| s.stress).collect()
     }
@@ -214,9 +214,9 @@ impl TendonState {
 /// Internal forces, tangent and trial state of a tendon.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TendonResponse {
-    /// Internal forces [N], (x, y) per tendon point.
+    /// Internal forces \[N\], (x, y) per tendon point.
     pub f_int: Vec<f64>,
-    /// Tangent ∂f_int/∂u [N/m], dense row-major (2·n_points)².
+    /// Tangent ∂f_int/∂u \[N/m\], dense row-major (2·n_points)².
     pub k: Vec<f64>,
     /// `false` when a slipping friction deviator makes the tangent non-symmetric.
     pub symmetric: bool,
@@ -243,9 +243,9 @@ pub struct ExternalTendon {
 const KFLOOR: f64 = 1e-9;
 
 impl ExternalTendon {
-    /// Tendon through `points` [m] (anchor, deviators…, anchor; ≥ 2 points), area `area`
-    /// [m²], modulus `modulus` [Pa], uniform initial stress `initial_stress` [Pa] (after
-    /// losses), steel law and deviator mode. Deviation angles Δα_j [rad] are taken from the
+    /// Tendon through `points` \[m\] (anchor, deviators…, anchor; ≥ 2 points), area `area`
+    /// \[m²\], modulus `modulus` \[Pa\], uniform initial stress `initial_stress` \[Pa\] (after
+    /// losses), steel law and deviator mode. Deviation angles Δα_j \[rad\] are taken from the
     /// reference geometry (see [`Self::with_deviation_angles`] to override).
     pub fn new(
         points: &[[f64; 2]],
@@ -334,14 +334,14 @@ impl ExternalTendon {
         Ok(())
     }
 
-    /// Replace the initial stresses [Pa] by one value per span (e.g. from
+    /// Replace the initial stresses \[Pa\] by one value per span (e.g. from
     /// [`crate::prestress::friction`]). For `Frictionless` the length-weighted mean is used.
     pub fn with_span_initial_stresses(mut self, s: Vec<f64>) -> Result<Self, TendonError> {
         self.set_initial_stresses(s)?;
         Ok(self)
     }
 
-    /// Override the deviation angles Δα_j [rad] (one per deviator), e.g. for a curved
+    /// Override the deviation angles Δα_j \[rad\] (one per deviator), e.g. for a curved
     /// saddle whose angle differs from the chord geometry.
     pub fn with_deviation_angles(mut self, a: Vec<f64>) -> Result<Self, TendonError> {
         if a.len() != self.deviation.len() || a.iter().any(|x| x.is_nan() || *x < 0.0) {
@@ -361,19 +361,19 @@ impl ExternalTendon {
     pub fn n_spans(&self) -> usize {
         self.points.len() - 1
     }
-    /// Reference span lengths L_i [m].
+    /// Reference span lengths L_i \[m\].
     pub fn reference_lengths(&self) -> &[f64] {
         &self.ref_lengths
     }
-    /// Deviation angles Δα_j [rad] at the deviators P_1 … P_{m−1}.
+    /// Deviation angles Δα_j \[rad\] at the deviators P_1 … P_{m−1}.
     pub fn deviation_angles(&self) -> &[f64] {
         &self.deviation
     }
-    /// Initial span stresses [Pa].
+    /// Initial span stresses \[Pa\].
     pub fn initial_stresses(&self) -> &[f64] {
         &self.initial_stress
     }
-    /// Tendon area A_p [m²].
+    /// Tendon area A_p \[m²\].
     pub fn area(&self) -> f64 {
         self.area
     }
@@ -400,7 +400,7 @@ impl ExternalTendon {
         }
     }
 
-    /// Strain of span i for current length `l` and slips `s` (deviator j ↔ s[j−1]).
+    /// Strain of span i for current length `l` and slips `s` (deviator j ↔ s\[j−1\]).
     fn span_strain(&self, i: usize, l: f64, s: &[f64]) -> f64 {
         let m = self.n_spans();
         let s_left = if i >= 1 { s[i - 1] } else { 0.0 };
@@ -408,7 +408,7 @@ impl ExternalTendon {
         self.initial_strain[i] + (l - self.ref_lengths[i] - s_right + s_left) / self.ref_lengths[i]
     }
 
-    /// Response for displacements `u` [m] of the tendon points and the committed state.
+    /// Response for displacements `u` \[m\] of the tendon points and the committed state.
     ///
     /// Panics if `u` or `committed` do not match the tendon.
     pub fn response(&self, u: &[[f64; 2]], committed: &TendonState) -> TendonResponse {

@@ -2,9 +2,9 @@
 //!
 //! `σ_p(s) = σ_pi · exp[−μ (Σ Δα + k s)]`
 //!
-//! with σ_pi the stress at the jack [Pa], μ the curvature friction coefficient [-], Σ Δα the
-//! cumulative angular deviation from the jack [rad], s the distance from the jack [m] and k the
-//! wobble coefficient [rad/m] (seed: 0.0001 per cm = 0.01 /m).
+//! with σ_pi the stress at the jack \[Pa\], μ the curvature friction coefficient \[-\], Σ Δα the
+//! cumulative angular deviation from the jack \[rad\], s the distance from the jack \[m\] and k the
+//! wobble coefficient \[rad/m\] (seed: 0.0001 per cm = 0.01 /m).
 //!
 //! A tendon path is a polyline (straight segments with angle changes at the vertices) or a
 //! densely sampled curve (its vertex angles approximate ∫|dθ|). Between vertices the stress
@@ -15,10 +15,10 @@
 /// Friction coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrictionParams {
-    /// Curvature friction coefficient μ [-] (seed: 0.50 steel on concrete, 0.30 corrugated
+    /// Curvature friction coefficient μ \[-\] (seed: 0.50 steel on concrete, 0.30 corrugated
     /// metal sheathing, 0.25 steel on metal sheathing).
     pub mu: f64,
-    /// Wobble coefficient k [rad/m], multiplied by μ like the angles.
+    /// Wobble coefficient k \[rad/m\], multiplied by μ like the angles.
     pub wobble: f64,
 }
 
@@ -26,7 +26,7 @@ pub struct FrictionParams {
 pub const SEED_WOBBLE: f64 = 0.01;
 
 impl FrictionParams {
-    /// μ [-] with the seed's wobble k = 0.01 rad/m.
+    /// μ \[-\] with the seed's wobble k = 0.01 rad/m.
     pub fn seed(mu: f64) -> Self {
         Self {
             mu,
@@ -35,8 +35,8 @@ impl FrictionParams {
     }
 }
 
-/// Friction factor σ_p/σ_pi = exp[−μ (α + k s)] [-] for cumulative deviation `alpha` [rad]
-/// and distance `s` [m] from the jack.
+/// Friction factor σ_p/σ_pi = exp\[−μ (α + k s)\] \[-\] for cumulative deviation `alpha` \[rad\]
+/// and distance `s` \[m\] from the jack.
 pub fn friction_factor(p: &FrictionParams, alpha: f64, s: f64) -> f64 {
     (-p.mu * (alpha + p.wobble * s)).exp()
 }
@@ -53,14 +53,14 @@ pub enum FrictionError {
 /// angle change at each point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TendonPath {
-    /// Arc length of each point from the first one [m] (strictly increasing, s[0] = 0).
+    /// Arc length of each point from the first one \[m\] (strictly increasing, s\[0\] = 0).
     pub s: Vec<f64>,
-    /// Absolute angle change |Δθ| at each point [rad] (0 at the two ends).
+    /// Absolute angle change |Δθ| at each point \[rad\] (0 at the two ends).
     pub turn: Vec<f64>,
 }
 
 impl TendonPath {
-    /// Polyline (or sampled curve) through `points` [m], ≥ 2 points, no zero-length segment.
+    /// Polyline (or sampled curve) through `points` \[m\], ≥ 2 points, no zero-length segment.
     pub fn from_points(points: &[[f64; 2]]) -> Result<Self, FrictionError> {
         if points.len() < 2 {
             return Err(FrictionError::Invalid("at least two points needed".into()));
@@ -86,7 +86,7 @@ impl TendonPath {
         Ok(Self { s, turn })
     }
 
-    /// Path from arc lengths [m] and angle changes [rad] at each point (e.g. a curved tendon
+    /// Path from arc lengths \[m\] and angle changes \[rad\] at each point (e.g. a curved tendon
     /// sampled analytically).
     pub fn from_arc_and_turns(s: Vec<f64>, turn: Vec<f64>) -> Result<Self, FrictionError> {
         if s.len() < 2 || turn.len() != s.len() {
@@ -105,7 +105,7 @@ impl TendonPath {
         Ok(Self { s, turn })
     }
 
-    /// Total length [m].
+    /// Total length \[m\].
     pub fn length(&self) -> f64 {
         *self.s.last().unwrap()
     }
@@ -131,7 +131,7 @@ pub enum AnchorEnd {
     End,
 }
 
-/// One piece of a stress profile: σ(s) = c + a·exp(r (s − s0)) on [s0, s1] (monotone).
+/// One piece of a stress profile: σ(s) = c + a·exp(r (s − s0)) on \[s0, s1\] (monotone).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Piece {
     s0: f64,
@@ -142,7 +142,7 @@ struct Piece {
 }
 
 impl Piece {
-    /// The same function restricted to [x0, x1] (re-based at x0).
+    /// The same function restricted to \[x0, x1\] (re-based at x0).
     fn sub(&self, x0: f64, x1: f64) -> Piece {
         Piece {
             s0: x0,
@@ -190,7 +190,7 @@ impl Piece {
     }
 }
 
-/// Stress along a tendon after stressing [Pa], exact piecewise representation.
+/// Stress along a tendon after stressing \[Pa\], exact piecewise representation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StressProfile {
     pieces: Vec<Piece>,
@@ -200,17 +200,17 @@ pub struct StressProfile {
 /// Result of an anchorage-set computation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnchorageSet {
-    /// Stress profile after the set [Pa].
+    /// Stress profile after the set \[Pa\].
     pub profile: StressProfile,
-    /// Length affected by the set, measured from the anchored end [m].
+    /// Length affected by the set, measured from the anchored end \[m\].
     pub set_length: f64,
-    /// Stress at the anchored end after the set [Pa].
+    /// Stress at the anchored end after the set \[Pa\].
     pub anchor_stress: f64,
-    /// Mirror level σ_ref [Pa]: σ_after = min(σ, 2σ_ref − σ) in the affected zone.
+    /// Mirror level σ_ref \[Pa\]: σ_after = min(σ, 2σ_ref − σ) in the affected zone.
     pub reference_stress: f64,
 }
 
-/// Stress profile after stressing to `sigma_pi` [Pa] from the given end(s).
+/// Stress profile after stressing to `sigma_pi` \[Pa\] from the given end(s).
 pub fn jacking_profile(
     path: &TendonPath,
     sigma_pi: f64,
@@ -277,7 +277,7 @@ pub fn jacking_profile(
 }
 
 impl StressProfile {
-    /// Stress at arc length `s` [m]; at a vertex with a jump the lower value (after the
+    /// Stress at arc length `s` \[m\]; at a vertex with a jump the lower value (after the
     /// deviation, seen from the jack) is returned.
     pub fn at(&self, s: f64) -> f64 {
         self.pieces
@@ -287,12 +287,12 @@ impl StressProfile {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// Stress at each path point [m] (lower value at jumps).
+    /// Stress at each path point \[m\] (lower value at jumps).
     pub fn at_points(&self) -> Vec<f64> {
         self.points.iter().map(|&s| self.at(s)).collect()
     }
 
-    /// Mean stress over each segment (path point i to i+1) [Pa], e.g. initial span stresses
+    /// Mean stress over each segment (path point i to i+1) \[Pa\], e.g. initial span stresses
     /// of an [`crate::elements::tendon::ExternalTendon`] with the same points.
     pub fn segment_means(&self) -> Vec<f64> {
         self.points
@@ -301,7 +301,7 @@ impl StressProfile {
             .collect()
     }
 
-    /// Mean stress over [x0, x1] [Pa].
+    /// Mean stress over \[x0, x1\] \[Pa\].
     pub fn mean(&self, x0: f64, x1: f64) -> f64 {
         let tot: f64 = self
             .pieces
@@ -314,12 +314,12 @@ impl StressProfile {
         tot / (x1 - x0)
     }
 
-    /// Tendon length [m].
+    /// Tendon length \[m\].
     pub fn length(&self) -> f64 {
         *self.points.last().unwrap()
     }
 
-    /// Location [m] of the minimum of the profile (far end for one-end jacking).
+    /// Location \[m\] of the minimum of the profile (far end for one-end jacking).
     fn argmin(&self) -> f64 {
         let mut best = (f64::INFINITY, 0.0);
         for q in &self.pieces {
@@ -333,7 +333,7 @@ impl StressProfile {
         best.1
     }
 
-    /// Anchorage set (wedge draw-in) `draw_in` [m] at `end`, tendon modulus `e_p` [Pa], by
+    /// Anchorage set (wedge draw-in) `draw_in` \[m\] at `end`, tendon modulus `e_p` \[Pa\], by
     /// the standard area method: with reverse friction equal to forward friction the stress
     /// after the set is the mirror image σ_after = 2σ_ref − σ in the set zone, and σ_ref is
     /// found from  `2 ∫ max(σ − σ_ref, 0) ds = E_p · δ`  (the shortening of the tendon equals
@@ -528,7 +528,7 @@ mod tests {
     }
 
     /// Anchorage set on a straight tendon with wobble friction, σ = σ0 e^{−βs}: the set length
-    /// x solves 2σ0[(1 − e^{−βx})/β − x e^{−βx}] = E_p δ (solved here by an independent Newton
+    /// x solves 2σ0\[(1 − e^{−βx})/β − x e^{−βx}\] = E_p δ (solved here by an independent Newton
     /// iteration) and σ(0) = 2σ0 e^{−βx} − σ0 (tolerance 1e-9 rel). The textbook linear
     /// approximation x ≈ √(E_p δ/(σ0 β)) = 20.48 m, loss ≈ 2σ0βx = 114.3 MPa for
     /// σ0 = 1395 MPa, μ = 0.2, k = 0.01/m, δ = 6 mm, E_p = 195 GPa agrees within 2 % (the
