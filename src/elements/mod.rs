@@ -1,3 +1,5 @@
 //! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.
 
 pub mod continuum;
+pub mod interface;
+pub mod tendon;

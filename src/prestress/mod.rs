@@ -1,1 +1,3 @@
 //! Prestressing: tendon geometry, friction losses and equivalent forces.
+
+pub mod friction;
