@@ -1,1 +1,2 @@
 //! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.
+pub mod bar;
