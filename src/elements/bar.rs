@@ -1393,7 +1393,6 @@ mod tests {
             let (nodes, elems) = mesh(kind, 4, 4, 4.0, 4.0, 0.0);
             let coords = coords_of(&nodes, &elems);
             let hosts = hosts_of(kind, &coords);
-            let emb = BarEmbedder::new(&hosts).unwrap();
             for path in [
                 vec![[0.0, 2.0], [4.0, 2.0]], // interior mesh line
                 vec![[1.0, 0.0], [1.0, 4.0]], // interior mesh line

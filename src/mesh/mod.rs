@@ -1,1 +1,2 @@
 //! Meshes: nodes, elements and regions; generators and readers.
+pub mod gmsh;
