@@ -40,19 +40,35 @@ fn model_from_mesh(
         nodes,
         elements: elements
             .into_iter()
-            .map(|(nodes, region)| Element { kind, nodes, region, integration: Integration::Full })
+            .map(|(nodes, region)| Element {
+                kind,
+                nodes,
+                region,
+                integration: Integration::Full,
+            })
             .collect(),
         regions: thickness
             .iter()
             .enumerate()
-            .map(|(i, t)| Region { name: format!("r{i}"), material: 0, thickness: *t })
+            .map(|(i, t)| Region {
+                name: format!("r{i}"),
+                material: 0,
+                thickness: *t,
+            })
             .collect(),
         materials: vec![NamedMaterial {
             name: "m".into(),
-            law: Material::Elastic { e, nu, density: 0.0 },
+            law: Material::Elastic {
+                e,
+                nu,
+                density: 0.0,
+            },
         }],
         supports: vec![],
-        load_cases: vec![LoadCase { name: "P".into(), ..Default::default() }],
+        load_cases: vec![LoadCase {
+            name: "P".into(),
+            ..Default::default()
+        }],
         monitors: vec![],
         steps: vec![Step {
             name: "s".into(),
@@ -67,7 +83,10 @@ fn model_from_mesh(
 
 /// Linear displacement field of the patch tests.
 fn linear_field(p: [f64; 2]) -> [f64; 2] {
-    [1e-3 + 2e-3 * p[0] - 1e-3 * p[1], -5e-4 + 0.5e-3 * p[0] + 1.5e-3 * p[1]]
+    [
+        1e-3 + 2e-3 * p[0] - 1e-3 * p[1],
+        -5e-4 + 0.5e-3 * p[0] + 1.5e-3 * p[1],
+    ]
 }
 
 /// Constant-strain patch test on a 2×2 patch with a moved interior node (and, for quadratic
@@ -77,10 +96,17 @@ fn linear_field(p: [f64; 2]) -> [f64; 2] {
 #[test]
 fn patch_tests_reproduce_constant_strain() {
     for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
-        let bands = [Band { depth: 1.0, rows: 2, region: 0 }];
+        let bands = [Band {
+            depth: 1.0,
+            rows: 2,
+            region: 0,
+        }];
         let mut g = generate([0.0, 0.0], 1.0, 2, &bands, kind);
         let on_boundary = |p: [f64; 2]| {
-            p[0].abs() < 1e-12 || p[1].abs() < 1e-12 || (p[0] - 1.0).abs() < 1e-12 || (p[1] - 1.0).abs() < 1e-12
+            p[0].abs() < 1e-12
+                || p[1].abs() < 1e-12
+                || (p[0] - 1.0).abs() < 1e-12
+                || (p[1] - 1.0).abs() < 1e-12
         };
         // Distort every interior node by a fixed pseudo-random offset.
         for (i, p) in g.nodes.iter_mut().enumerate() {
@@ -101,21 +127,34 @@ fn patch_tests_reproduce_constant_strain() {
                 [(i, Dir::X, u[0]), (i, Dir::Y, u[1])]
             })
             .collect();
-        m.supports.push(Support { name: "boundary".into(), dofs });
+        m.supports.push(Support {
+            name: "boundary".into(),
+            dofs,
+        });
         let mut last = Last::default();
         steps::run(&m, &mut last).unwrap();
         for (i, p) in m.nodes.iter().enumerate() {
             let u = linear_field(*p);
             // Round-off of a well-conditioned 2×2 patch: 1e-12 of the displacement scale.
-            assert!((last.u[2 * i] - u[0]).abs() < 1e-12 && (last.u[2 * i + 1] - u[1]).abs() < 1e-12, "{kind:?} node {i}");
+            assert!(
+                (last.u[2 * i] - u[0]).abs() < 1e-12 && (last.u[2 * i + 1] - u[1]).abs() < 1e-12,
+                "{kind:?} node {i}"
+            );
         }
         let eps = [2e-3, 1.5e-3, -1e-3 + 0.5e-3];
         let c = e / (1.0 - nu * nu);
-        let sig = [c * (eps[0] + nu * eps[1]), c * (eps[1] + nu * eps[0]), c * (1.0 - nu) / 2.0 * eps[2]];
+        let sig = [
+            c * (eps[0] + nu * eps[1]),
+            c * (eps[1] + nu * eps[0]),
+            c * (1.0 - nu) / 2.0 * eps[2],
+        ];
         for s in &last.stress {
             for k in 0..3 {
                 // Stress ~ E·ε ~ 1e8 Pa; round-off in derivatives ~1e-12 relative.
-                assert!((s[k] - sig[k]).abs() < 1e-9 * c * 2e-3, "{kind:?} stress {s:?} vs {sig:?}");
+                assert!(
+                    (s[k] - sig[k]).abs() < 1e-9 * c * 2e-3,
+                    "{kind:?} stress {s:?} vs {sig:?}"
+                );
             }
         }
     }
@@ -135,7 +174,14 @@ struct Tg {
 impl Tg {
     fn new(t: f64) -> Self {
         let c = 0.25;
-        Self { p: 1e4, l: 2.0, c, e: 30e9, nu: 0.25, i: t * (2.0 * c).powi(3) / 12.0 }
+        Self {
+            p: 1e4,
+            l: 2.0,
+            c,
+            e: 30e9,
+            nu: 0.25,
+            i: t * (2.0 * c).powi(3) / 12.0,
+        }
     }
     fn g(&self) -> f64 {
         self.e / (2.0 * (1.0 + self.nu))
@@ -145,7 +191,8 @@ impl Tg {
         let u = -p * x * x * y / (2.0 * e * i) - nu * p * y.powi(3) / (6.0 * e * i)
             + p * y.powi(3) / (6.0 * g * i)
             + (p * l * l / (2.0 * e * i) - p * c * c / (2.0 * g * i)) * y;
-        let v = nu * p * x * y * y / (2.0 * e * i) + p * x.powi(3) / (6.0 * e * i) - p * l * l * x / (2.0 * e * i)
+        let v = nu * p * x * y * y / (2.0 * e * i) + p * x.powi(3) / (6.0 * e * i)
+            - p * l * l * x / (2.0 * e * i)
             + p * l.powi(3) / (3.0 * e * i);
         [u, v]
     }
@@ -160,7 +207,17 @@ impl Tg {
 fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
     let t = 0.1;
     let tg = Tg::new(t);
-    let g = generate([0.0, -tg.c], tg.l, nx, &[Band { depth: 2.0 * tg.c, rows: ny, region: 0 }], kind);
+    let g = generate(
+        [0.0, -tg.c],
+        tg.l,
+        nx,
+        &[Band {
+            depth: 2.0 * tg.c,
+            rows: ny,
+            region: 0,
+        }],
+        kind,
+    );
     let mut m = model_from_mesh(kind, g.nodes.clone(), g.elements.clone(), &[t], tg.e, tg.nu);
     let clamp: Vec<(usize, Dir, f64)> = g
         .nodes
@@ -172,7 +229,10 @@ fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
             [(i, Dir::X, u[0]), (i, Dir::Y, u[1])]
         })
         .collect();
-    m.supports.push(Support { name: "clamp".into(), dofs: clamp });
+    m.supports.push(Support {
+        name: "clamp".into(),
+        dofs: clamp,
+    });
     // Consistent nodal forces of the parabolic traction on the edges at x = 0 (4-point Gauss,
     // exact for the quadratic traction times quadratic shape functions).
     let mut forces = vec![0.0; m.nodes.len()];
@@ -186,8 +246,16 @@ fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
             let r = segfem::fem::quadrature::gauss(4);
             for (s, w) in r.points.iter().zip(&r.weights) {
                 let (nv, dn) = segfem::fem::shape::line_shape(nodes.len(), *s);
-                let y: f64 = nodes.iter().enumerate().map(|(a, &n)| nv[a] * m.nodes[n][1]).sum();
-                let dy: f64 = nodes.iter().enumerate().map(|(a, &n)| dn[a] * m.nodes[n][1]).sum();
+                let y: f64 = nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(a, &n)| nv[a] * m.nodes[n][1])
+                    .sum();
+                let dy: f64 = nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(a, &n)| dn[a] * m.nodes[n][1])
+                    .sum();
                 for (a, &n) in nodes.iter().enumerate() {
                     forces[n] += w * dy.abs() * nv[a] * tg.traction_y(y) * t;
                 }
@@ -223,7 +291,11 @@ fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
             ref2 += w * det * (ue[0].powi(2) + ue[1].powi(2));
         }
     }
-    let tip = m.nodes.iter().position(|p| p[0].abs() < 1e-12 && p[1].abs() < 1e-12).unwrap();
+    let tip = m
+        .nodes
+        .iter()
+        .position(|p| p[0].abs() < 1e-12 && p[1].abs() < 1e-12)
+        .unwrap();
     ((err2 / ref2).sqrt(), last.u[2 * tip + 1])
 }
 
@@ -233,24 +305,41 @@ fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
 fn cantilever_matches_timoshenko_goodier_and_converges_at_the_expected_rate() {
     let tg = Tg::new(0.1);
     let exact_tip = tg.disp(0.0, 0.0)[1];
-    for (kind, expected_rate, tip_tol) in [(QuadKind::Q4, 2.0, 2e-2), (QuadKind::Q8, 3.0, 1e-4), (QuadKind::Q9, 3.0, 1e-4)] {
-        let errs: Vec<(f64, f64)> = [(8, 2), (16, 4), (32, 8)].iter().map(|&(nx, ny)| cantilever(kind, nx, ny)).collect();
+    for (kind, expected_rate, tip_tol) in [
+        (QuadKind::Q4, 2.0, 2e-2),
+        (QuadKind::Q8, 3.0, 1e-4),
+        (QuadKind::Q9, 3.0, 1e-4),
+    ] {
+        let errs: Vec<(f64, f64)> = [(8, 2), (16, 4), (32, 8)]
+            .iter()
+            .map(|&(nx, ny)| cantilever(kind, nx, ny))
+            .collect();
         let rate1 = (errs[0].0 / errs[1].0).log2();
         let rate2 = (errs[1].0 / errs[2].0).log2();
         // Asymptotic rates are approached from either side on coarse meshes; ±0.25 allows for
         // the pre-asymptotic range while still telling order 2 from order 3.
-        assert!((rate2 - expected_rate).abs() < 0.25, "{kind:?}: rates {rate1:.2}, {rate2:.2} (errors {errs:?})");
+        assert!(
+            (rate2 - expected_rate).abs() < 0.25,
+            "{kind:?}: rates {rate1:.2}, {rate2:.2} (errors {errs:?})"
+        );
         // Finest mesh tip deflection: Q4 is still stiff in bending (shear locking ~1 %), the
         // quadratic elements are within 1e-4 of the exact cubic field.
         let tip = errs[2].1;
-        assert!(((tip - exact_tip) / exact_tip).abs() < tip_tol, "{kind:?}: tip {tip} vs exact {exact_tip}");
+        assert!(
+            ((tip - exact_tip) / exact_tip).abs() < tip_tol,
+            "{kind:?}: tip {tip} vs exact {exact_tip}"
+        );
     }
 }
 
 /// The sum of reactions balances the applied loads (self weight and point loads) to 1e-9.
 #[test]
 fn reactions_balance_applied_loads() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/box-beam.toml")).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/box-beam.toml"
+    ))
+    .unwrap();
     let model = segfem::input::parse(&text, "box-beam.toml").unwrap().model;
     let mut last = Last::default();
     steps::run(&model, &mut last).unwrap();
@@ -267,8 +356,14 @@ fn reactions_balance_applied_loads() {
     }
     // Applied: weight 0.27 m² × 7.2 m × 2548.4 kg/m³ × 9.81 + 2 × 56 kN.
     let w = 0.27 * 7.2 * 2548.4 * 9.81 + 2.0 * 56e3;
-    assert!((applied[1] + w).abs() < 1e-9 * w, "applied {applied:?} vs {w}");
-    assert!((reaction[1] + applied[1]).abs() < 1e-9 * w, "reaction {reaction:?}");
+    assert!(
+        (applied[1] + w).abs() < 1e-9 * w,
+        "applied {applied:?} vs {w}"
+    );
+    assert!(
+        (reaction[1] + applied[1]).abs() < 1e-9 * w,
+        "reaction {reaction:?}"
+    );
     assert!((reaction[0] + applied[0]).abs() < 1e-9 * w);
 }
 
@@ -280,7 +375,15 @@ fn banded_generator_reproduces_section_properties() {
     let depths = [0.10, 0.40, 0.10];
     let widths = [0.70, 0.20, 1.20];
     for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
-        let bands: Vec<Band> = depths.iter().enumerate().map(|(i, d)| Band { depth: *d, rows: 2 + i, region: i }).collect();
+        let bands: Vec<Band> = depths
+            .iter()
+            .enumerate()
+            .map(|(i, d)| Band {
+                depth: *d,
+                rows: 2 + i,
+                region: i,
+            })
+            .collect();
         let len = 1.0;
         let g = generate([0.0, 0.0], len, 3, &bands, kind);
         let (mut a, mut s, mut i0) = (0.0, 0.0, 0.0);
@@ -300,8 +403,15 @@ fn banded_generator_reproduces_section_properties() {
         let i = i0 - a * c * c;
         let (a_ref, c_ref, i_ref) = segfem::mesh::banded::section_properties(&depths, &widths);
         // Gauss rules integrate y² exactly on straight-sided elements: round-off only.
-        assert!((a - a_ref).abs() < 1e-12 && (c - c_ref).abs() < 1e-12 && (i - i_ref).abs() < 1e-12 * i_ref.max(1.0));
+        assert!(
+            (a - a_ref).abs() < 1e-12
+                && (c - c_ref).abs() < 1e-12
+                && (i - i_ref).abs() < 1e-12 * i_ref.max(1.0)
+        );
         // VALIDATION.md §1 hand values, given to 3–4 significant digits.
-        assert!((a - 0.270).abs() < 5e-4 && (c - 0.346).abs() < 5e-4 && (i - 0.01252).abs() < 5e-6, "{a} {c} {i}");
+        assert!(
+            (a - 0.270).abs() < 5e-4 && (c - 0.346).abs() < 5e-4 && (i - 0.01252).abs() < 5e-6,
+            "{a} {c} {i}"
+        );
     }
 }

@@ -1,5 +1,6 @@
 //! Element kinds: plane-stress continuum, embedded bars, joint interfaces and external tendons.
 
+pub mod bar;
 pub mod continuum;
 pub mod interface;
 pub mod tendon;

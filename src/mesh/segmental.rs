@@ -59,7 +59,8 @@ pub fn generate_segments(
         out.nodes.extend(g.nodes);
         let first = out.elements.len();
         for (el, region) in g.elements {
-            out.elements.push((el.iter().map(|v| v + off).collect(), region, s));
+            out.elements
+                .push((el.iter().map(|v| v + off).collect(), region, s));
         }
         // Element (row r, column c) is first + r·n + c; edge 1 is the right edge (nodes 1→2),
         // edge 3 the left edge (nodes 3→0, top to bottom, so reversed here to go upward).
@@ -84,16 +85,28 @@ pub fn generate_segments(
             let faces = (0..rows)
                 .map(|r| {
                     let (b, _) = edge(r, 0, false);
-                    JointFace { a: left_faces[r].a.clone(), b, region: left_faces[r].region }
+                    JointFace {
+                        a: left_faces[r].a.clone(),
+                        b,
+                        region: left_faces[r].region,
+                    }
                 })
                 .collect();
-            out.joints.push(Joint { left: s - 1, x, faces });
+            out.joints.push(Joint {
+                left: s - 1,
+                x,
+                faces,
+            });
         }
         prev_right = Some(
             (0..rows)
                 .map(|r| {
                     let (a, region) = edge(r, n - 1, true);
-                    JointFace { a, b: vec![], region }
+                    JointFace {
+                        a,
+                        b: vec![],
+                        region,
+                    }
                 })
                 .collect(),
         );
@@ -110,7 +123,18 @@ mod tests {
     /// the same coordinates but with distinct nodes.
     #[test]
     fn joints_pair_coincident_distinct_nodes() {
-        let bands = [Band { depth: 0.2, rows: 1, region: 0 }, Band { depth: 0.4, rows: 2, region: 1 }];
+        let bands = [
+            Band {
+                depth: 0.2,
+                rows: 1,
+                region: 0,
+            },
+            Band {
+                depth: 0.4,
+                rows: 2,
+                region: 1,
+            },
+        ];
         for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
             let m = generate_segments(0.0, 0.0, &[1.0, 1.0, 1.5], &[2, 2, 3], &bands, kind);
             assert_eq!(m.joints.len(), 2);
@@ -123,7 +147,11 @@ mod tests {
                     for (a, b) in f.a.iter().zip(&f.b) {
                         assert_ne!(a, b);
                         let (pa, pb) = (m.nodes[*a], m.nodes[*b]);
-                        assert!((pa[0] - j.x).abs() < 1e-12 && (pa[0] - pb[0]).abs() < 1e-12 && (pa[1] - pb[1]).abs() < 1e-12);
+                        assert!(
+                            (pa[0] - j.x).abs() < 1e-12
+                                && (pa[0] - pb[0]).abs() < 1e-12
+                                && (pa[1] - pb[1]).abs() < 1e-12
+                        );
                     }
                     // Bottom to top.
                     assert!(m.nodes[f.a[1]][1] > m.nodes[f.a[0]][1]);
