@@ -1158,8 +1158,11 @@ $EndElements
         b
     }
 
+    /// Nodes, elements and physical names: the version-independent content.
+    type Content<'a> = (&'a [(u64, [f64; 2])], &'a [GmshElement], &'a [(i32, i32, String)]);
+
     /// Version-independent content.
-    fn content(m: &GmshMesh) -> (&[(u64, [f64; 2])], &[GmshElement], &[(i32, i32, String)]) {
+    fn content(m: &GmshMesh) -> Content<'_> {
         (&m.nodes, &m.elements, &m.physical_names)
     }
 
