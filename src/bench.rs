@@ -79,6 +79,8 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
                 density: 2500.0,
             },
         }],
+        interfaces: vec![],
+        joints: vec![],
         supports: vec![],
         load_cases: vec![],
         monitors: vec![],

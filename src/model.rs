@@ -2,6 +2,7 @@
 //! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
 
 use crate::elements::continuum::Integration;
+use crate::elements::interface::InterfaceParams;
 use crate::fem::shape::QuadKind;
 use crate::materials::point::Material;
 use serde::Serialize;
@@ -111,6 +112,21 @@ pub enum MonitorKind {
         /// Load case index.
         case: usize,
     },
+    /// Largest opening of a joint over its depth [m].
+    JointOpening {
+        /// Joint index.
+        joint: usize,
+    },
+    /// Depth of a joint still in contact (closed) [m].
+    JointContactDepth {
+        /// Joint index.
+        joint: usize,
+    },
+    /// Largest slip (relative tangential displacement) of a joint [m].
+    JointSlip {
+        /// Joint index.
+        joint: usize,
+    },
 }
 
 /// A named monitor: one column of `history.csv`.
@@ -129,6 +145,9 @@ impl Monitor {
             MonitorKind::Displacement { .. } => "m",
             MonitorKind::Reaction { .. } => "N",
             MonitorKind::LoadFactor { .. } => "-",
+            MonitorKind::JointOpening { .. }
+            | MonitorKind::JointContactDepth { .. }
+            | MonitorKind::JointSlip { .. } => "m",
         }
     }
 }
@@ -182,6 +201,44 @@ impl Default for SolverControls {
     }
 }
 
+/// A named joint material (contact law parameters).
+#[derive(Debug, Clone, Serialize)]
+pub struct JointMaterial {
+    /// User name.
+    pub name: String,
+    /// Contact-law parameters (penalties in Pa/m).
+    #[serde(skip)]
+    pub params: InterfaceParams,
+}
+
+/// One joint contact element between two facing element edges.
+#[derive(Debug, Clone, Serialize)]
+pub struct InterfaceEl {
+    /// Face A nodes (counter-clockwise edge order of its element: start, end, [mid]), then
+    /// face B nodes.
+    pub nodes: Vec<usize>,
+    /// Number of face-A nodes.
+    pub n_a: usize,
+    /// Thickness of the joint (that of the band it lies in) [m].
+    pub thickness: f64,
+    /// Contact-law parameters (with the penalty stiffness resolved).
+    #[serde(skip)]
+    pub params: InterfaceParams,
+    /// Joint index.
+    pub joint: usize,
+}
+
+/// A joint between two segments: a set of interface elements.
+#[derive(Debug, Clone, Serialize)]
+pub struct Joint {
+    /// Name (e.g. "J3").
+    pub name: String,
+    /// Abscissa [m] (of face A's first node).
+    pub x: f64,
+    /// Interface elements of this joint (indices into `Model::interfaces`).
+    pub interfaces: Vec<usize>,
+}
+
 /// The complete validated model.
 #[derive(Debug, Clone, Serialize)]
 pub struct Model {
@@ -195,6 +252,10 @@ pub struct Model {
     pub regions: Vec<Region>,
     /// Materials.
     pub materials: Vec<NamedMaterial>,
+    /// Joint contact elements.
+    pub interfaces: Vec<InterfaceEl>,
+    /// Joints (groups of interface elements).
+    pub joints: Vec<Joint>,
     /// Supports.
     pub supports: Vec<Support>,
     /// Load cases.

@@ -64,6 +64,8 @@ fn model_from_mesh(
                 density: 0.0,
             },
         }],
+        interfaces: vec![],
+        joints: vec![],
         supports: vec![],
         load_cases: vec![LoadCase {
             name: "P".into(),

@@ -2,6 +2,7 @@
 //! (committed and trial), and the assembly of internal forces and tangent.
 
 use crate::elements::continuum::{self, GaussOutput};
+use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
 use crate::materials::point::{PointState, UpdateError};
@@ -32,8 +33,27 @@ pub struct System<'m> {
     pub gauss: Vec<GaussOutput>,
     /// Trial Gauss outputs.
     pub gauss_trial: Vec<GaussOutput>,
-    /// True if every material is linear (tangent constant).
+    /// True if every material is linear and there are no joints (tangent constant).
     pub linear: bool,
+    /// Joint contact elements (geometry from the contact search, done once).
+    pub interfaces: Vec<InterfaceElement>,
+    /// Committed joint integration-point states.
+    pub iface_committed: Vec<Vec<InterfacePointState>>,
+    /// Trial joint states (of the last assembly).
+    pub iface_trial: Vec<Vec<InterfacePointState>>,
+    /// True if the last assembled tangent was made symmetric (friction slip).
+    pub symmetrised: bool,
+}
+
+/// Replace a square row-major matrix of order n by its symmetric part.
+fn symmetrise(k: &mut [f64], n: usize) {
+    for i in 0..n {
+        for j in 0..i {
+            let m = 0.5 * (k[i * n + j] + k[j * n + i]);
+            k[i * n + j] = m;
+            k[j * n + i] = m;
+        }
+    }
 }
 
 /// Element force and row-major tangent, or the failing element and why.
@@ -56,7 +76,12 @@ impl<'m> System<'m> {
             .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
             .collect();
         let dofs = DofMap::new(model.nodes.len(), &constrained);
-        let elem_nodes: Vec<Vec<usize>> = model.elements.iter().map(|e| e.nodes.clone()).collect();
+        let elem_nodes: Vec<Vec<usize>> = model
+            .elements
+            .iter()
+            .map(|e| e.nodes.clone())
+            .chain(model.interfaces.iter().map(|i| i.nodes.clone()))
+            .collect();
         let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
         let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
         let mut committed = Vec::new();
@@ -69,8 +94,22 @@ impl<'m> System<'m> {
             }
             gp_offset.push(committed.len());
         }
-        let linear = model.materials.iter().all(|m| m.law.is_linear());
+        let linear = model.materials.iter().all(|m| m.law.is_linear()) && model.interfaces.is_empty();
         let n_gp = committed.len();
+        let interfaces: Vec<InterfaceElement> = model
+            .interfaces
+            .iter()
+            .map(|i| {
+                let c: Vec<[f64; 2]> = i.nodes.iter().map(|&n| model.nodes[n]).collect();
+                InterfaceElement::new(&c[..i.n_a], &c[i.n_a..], &i.params)
+                    .expect("interface geometry checked at input")
+            })
+            .collect();
+        let iface_committed: Vec<Vec<InterfacePointState>> = interfaces
+            .iter()
+            .zip(&model.interfaces)
+            .map(|(el, i)| el.initial_states(&i.params))
+            .collect();
         Self {
             model,
             dofs,
@@ -82,6 +121,10 @@ impl<'m> System<'m> {
             gauss: vec![GaussOutput::default(); n_gp],
             gauss_trial: vec![GaussOutput::default(); n_gp],
             linear,
+            iface_trial: iface_committed.clone(),
+            iface_committed,
+            interfaces,
+            symmetrised: false,
         }
     }
 
@@ -166,6 +209,42 @@ impl<'m> System<'m> {
             }
             start = end;
         }
+        // Joint contact elements.
+        let n_cont = n_el;
+        let results: Vec<_> = self
+            .interfaces
+            .par_iter()
+            .zip(&model.interfaces)
+            .zip(&self.iface_committed)
+            .map(|((el, data), committed)| {
+                let ue: Vec<f64> = data
+                    .nodes
+                    .iter()
+                    .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
+                    .collect();
+                el.response(&data.params, data.thickness, &ue, committed)
+            })
+            .collect();
+        let mut symmetrised = false;
+        for (i, r) in results.into_iter().enumerate() {
+            let nodes = &model.interfaces[i].nodes;
+            for (a, &n) in nodes.iter().enumerate() {
+                f_int[2 * n] += r.f_int[2 * a];
+                f_int[2 * n + 1] += r.f_int[2 * a + 1];
+            }
+            if let Some(k) = k_values.as_mut() {
+                let mut ke = r.k;
+                if !r.symmetric {
+                    // Slip makes the tangent unsymmetric; the Cholesky path takes its
+                    // symmetric part (more iterations, same converged answer).
+                    symmetrise(&mut ke, 2 * nodes.len());
+                    symmetrised = true;
+                }
+                self.asm.add_matrix(n_cont + i, &ke, k);
+            }
+            self.iface_trial[i] = r.states;
+        }
+        self.symmetrised = symmetrised;
         Ok(Assembled { f_int, k_values })
     }
 
@@ -175,6 +254,7 @@ impl<'m> System<'m> {
         std::mem::swap(&mut self.committed, &mut self.trial);
         self.trial.clone_from(&self.committed);
         std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
+        self.iface_committed.clone_from(&self.iface_trial);
     }
 
     /// Gather the free-equation part of a full dof vector.

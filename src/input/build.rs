@@ -187,6 +187,8 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         elements,
         regions,
         materials,
+        interfaces: Vec::new(),
+        joints: Vec::new(),
         supports: Vec::new(),
         load_cases: Vec::new(),
         monitors: Vec::new(),

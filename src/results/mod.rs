@@ -4,3 +4,4 @@ pub mod atomic;
 pub mod fields;
 pub mod recorder;
 pub mod vtu;
+pub mod joints;

@@ -4,6 +4,7 @@
 
 use super::atomic::write_atomic;
 use super::fields::{principal, recover};
+use super::joints::summarise;
 use super::vtu::{render, render_pvd, Array, Grid};
 use crate::analysis::steps::{Observer, Snapshot};
 use crate::model::{Model, MonitorKind};
@@ -90,6 +91,9 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
+                MonitorKind::JointOpening { joint } => summarise(snap.system, *joint).max_opening,
+                MonitorKind::JointContactDepth { joint } => summarise(snap.system, *joint).contact_depth,
+                MonitorKind::JointSlip { joint } => summarise(snap.system, *joint).max_slip,
             })
             .collect()
     }
