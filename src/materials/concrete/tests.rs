@@ -1,0 +1,1 @@
+//! Material-point tests of the concrete model.
