@@ -26,6 +26,9 @@ use crate::materials::error::MaterialError;
 
 /// Newton tolerance on the scaled residual (stresses/f_cm, dimensionless).
 const TOL: f64 = 1e-11;
+/// Residual below which a stagnating Newton iteration (round-off floor, e.g. near the
+/// Lode-angle meridians where λ(θ) is strongly curved) is accepted as converged.
+const STAGNATION_TOL: f64 = 1e-8;
 /// Maximum Newton iterations per (sub)step.
 const MAX_ITER: usize = 60;
 /// Largest number of substeps tried.
@@ -58,9 +61,64 @@ pub fn initial_yield(p: &ConcreteParams) -> (f64, f64) {
     (e0, e0 - r * p.fcm / p.ec)
 }
 
+/// Start ε̄* [-] of the linear post-peak branch: the curve strain beyond the peak at which
+/// the plastic modulus H = E E_t/(E − E_t) of the MC90 curve reaches −h E
+/// (h = `softening_limit`), i.e. E_t = −h E/(1 − h). None if the curve is never that steep
+/// before ε_lim (where its slope is steepest) or h ≥ 1.
+///
+/// On the ascending formula dσ/dε = (f_cm/ε_c1)(k_p − 2η − aη²)/(1 + aη)², a = k_p − 2;
+/// setting it to E_t gives (a + m a²)η² + (2 + 2ma)η − (k_p − m) = 0, m = E_t ε_c1/f_cm.
+pub fn softening_start(p: &ConcreteParams) -> Option<f64> {
+    let h = p.softening_limit;
+    if !(h > 0.0 && h < 1.0) {
+        return None;
+    }
+    let c = p.curve();
+    let et = -h * p.ec / (1.0 - h);
+    if c.eval(c.eps_lim()).1 >= et {
+        return None;
+    }
+    let a = c.kp - 2.0;
+    let m = et * c.eps_c1 / c.fcm;
+    let qa = a + m * a * a;
+    let qb = 2.0 + 2.0 * m * a;
+    let qc = -(c.kp - m);
+    let eta = if qa.abs() < 1e-14 {
+        -qc / qb
+    } else {
+        let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
+        let r1 = (-qb + disc) / (2.0 * qa);
+        let r2 = (-qb - disc) / (2.0 * qa);
+        if (1.0..=c.eta_lim + 1e-12).contains(&r1) {
+            r1
+        } else {
+            r2
+        }
+    };
+    Some(eta.clamp(1.0, c.eta_lim) * c.eps_c1)
+}
+
+/// Hardening law σ_c(ε̄) [Pa] and slope [Pa]: the MC90 curve, continued beyond ε̄* (see
+/// [`softening_start`]) by a straight line of slope E_t = −hE/(1 − h) down to zero stress
+/// (then σ_c = 0). The limit keeps the local return-mapping problem well posed: with the
+/// raw MC90 branch the plastic modulus reaches ≈ −0.54 E near ε_lim, below −nᵀDn for
+/// biaxial compression, where the strain-driven point problem has no (unique) solution.
+pub fn hardening_curve(p: &ConcreteParams, ebar: f64) -> (f64, f64) {
+    let c = p.curve();
+    if let Some(es) = softening_start(p) {
+        if ebar > es {
+            let (s0, _) = c.eval(es);
+            let et = -p.softening_limit * p.ec / (1.0 - p.softening_limit);
+            let s = s0 + et * (ebar - es);
+            return if s > 0.0 { (s, et) } else { (0.0, 0.0) };
+        }
+    }
+    c.eval(ebar)
+}
+
 /// σ_c, κ and their derivatives at curve strain `ebar` [-].
 pub fn hardening(p: &ConcreteParams, ebar: f64) -> Hardening {
-    let (s, ds) = p.curve().eval(ebar);
+    let (s, ds) = hardening_curve(p, ebar);
     let (_, k0) = initial_yield(p);
     Hardening {
         sigma_c: s,
@@ -158,8 +216,9 @@ fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
         b.swap(c, piv);
         for r in c + 1..4 {
             let f = a[r][c] / a[c][c];
-            for k in c..4 {
-                a[r][k] -= f * a[c][k];
+            let pivot_row = a[c];
+            for (ark, ack) in a[r].iter_mut().zip(pivot_row.iter()).skip(c) {
+                *ark -= f * ack;
             }
             b[r] -= f * b[c];
         }
@@ -241,7 +300,7 @@ fn step(
     let mut eb = ebar_n;
     let (mut r, mut norm) = resid(&s, eb);
     let mut it = 0;
-    while norm > TOL {
+    'newton: while norm > TOL {
         it += 1;
         if it > MAX_ITER || !norm.is_finite() {
             return Err((it, norm));
@@ -255,6 +314,10 @@ fn step(
             let eb_new = (eb + t * dy[3] * cs[3]).max(ebar_n);
             let (r_new, n_new) = resid(&s_new, eb_new);
             if n_new.is_finite() && (n_new <= (1.0 - 1e-4 * t) * norm || t < 1e-3) {
+                if n_new >= norm && norm < STAGNATION_TOL {
+                    // Round-off floor reached (no descent possible): accept the iterate.
+                    break 'newton;
+                }
                 s = s_new;
                 eb = eb_new;
                 r = r_new;

@@ -23,7 +23,7 @@
 //! identically zero but the residual stiffness is returned, when `secant_crack_tangent` is
 //! set, and in the step in which a crack forms (the regime switch is discontinuous).
 
-use super::{compression, ConcreteParams, ConcreteState, MaterialError};
+use super::{compression, ConcreteParams, ConcreteState, MaterialError, UpdateResult};
 
 /// Strain transformation ε' = T ε to axes rotated by `phi` (engineering shear).
 pub fn strain_transform(phi: f64) -> [[f64; 3]; 3] {
@@ -71,6 +71,7 @@ fn direction(
     e: f64,
 ) -> DirResult {
     let e_el = e + plastic;
+    let ebar = ebar.max(compression::initial_yield(p).0);
     let mut r = DirResult {
         sigma: 0.0,
         k: 0.0,
@@ -131,7 +132,7 @@ pub fn update_cracked(
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
-) -> Result<(ConcreteState, [f64; 3], [[f64; 3]; 3]), MaterialError> {
+) -> UpdateResult {
     if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
         && !(char_length > 0.0 && char_length.is_finite())
     {

@@ -106,6 +106,10 @@ pub struct ConcreteParams {
     /// crushed and carries no stress (default 0.0035; set ε_cu = ε_c1 for "crushed at the
     /// failure surface").
     pub eps_cu: f64,
+    /// Post-peak softening limit h [-]: the plastic modulus of the hardening law is bounded
+    /// below by −h E (straight line beyond that point, see
+    /// [`compression::hardening_curve`]); default 0.25; ≥ 1 disables the limit (raw MC90).
+    pub softening_limit: f64,
     /// Crack/crush discrimination ratio r_d [-]: σ1 ≥ r_d f_tm → crack (MC90/seed: 0.5).
     pub crack_ratio: f64,
     /// Post-cracking tension law.
@@ -144,6 +148,7 @@ impl ConcreteParams {
             initial_yield_ratio: 0.0,
             normalize_equivalent_stress: true,
             eps_cu: 0.0035,
+            softening_limit: 0.25,
             crack_ratio: 0.5,
             tension: TensionSoftening::Hinton { alpha: 5e-4 },
             shear: ShearRetention::default(),
@@ -196,6 +201,14 @@ impl ConcreteParams {
         } else {
             1.0
         }
+    }
+
+    /// Compression-dominated stress state (routes to plasticity/crushing, MODEL.md §1.6):
+    /// largest principal stress σ1 < r_d f_tm and I1 = σx + σy < 0. The I1 condition keeps
+    /// small tensile states out of the hardening model, whose loading surfaces pass
+    /// through the origin when the initial yield stress is zero.
+    pub fn compression_dominated(&self, s: &[f64; 3]) -> bool {
+        principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < 0.0
     }
 
     /// Cracking strain ε0 = f_tm/E [-].
@@ -338,6 +351,9 @@ fn matvec(d: &[[f64; 3]; 3], v: &[f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| (0..3).map(|j| d[i][j] * v[j]).sum())
 }
 
+/// Result of [`update`]: (trial state, stress (σx, σy, τxy) [Pa], tangent [[Pa; 3]; 3]).
+pub type UpdateResult = Result<(ConcreteState, [f64; 3], [[f64; 3]; 3]), MaterialError>;
+
 /// Stress update from the committed state and the total strain (εx, εy, γxy) [-].
 ///
 /// `char_length` [m] is the element's characteristic length (used by crack-band
@@ -353,7 +369,7 @@ pub fn update(
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
-) -> Result<(ConcreteState, [f64; 3], [[f64; 3]; 3]), MaterialError> {
+) -> UpdateResult {
     if !strain.iter().all(|v| v.is_finite()) {
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
@@ -366,42 +382,59 @@ pub fn update(
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let s_tr = matvec(&d, &ee);
-    let (s1, phi) = principal_max(&s_tr);
-    if s1 >= p.crack_ratio * p.ftm {
-        // Tension-dominated: elastic until the Ottosen failure surface, then crack.
-        if ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
+    let (_, phi) = principal_max(&s_tr);
+    // Plastic (compression) branch: if the trial stress is compression-dominated, or if the
+    // trial would yield and the returned stress is compression-dominated. Routing on the
+    // returned stress as well avoids sending a plastically flowing point to the elastic
+    // branch only because its elastic trial shows lateral tension (uniaxial compression
+    // with dilatancy does exactly that).
+    let trial_cd = p.compression_dominated(&s_tr);
+    // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
+    let ebar_n = committed.ebar.max(compression::initial_yield(p).0);
+    let yields = compression::sigma_hat(p, &s_tr).0
+        > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
+    if trial_cd || yields {
+        let res = compression::update(
+            p,
+            &committed.strain,
+            &committed.plastic_strain,
+            ebar_n,
+            strain,
+        );
+        let accept = match &res {
+            Ok(u) => trial_cd || (u.plastic && p.compression_dominated(&u.stress)),
+            Err(_) => trial_cd,
+        };
+        if accept {
+            let u = res?;
             let mut st = committed.clone();
-            st.n_cracks = 1;
-            st.crack_angle = phi;
-            st.crack_max = [0.0; 2];
-            st.dir_ebar = [committed.ebar; 2];
-            st.dir_plastic = [0.0; 2];
-            return cracking::update_cracked(p, &st, strain, char_length);
+            st.strain = *strain;
+            st.plastic_strain = u.plastic_strain;
+            st.ebar = u.ebar;
+            st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
+            if u.ebar >= p.eps_cu || compression::hardening(p, u.ebar).sigma_c <= 0.0 {
+                st.crushed = true;
+                return Ok(crushed(p, &st, strain));
+            }
+            st.stress = u.stress;
+            return Ok((st, u.stress, u.tangent));
         }
-        let mut st = committed.clone();
-        st.strain = *strain;
-        st.stress = s_tr;
-        return Ok((st, s_tr, d));
     }
-    // Compression-dominated: elastoplastic update.
-    let u = compression::update(
-        p,
-        &committed.strain,
-        &committed.plastic_strain,
-        committed.ebar,
-        strain,
-    )?;
+    // Tension-dominated: elastic until the Ottosen failure surface, then crack.
+    let (s1, _) = principal_max(&s_tr);
+    if s1 >= p.crack_ratio * p.ftm && ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
+        let mut st = committed.clone();
+        st.n_cracks = 1;
+        st.crack_angle = phi;
+        st.crack_max = [0.0; 2];
+        st.dir_ebar = [ebar_n; 2];
+        st.dir_plastic = [0.0; 2];
+        return cracking::update_cracked(p, &st, strain, char_length);
+    }
     let mut st = committed.clone();
     st.strain = *strain;
-    st.plastic_strain = u.plastic_strain;
-    st.ebar = u.ebar;
-    st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
-    if u.ebar >= p.eps_cu {
-        st.crushed = true;
-        return Ok(crushed(p, &st, strain));
-    }
-    st.stress = u.stress;
-    Ok((st, u.stress, u.tangent))
+    st.stress = s_tr;
+    Ok((st, s_tr, d))
 }
 
 /// Response of a crushed point: zero stress, residual tangent.

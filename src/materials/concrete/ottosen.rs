@@ -184,16 +184,14 @@ pub fn equivalent_stress_hessian(p: &OttosenParams, s: &[f64; 3]) -> [[f64; 3]; 
         sm[j] -= h;
         let gp = equivalent_stress_gradient(p, &sp).1;
         let gm = equivalent_stress_gradient(p, &sm).1;
-        for i in 0..3 {
-            hm[i][j] = (gp[i] - gm[i]) / (2.0 * h);
+        for (row, (a, b)) in hm.iter_mut().zip(gp.iter().zip(gm.iter())) {
+            row[j] = (a - b) / (2.0 * h);
         }
     }
-    for i in 0..3 {
-        for j in 0..i {
-            let a = 0.5 * (hm[i][j] + hm[j][i]);
-            hm[i][j] = a;
-            hm[j][i] = a;
-        }
+    for (i, j) in [(1, 0), (2, 0), (2, 1)] {
+        let a = 0.5 * (hm[i][j] + hm[j][i]);
+        hm[i][j] = a;
+        hm[j][i] = a;
     }
     hm
 }
