@@ -497,7 +497,7 @@ proptest! {
     /// Cracked regime: crack in a random direction, then random strain states around it
     /// (opening on the envelope with shear → non-symmetric term, unloading, closing,
     /// compression along the crack, second crack). Tolerance 1e-5 E (closed-form laws; the
-    /// exponential's curvature with h = 1e-7 and α = 5e-4 gives ≈ 1e-8 relative).
+    /// exponential's curvature with h = 1e-8 and α = 5e-4 gives ≈ 1e-10 relative).
     #[test]
     fn tangent_fd_cracked(
         phi in -1.5..1.5f64,
