@@ -94,7 +94,8 @@ impl<'m> System<'m> {
             }
             gp_offset.push(committed.len());
         }
-        let linear = model.materials.iter().all(|m| m.law.is_linear()) && model.interfaces.is_empty();
+        let linear =
+            model.materials.iter().all(|m| m.law.is_linear()) && model.interfaces.is_empty();
         let n_gp = committed.len();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces

@@ -2,7 +2,11 @@
 //! and trial state apart.
 
 pub mod chain;
+pub mod concrete;
 pub mod elastic;
+pub mod error;
+pub mod mc90;
 pub mod mc90_time;
 pub mod point;
+pub mod steel;
 pub mod viscoplastic;

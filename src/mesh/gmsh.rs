@@ -1159,7 +1159,11 @@ $EndElements
     }
 
     /// Nodes, elements and physical names: the version-independent content.
-    type Content<'a> = (&'a [(u64, [f64; 2])], &'a [GmshElement], &'a [(i32, i32, String)]);
+    type Content<'a> = (
+        &'a [(u64, [f64; 2])],
+        &'a [GmshElement],
+        &'a [(i32, i32, String)],
+    );
 
     /// Version-independent content.
     fn content(m: &GmshMesh) -> Content<'_> {

@@ -35,7 +35,12 @@ pub struct JointSummary {
 
 /// Summarise joint `j` of the model from the committed states.
 pub fn summarise(sys: &System, j: usize) -> JointSummary {
-    let mut s = JointSummary { max_opening: 0.0, contact_depth: 0.0, max_slip: 0.0, profile: Vec::new() };
+    let mut s = JointSummary {
+        max_opening: 0.0,
+        contact_depth: 0.0,
+        max_slip: 0.0,
+        profile: Vec::new(),
+    };
     for &i in &sys.model.joints[j].interfaces {
         let el = &sys.interfaces[i];
         for (p, st) in el.points().iter().zip(&sys.iface_committed[i]) {

@@ -2,6 +2,6 @@
 
 pub mod atomic;
 pub mod fields;
+pub mod joints;
 pub mod recorder;
 pub mod vtu;
-pub mod joints;

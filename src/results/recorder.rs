@@ -92,7 +92,9 @@ impl<'m> Recorder<'m> {
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
                 MonitorKind::JointOpening { joint } => summarise(snap.system, *joint).max_opening,
-                MonitorKind::JointContactDepth { joint } => summarise(snap.system, *joint).contact_depth,
+                MonitorKind::JointContactDepth { joint } => {
+                    summarise(snap.system, *joint).contact_depth
+                }
                 MonitorKind::JointSlip { joint } => summarise(snap.system, *joint).max_slip,
             })
             .collect()

@@ -1,0 +1,227 @@
+//! Smeared fixed orthogonal cracking (seed §5.3, MODEL.md §1.6, §2.4).
+//!
+//! After the first crack the point is orthotropic in the fixed crack axes (n, t), n = normal
+//! of crack 1 at angle φ from x, t = n rotated by +90°; the Poisson effect is neglected
+//! (seed: "insignificant Poisson effect"). With ε' = T(φ)(ε − ε_p) (ε_p = plastic strain of
+//! the uncracked phase, frozen):
+//!
+//! * each direction i ∈ {n, t} has a uniaxial law σ_i(ε'_i):
+//!   - cracked direction, ε ≥ 0: tension-softening envelope (seed eq. 21) on loading,
+//!     secant to the origin on unloading/reloading (closing/reopening);
+//!   - uncracked direction, ε ≥ 0: σ = E ε; a second crack forms (normal t) when σ_t ≥ f_tm;
+//!   - ε < 0 (closed crack or compression): 1-D elastoplasticity on the MC90 curve
+//!     (same hardening variable ε̄ as the uncracked model, one per direction, closed-form
+//!     return), so struts parallel to cracks crush at f_cm;
+//! * shear: τ_nt = β G γ_nt, β from [`super::ShearRetention`] at the largest crack-normal
+//!   strain reached (so a closed crack keeps its shear reduction);
+//! * two cracks both open → no stress (seed: "concrete stresses are then zeroed").
+//!
+//! Stress σ = Tᵀ σ', tangent Tᵀ D' T. D' is the consistent tangent of the laws above: it
+//! has the off-diagonal term ∂τ/∂ε_n = β'(ε_n) G γ while crack 1 opens on its envelope
+//! (non-symmetric) and a negative normal entry on the softening branch.
+//! The tangent is *not* consistent (documented algorithmic choice) where the stress is
+//! identically zero but the residual stiffness is returned, when `secant_crack_tangent` is
+//! set, and in the step in which a crack forms (the regime switch is discontinuous).
+
+use super::{compression, ConcreteParams, ConcreteState, MaterialError, UpdateResult};
+
+/// Strain transformation ε' = T ε to axes rotated by `phi` (engineering shear).
+pub fn strain_transform(phi: f64) -> [[f64; 3]; 3] {
+    let (s, c) = phi.sin_cos();
+    [
+        [c * c, s * s, c * s],
+        [s * s, c * c, -c * s],
+        [-2.0 * c * s, 2.0 * c * s, c * c - s * s],
+    ]
+}
+
+/// Tension envelope σ(ε) [Pa] and slope [Pa] for ε ≥ 0: E ε up to ε0 = f_tm/E, then
+/// f_tm exp(−(ε − ε0)/α) (seed eq. 21).
+pub fn tension_envelope(p: &ConcreteParams, alpha: f64, eps: f64) -> (f64, f64) {
+    let e0 = p.eps0();
+    if eps <= e0 {
+        (p.ec * eps, p.ec)
+    } else {
+        let x = (-(eps - e0) / alpha).exp();
+        (p.ftm * x, -p.ftm / alpha * x)
+    }
+}
+
+/// Result of one direction law.
+#[derive(Debug, Clone, Copy)]
+struct DirResult {
+    sigma: f64,
+    k: f64,
+    emax: f64,
+    ebar: f64,
+    plastic: f64,
+    open: bool,
+    loading_crack: bool,
+    e_el: f64,
+}
+
+/// Uniaxial law of one crack-axis direction at strain `e`.
+fn direction(
+    p: &ConcreteParams,
+    alpha: f64,
+    cracked: bool,
+    emax: f64,
+    ebar: f64,
+    plastic: f64,
+    e: f64,
+) -> DirResult {
+    let e_el = e + plastic;
+    let ebar = ebar.max(compression::initial_yield(p).0);
+    let mut r = DirResult {
+        sigma: 0.0,
+        k: 0.0,
+        emax,
+        ebar,
+        plastic,
+        open: false,
+        loading_crack: false,
+        e_el,
+    };
+    if e_el >= 0.0 {
+        if !cracked {
+            r.sigma = p.ec * e_el;
+            r.k = p.ec;
+        } else if e_el >= emax {
+            let (s, k) = tension_envelope(p, alpha, e_el);
+            r.sigma = s;
+            r.k = if p.secant_crack_tangent && e_el > 0.0 {
+                s / e_el
+            } else {
+                k
+            };
+            r.emax = e_el;
+            r.open = e_el > 0.0;
+            r.loading_crack = e_el > 0.0;
+        } else {
+            let (s, _) = tension_envelope(p, alpha, emax);
+            let sec = s / emax;
+            r.sigma = sec * e_el;
+            r.k = sec;
+            r.open = e_el > 0.0;
+        }
+        return r;
+    }
+    // Compression: 1-D return on the MC90 curve (closed form, see module doc of
+    // `compression`): σ_c(ε̄) = −E(e + p + Δp), Δp = κ(ε̄) − κ(ε̄_n) ⇒
+    // ε̄ = −e − p + κ(ε̄_n) + κ0.
+    let h_n = compression::hardening(p, ebar);
+    let s_tr = p.ec * e_el;
+    if -s_tr <= h_n.sigma_c {
+        r.sigma = s_tr;
+        r.k = p.ec;
+        return r;
+    }
+    let (_, k0) = compression::initial_yield(p);
+    let eb = (-e - plastic + h_n.kappa + k0).max(ebar);
+    let h = compression::hardening(p, eb);
+    r.ebar = eb;
+    r.plastic = plastic + (h.kappa - h_n.kappa).max(0.0);
+    r.sigma = -h.sigma_c;
+    r.k = h.dsigma_c;
+    r
+}
+
+/// Stress update of a cracked point (`committed.n_cracks` ≥ 1).
+pub fn update_cracked(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+) -> UpdateResult {
+    if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
+        && !(char_length > 0.0 && char_length.is_finite())
+    {
+        return Err(MaterialError::InvalidParams(format!(
+            "crack band needs a positive characteristic length, got {char_length}"
+        )));
+    }
+    let alpha = p.softening_alpha(char_length);
+    let t = strain_transform(committed.crack_angle);
+    let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
+    let el: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * ee[j]).sum());
+    let mut n_cracks = committed.n_cracks;
+    let mut crack_max = committed.crack_max;
+    let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
+        direction(
+            p,
+            alpha,
+            (i as u8) < n_cracks,
+            crack_max[i],
+            committed.dir_ebar[i],
+            committed.dir_plastic[i],
+            el[i],
+        )
+    };
+    let r0 = eval(0, n_cracks, &crack_max);
+    let mut r1 = eval(1, n_cracks, &crack_max);
+    if n_cracks == 1 && r1.sigma >= p.ftm {
+        n_cracks = 2;
+        crack_max[1] = 0.0;
+        r1 = eval(1, n_cracks, &crack_max);
+    }
+    let g = 0.5 * p.ec / (1.0 + p.nu);
+    let mut st = committed.clone();
+    st.strain = *strain;
+    st.n_cracks = n_cracks;
+    st.crack_max = [r0.emax, if n_cracks >= 2 { r1.emax } else { 0.0 }];
+    st.crack_strain = [r0.e_el, if n_cracks >= 2 { r1.e_el } else { 0.0 }];
+    st.dir_ebar = [r0.ebar, r1.ebar];
+    st.dir_plastic = [r0.plastic, r1.plastic];
+    if r0.ebar >= p.eps_cu || r1.ebar >= p.eps_cu {
+        st.crushed = true;
+        st.stress = [0.0; 3];
+        let d = super::d_matrix(p.ec, p.nu).map(|r| r.map(|v| v * p.residual_stiffness));
+        return Ok((st, [0.0; 3], d));
+    }
+    let mut sl = [0.0; 3];
+    let mut dl = [[0.0; 3]; 3];
+    if n_cracks >= 2 && r0.open && r1.open {
+        let rs = p.residual_stiffness;
+        dl[0][0] = rs * p.ec;
+        dl[1][1] = rs * p.ec;
+        dl[2][2] = rs * g;
+    } else {
+        sl[0] = r0.sigma;
+        sl[1] = r1.sigma;
+        dl[0][0] = r0.k;
+        dl[1][1] = r1.k;
+        // Shear retention at the largest crack strain reached by the existing cracks.
+        let (imax, emax) = if n_cracks >= 2 && st.crack_max[1] > st.crack_max[0] {
+            (1, st.crack_max[1])
+        } else {
+            (0, st.crack_max[0])
+        };
+        let (beta, dbeta) = p.shear.beta(emax);
+        sl[2] = beta * g * el[2];
+        dl[2][2] = beta * g;
+        let loading = if imax == 0 {
+            r0.loading_crack
+        } else {
+            r1.loading_crack
+        };
+        if loading && !p.secant_crack_tangent {
+            dl[2][imax] = dbeta * g * el[2];
+        }
+    }
+    // σ = Tᵀ σ', D = Tᵀ D' T
+    let s: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| t[k][i] * sl[k]).sum());
+    let mut dt = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in 0..3 {
+            dt[a][b] = (0..3).map(|k| dl[a][k] * t[k][b]).sum();
+        }
+    }
+    let mut d = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in 0..3 {
+            d[a][b] = (0..3).map(|k| t[k][a] * dt[k][b]).sum();
+        }
+    }
+    st.stress = s;
+    Ok((st, s, d))
+}

@@ -1,0 +1,455 @@
+//! Plane-stress concrete material point (MODEL.md §1, §2.2, §2.4; seed §5.2–5.3).
+//!
+//! * Uncracked, compression-dominated states (largest principal trial stress
+//!   σ1 < r_d f_tm, r_d = ½ by default): isotropic-hardening elastoplasticity on
+//!   Ottosen-shaped loading surfaces with the MC90 curve as hardening law
+//!   ([`compression`]); crushing when the equivalent curve strain reaches ε_cu.
+//! * Uncracked, tension-dominated states (σ1 ≥ r_d f_tm): linear elastic until the Ottosen
+//!   failure surface F(σ; f_cm) = 0 is reached, then a smeared crack opens normal to σ1
+//!   ([`cracking`]): fixed orthogonal cracks, tension stiffening, shear retention, secant
+//!   unloading/closing, second orthogonal crack, no stress when both cracks are open.
+//!
+//! Units: stresses and moduli in Pa, strains dimensionless (engineering shear strain
+//! γxy), lengths in m. Sign convention: tension positive. Voigt order (xx, yy, xy).
+//!
+//! The update is a pure function of (committed state, total strain): calling it twice with
+//! the same arguments gives the same result, so a load step can be retried.
+
+pub mod compression;
+pub mod cracking;
+pub mod ottosen;
+
+pub use crate::materials::error::MaterialError;
+use crate::materials::mc90::{self, CompressionCurve, OttosenParams, TensileRef};
+
+/// Post-cracking tension law of seed eq. 21 (Hinton): σ_n = f_tm exp(−(ε_n − ε0)/α) for
+/// ε_n > ε0 = f_tm/E.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum TensionSoftening {
+    /// Fixed decay strain α [-] (the paper's "softening parameter"; mesh dependent, meant as
+    /// a tension-stiffening law for reinforced zones).
+    Hinton {
+        /// Decay strain α [-].
+        alpha: f64,
+    },
+    /// Crack band (Bažant–Oh): α chosen per element so that the energy dissipated per unit
+    /// volume, f_tm α + f_tm²/(2E), equals G_f/h, h = characteristic element length [m]:
+    /// α = G_f/(h f_tm) − ε0/2, floored at ε0/10 (elements too large for snap-back-free
+    /// softening then dissipate more than G_f).
+    CrackBand {
+        /// Fracture energy G_f [N/m = J/m²].
+        gf: f64,
+    },
+}
+
+/// Shear retention factor of seed eqs. 22–23 (Cervenka): G_c = β G,
+/// β = 1 − (ε/ε_ref)^k1, floored at β_min; ε = largest crack-normal strain reached.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShearRetention {
+    /// Exponent k1 [-] (seed: 0.075).
+    pub k1: f64,
+    /// Crack strain at which β would vanish ε_ref [-] (seed: 0.005).
+    pub eps_ref: f64,
+    /// Floor β_min [-] keeping the tangent non-singular (MODEL.md §2.4 decision: 1e-3).
+    pub beta_min: f64,
+}
+
+impl Default for ShearRetention {
+    fn default() -> Self {
+        ShearRetention {
+            k1: 0.075,
+            eps_ref: 0.005,
+            beta_min: 1e-3,
+        }
+    }
+}
+
+impl ShearRetention {
+    /// β(ε) [-] and dβ/dε [-] for crack-normal strain `eps` [-] (β = 1 for ε ≤ 0).
+    pub fn beta(&self, eps: f64) -> (f64, f64) {
+        if eps <= 0.0 {
+            return (1.0, 0.0);
+        }
+        let x = eps / self.eps_ref;
+        let b = 1.0 - x.powf(self.k1);
+        if b <= self.beta_min {
+            (self.beta_min, 0.0)
+        } else {
+            (b, -self.k1 / self.eps_ref * x.powf(self.k1 - 1.0))
+        }
+    }
+}
+
+/// Concrete parameters. Build with [`ConcreteParams::from_mc90`] and adjust fields.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct ConcreteParams {
+    /// Mean compressive strength f_cm [Pa] (> 0, magnitude).
+    pub fcm: f64,
+    /// Mean tensile strength f_tm [Pa].
+    pub ftm: f64,
+    /// Elastic modulus E [Pa]; also the initial tangent of the hardening curve (eq. 20).
+    pub ec: f64,
+    /// Poisson ratio ν [-] (uncracked concrete; neglected after cracking, as in the seed).
+    pub nu: f64,
+    /// Ottosen parameters α, β, c1, c2 [-].
+    pub ottosen: OttosenParams,
+    /// Strain at peak of the MC90 curve ε_c1 [-] (0.0022).
+    pub eps_c1: f64,
+    /// Initial yield ratio σ_c0/f_cm [-] (0 = plastic from the start, the seed's "zeroed
+    /// initial yielding stresses"; > 0 shifts the uniaxial curve by κ0, see
+    /// [`compression`]).
+    pub initial_yield_ratio: f64,
+    /// Normalise σ_e by q_c so that uniaxial compression follows the MC90 curve exactly
+    /// (MODEL.md §1.4 decision; default true).
+    pub normalize_equivalent_stress: bool,
+    /// Crushing strain ε_cu [-]: when the equivalent curve strain ε̄ reaches it the point is
+    /// crushed and carries no stress (default 0.0035; set ε_cu = ε_c1 for "crushed at the
+    /// failure surface").
+    pub eps_cu: f64,
+    /// Post-peak softening limit h [-]: the plastic modulus of the hardening law is bounded
+    /// below by −h E (straight line beyond that point, see
+    /// [`compression::hardening_curve`]); default 0.25; ≥ 1 disables the limit (raw MC90).
+    pub softening_limit: f64,
+    /// Crack/crush discrimination ratio r_d [-]: σ1 ≥ r_d f_tm → crack (MC90/seed: 0.5).
+    pub crack_ratio: f64,
+    /// Post-cracking tension law.
+    pub tension: TensionSoftening,
+    /// Shear retention law.
+    pub shear: ShearRetention,
+    /// Residual stiffness ratio [-] for the tangent of points that carry no stress (both
+    /// cracks open, crushed): tangent = ratio × elastic stiffness, stress stays 0.
+    pub residual_stiffness: f64,
+    /// Use secant (non-negative, symmetric) crack-direction stiffness instead of the
+    /// consistent tangent for cracked points (robust for modified Newton; default false).
+    pub secant_crack_tangent: bool,
+}
+
+impl ConcreteParams {
+    /// MC90 defaults from the mean compressive strength `fcm` [Pa] and Poisson ratio `nu`:
+    /// f_tm = 10 MPa · 0.14 (f_cm/10 MPa)^(2/3) (eq. 19 corrected), E = E_ci, Ottosen
+    /// parameters from k = f_tm/f_cm, ε_c1 = 0.0022, zero initial yield, normalised σ_e,
+    /// ε_cu = 0.0035, Hinton tension stiffening with α = 5e-4 (the paper's value is unknown;
+    /// MODEL.md example), Cervenka shear retention k1 = 0.075.
+    pub fn from_mc90(fcm: f64, nu: f64) -> Self {
+        Self::from_mc90_with(fcm, nu, mc90::C_MEAN, TensileRef::Fcm)
+    }
+
+    /// As [`ConcreteParams::from_mc90`] with tensile-strength coefficient `c` [-] and
+    /// reference strength choice `f_ref`.
+    pub fn from_mc90_with(fcm: f64, nu: f64, c: f64, f_ref: TensileRef) -> Self {
+        let ftm = mc90::f_tm(fcm, c, f_ref);
+        ConcreteParams {
+            fcm,
+            ftm,
+            ec: mc90::eci(fcm),
+            nu,
+            ottosen: mc90::ottosen_params(ftm, fcm),
+            eps_c1: mc90::EPS_C1,
+            initial_yield_ratio: 0.0,
+            normalize_equivalent_stress: true,
+            eps_cu: 0.0035,
+            softening_limit: 0.25,
+            crack_ratio: 0.5,
+            tension: TensionSoftening::Hinton { alpha: 5e-4 },
+            shear: ShearRetention::default(),
+            residual_stiffness: 1e-6,
+            secant_crack_tangent: false,
+        }
+    }
+
+    /// Switch to crack-band softening with the MC90 fracture energy
+    /// G_f = 30 N/m (f_cm/10 MPa)^0.7 (d_max = 16 mm).
+    pub fn with_crack_band(mut self) -> Self {
+        self.tension = TensionSoftening::CrackBand {
+            gf: mc90::fracture_energy(self.fcm, 30.0),
+        };
+        self
+    }
+
+    /// Check parameter consistency (positive strengths/moduli, 0 ≤ ν < 0.5, E ε_c1 > f_cm
+    /// so that the curve rises, ε_cu > 0).
+    pub fn validate(&self) -> Result<(), MaterialError> {
+        let bad = |m: &str| Err(MaterialError::InvalidParams(m.to_string()));
+        if !(self.fcm > 0.0 && self.ftm > 0.0 && self.ec > 0.0) {
+            return bad("fcm, ftm and ec must be positive");
+        }
+        if !(0.0..0.5).contains(&self.nu) {
+            return bad("nu must be in [0, 0.5)");
+        }
+        if self.ec * self.eps_c1 <= self.fcm {
+            return bad("E·eps_c1 must exceed fcm (MC90 curve needs k_p > 1)");
+        }
+        if self.eps_cu <= 0.0 {
+            return bad("eps_cu must be positive");
+        }
+        match self.tension {
+            TensionSoftening::Hinton { alpha } if alpha <= 0.0 => bad("Hinton alpha must be > 0"),
+            TensionSoftening::CrackBand { gf } if gf <= 0.0 => bad("G_f must be > 0"),
+            _ => Ok(()),
+        }
+    }
+
+    /// MC90 uniaxial compression curve with this E, f_cm and ε_c1.
+    pub fn curve(&self) -> CompressionCurve {
+        CompressionCurve::new(self.fcm, self.ec, self.eps_c1)
+    }
+
+    /// Normalisation factor of σ_e: q_c if normalised, else 1 [-].
+    pub fn q_norm(&self) -> f64 {
+        if self.normalize_equivalent_stress {
+            ottosen::q_c(&self.ottosen)
+        } else {
+            1.0
+        }
+    }
+
+    /// Compression-dominated stress state (routes to plasticity/crushing, MODEL.md §1.6):
+    /// largest principal stress σ1 < r_d f_tm and I1 = σx + σy < 0. The I1 condition keeps
+    /// small tensile states out of the hardening model, whose loading surfaces pass
+    /// through the origin when the initial yield stress is zero.
+    pub fn compression_dominated(&self, s: &[f64; 3]) -> bool {
+        principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < 0.0
+    }
+
+    /// Cracking strain ε0 = f_tm/E [-].
+    pub fn eps0(&self) -> f64 {
+        self.ftm / self.ec
+    }
+
+    /// Decay strain α [-] of the tension-softening law for an element of characteristic
+    /// length `char_length` [m] (ignored for [`TensionSoftening::Hinton`]).
+    pub fn softening_alpha(&self, char_length: f64) -> f64 {
+        match self.tension {
+            TensionSoftening::Hinton { alpha } => alpha,
+            TensionSoftening::CrackBand { gf } => {
+                let e0 = self.eps0();
+                let a = gf / (char_length * self.ftm) - 0.5 * e0;
+                if a.is_finite() {
+                    a.max(0.1 * e0)
+                } else {
+                    0.1 * e0
+                }
+            }
+        }
+    }
+}
+
+/// State of a concrete point (committed or trial). Private fields; read through accessors.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ConcreteState {
+    pub(crate) strain: [f64; 3],
+    pub(crate) stress: [f64; 3],
+    pub(crate) plastic_strain: [f64; 3],
+    pub(crate) ebar: f64,
+    pub(crate) kappa: f64,
+    pub(crate) n_cracks: u8,
+    pub(crate) crack_angle: f64,
+    pub(crate) crack_max: [f64; 2],
+    pub(crate) crack_strain: [f64; 2],
+    pub(crate) dir_ebar: [f64; 2],
+    pub(crate) dir_plastic: [f64; 2],
+    pub(crate) crushed: bool,
+}
+
+impl Default for ConcreteState {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ConcreteState {
+    /// Virgin state: no strain, no plastic strain, no cracks.
+    pub fn new() -> Self {
+        ConcreteState {
+            strain: [0.0; 3],
+            stress: [0.0; 3],
+            plastic_strain: [0.0; 3],
+            ebar: 0.0,
+            kappa: 0.0,
+            n_cracks: 0,
+            crack_angle: 0.0,
+            crack_max: [0.0; 2],
+            crack_strain: [0.0; 2],
+            dir_ebar: [0.0; 2],
+            dir_plastic: [0.0; 2],
+            crushed: false,
+        }
+    }
+
+    /// Number of smeared cracks (0, 1 or 2).
+    pub fn n_cracks(&self) -> usize {
+        self.n_cracks as usize
+    }
+
+    /// Angle of the first crack's normal from the x axis [rad] (meaningful if cracked); the
+    /// second crack's normal is at +π/2.
+    pub fn crack_angle(&self) -> f64 {
+        self.crack_angle
+    }
+
+    /// Current crack-normal strains [-] of crack 1 and 2 (0 for absent cracks; negative when
+    /// the crack is closed).
+    pub fn crack_strains(&self) -> [f64; 2] {
+        self.crack_strain
+    }
+
+    /// Largest crack-normal strains reached [-].
+    pub fn max_crack_strains(&self) -> [f64; 2] {
+        self.crack_max
+    }
+
+    /// Equivalent plastic strain [-]: κ of the uncracked plasticity plus the compressive
+    /// plastic strains of the crack-axis directions.
+    pub fn equivalent_plastic_strain(&self) -> f64 {
+        self.kappa + self.dir_plastic[0] + self.dir_plastic[1]
+    }
+
+    /// Equivalent uniaxial curve strain ε̄ of the uncracked plasticity [-].
+    pub fn curve_strain(&self) -> f64 {
+        self.ebar
+    }
+
+    /// Plastic strain (εx, εy, γxy) of the uncracked plasticity [-] (frozen after cracking).
+    pub fn plastic_strain(&self) -> [f64; 3] {
+        self.plastic_strain
+    }
+
+    /// Whether the point is crushed (carries no stress).
+    pub fn is_crushed(&self) -> bool {
+        self.crushed
+    }
+
+    /// Total strain (εx, εy, γxy) [-] at which this state was computed.
+    pub fn strain(&self) -> [f64; 3] {
+        self.strain
+    }
+
+    /// Stress (σx, σy, τxy) [Pa] of this state.
+    pub fn stress(&self) -> [f64; 3] {
+        self.stress
+    }
+}
+
+/// Plane-stress isotropic elasticity matrix [Pa] for modulus `e` [Pa] and Poisson `nu`.
+pub fn d_matrix(e: f64, nu: f64) -> [[f64; 3]; 3] {
+    let f = e / (1.0 - nu * nu);
+    [
+        [f, f * nu, 0.0],
+        [f * nu, f, 0.0],
+        [0.0, 0.0, 0.5 * e / (1.0 + nu)],
+    ]
+}
+
+/// Largest principal stress σ1 [Pa] and the angle of its direction from x [rad].
+pub fn principal_max(s: &[f64; 3]) -> (f64, f64) {
+    let c = 0.5 * (s[0] + s[1]);
+    let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+    (c + r, 0.5 * (2.0 * s[2]).atan2(s[0] - s[1]))
+}
+
+fn matvec(d: &[[f64; 3]; 3], v: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|j| d[i][j] * v[j]).sum())
+}
+
+/// Result of [`update`]: (trial state, stress (σx, σy, τxy) [Pa], tangent [[Pa; 3]; 3]).
+pub type UpdateResult = Result<(ConcreteState, [f64; 3], [[f64; 3]; 3]), MaterialError>;
+
+/// Stress update from the committed state and the total strain (εx, εy, γxy) [-].
+///
+/// `char_length` [m] is the element's characteristic length (used by crack-band
+/// softening only). Returns the trial state, the stress (σx, σy, τxy) [Pa] and the tangent
+/// [[Pa; 3]; 3]: consistent for elastic and plastic (uncracked) points; for cracked points
+/// the consistent tangent of the crack-axis laws (non-symmetric when shear retention
+/// decreases with an opening crack; negative on the softening branch), or the secant
+/// stiffness if `secant_crack_tangent`; for points without stress the residual stiffness.
+/// At regime changes (crack formation, second crack, crushing) the tangent is that of the
+/// new regime.
+pub fn update(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+) -> UpdateResult {
+    if !strain.iter().all(|v| v.is_finite()) {
+        return Err(MaterialError::NonFiniteStrain(*strain));
+    }
+    if committed.crushed {
+        return Ok(crushed(p, committed, strain));
+    }
+    if committed.n_cracks > 0 {
+        return cracking::update_cracked(p, committed, strain, char_length);
+    }
+    let d = d_matrix(p.ec, p.nu);
+    let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
+    let s_tr = matvec(&d, &ee);
+    let (_, phi) = principal_max(&s_tr);
+    // Plastic (compression) branch: if the trial stress is compression-dominated, or if the
+    // trial would yield and the returned stress is compression-dominated. Routing on the
+    // returned stress as well avoids sending a plastically flowing point to the elastic
+    // branch only because its elastic trial shows lateral tension (uniaxial compression
+    // with dilatancy does exactly that).
+    let trial_cd = p.compression_dominated(&s_tr);
+    // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
+    let ebar_n = committed.ebar.max(compression::initial_yield(p).0);
+    let yields = compression::sigma_hat(p, &s_tr).0
+        > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
+    if trial_cd || yields {
+        let res = compression::update(
+            p,
+            &committed.strain,
+            &committed.plastic_strain,
+            ebar_n,
+            strain,
+        );
+        let accept = match &res {
+            Ok(u) => trial_cd || (u.plastic && p.compression_dominated(&u.stress)),
+            Err(_) => trial_cd,
+        };
+        if accept {
+            let u = res?;
+            let mut st = committed.clone();
+            st.strain = *strain;
+            st.plastic_strain = u.plastic_strain;
+            st.ebar = u.ebar;
+            st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
+            if u.ebar >= p.eps_cu || compression::hardening(p, u.ebar).sigma_c <= 0.0 {
+                st.crushed = true;
+                return Ok(crushed(p, &st, strain));
+            }
+            st.stress = u.stress;
+            return Ok((st, u.stress, u.tangent));
+        }
+    }
+    // Tension-dominated: elastic until the Ottosen failure surface, then crack.
+    let (s1, _) = principal_max(&s_tr);
+    if s1 >= p.crack_ratio * p.ftm && ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
+        let mut st = committed.clone();
+        st.n_cracks = 1;
+        st.crack_angle = phi;
+        st.crack_max = [0.0; 2];
+        st.dir_ebar = [ebar_n; 2];
+        st.dir_plastic = [0.0; 2];
+        return cracking::update_cracked(p, &st, strain, char_length);
+    }
+    let mut st = committed.clone();
+    st.strain = *strain;
+    st.stress = s_tr;
+    Ok((st, s_tr, d))
+}
+
+/// Response of a crushed point: zero stress, residual tangent.
+fn crushed(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+) -> (ConcreteState, [f64; 3], [[f64; 3]; 3]) {
+    let mut st = committed.clone();
+    st.strain = *strain;
+    st.stress = [0.0; 3];
+    st.crushed = true;
+    let d = d_matrix(p.ec, p.nu).map(|r| r.map(|v| v * p.residual_stiffness));
+    (st, [0.0; 3], d)
+}
+
+#[cfg(test)]
+mod tests;

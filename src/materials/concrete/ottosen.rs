@@ -1,0 +1,380 @@
+//! Ottosen four-parameter criterion in plane stress (MODEL.md §1.2–§1.5).
+//!
+//! Stress vectors are Voigt plane-stress vectors (σx, σy, τxy) [Pa], tension positive,
+//! σz = τxz = τyz = 0 (the deviator still has s_z = −(σx + σy)/3).
+
+use crate::materials::mc90::OttosenParams;
+
+/// Largest c2 used in λ(θ): dλ/dc is singular at |c| = 1 when c2 = 1 (MODEL.md §1.3 note).
+const C2_MAX: f64 = 1.0 - 1e-12;
+
+/// Stress invariants of a plane-stress state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Invariants {
+    /// First invariant I1 = σx + σy [Pa].
+    pub i1: f64,
+    /// Second deviatoric invariant J2 [Pa²].
+    pub j2: f64,
+    /// Third deviatoric invariant J3 = det s [Pa³].
+    pub j3: f64,
+    /// cos 3θ (MC90/Ottosen convention) clamped to [−1, 1]; 0 when J2 = 0 [-].
+    pub cos3theta: f64,
+}
+
+/// Invariants I1, J2, J3 and cos3θ = (3√3/2) J3 / J2^(3/2) of a plane-stress state `s` [Pa].
+pub fn invariants(s: &[f64; 3]) -> Invariants {
+    let i1 = s[0] + s[1];
+    let m = i1 / 3.0;
+    let (sx, sy, sz, t) = (s[0] - m, s[1] - m, -m, s[2]);
+    let j2 = 0.5 * (sx * sx + sy * sy + sz * sz) + t * t;
+    let j3 = sx * sy * sz - sz * t * t;
+    let cos3theta = if j2 <= 0.0 {
+        0.0
+    } else {
+        (1.5 * 3f64.sqrt() * j3 / j2.powf(1.5)).clamp(-1.0, 1.0)
+    };
+    Invariants {
+        i1,
+        j2,
+        j3,
+        cos3theta,
+    }
+}
+
+/// Principal stresses of a plane-stress state including σz = 0, sorted σ1 ≥ σ2 ≥ σ3 [Pa].
+pub fn principal_sorted(s: &[f64; 3]) -> [f64; 3] {
+    let c = 0.5 * (s[0] + s[1]);
+    let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+    let mut v = [c + r, c - r, 0.0];
+    v.sort_by(|a, b| b.total_cmp(a));
+    v
+}
+
+/// Lode angle θ [rad] in the MC90/Ottosen convention, θ ∈ [0, π/3]:
+/// cos 3θ = (3√3/2) J3/J2^(3/2); θ = 0 tensile meridian, θ = π/3 compressive meridian.
+/// Evaluated as θ = atan2(√3(σ2 − σ3), 2σ1 − σ2 − σ3) from the sorted principal stresses,
+/// which is equivalent but, unlike acos(cos3θ)/3, accurate to round-off at the meridians.
+/// Returns 0 for σ = 0.
+pub fn lode_angle_mc90(s: &[f64; 3]) -> f64 {
+    let [s1, s2, s3] = principal_sorted(s);
+    if s1 == s3 {
+        return 0.0;
+    }
+    (3f64.sqrt() * (s2 - s3)).atan2(2.0 * s1 - s2 - s3)
+}
+
+/// Lode angle θ_OH [rad] in the Owen–Hinton / Nayak–Zienkiewicz convention, θ ∈ [−π/6, π/6]:
+/// sin 3θ_OH = −(3√3/2) J3/J2^(3/2); θ_MC90 = θ_OH + π/6.
+pub fn lode_angle_owen_hinton(s: &[f64; 3]) -> f64 {
+    lode_angle_mc90(s) - std::f64::consts::FRAC_PI_6
+}
+
+/// λ(cos3θ) [-] and dλ/d(cos3θ) [-].
+///
+/// The two branches of MODEL.md §1.3 / seed eq. 17 are the same analytic function, since
+/// π/3 − ⅓ arccos(−x) = ⅓ arccos(x): λ = c1 cos[⅓ arccos(c2 cos3θ)] for all θ. c2 is capped
+/// at 1 − 1e-12 so that the derivative stays finite at |cos3θ| = 1.
+pub fn lambda(p: &OttosenParams, c: f64) -> (f64, f64) {
+    let c2 = p.c2.min(C2_MAX);
+    let x = (c2 * c).clamp(-1.0, 1.0);
+    let psi = x.acos();
+    let lam = p.c1 * (psi / 3.0).cos();
+    let dlam = p.c1 * c2 * (psi / 3.0).sin() / (3.0 * (1.0 - x * x).sqrt());
+    (lam, dlam)
+}
+
+/// Ottosen failure function F(σ) = α J2/f² + λ √J2/f + β I1/f − 1 [-] for strength `fcm`
+/// [Pa] (F < 0 inside, F = 0 on the surface).
+pub fn criterion(p: &OttosenParams, fcm: f64, s: &[f64; 3]) -> f64 {
+    let inv = invariants(s);
+    let (lam, _) = lambda(p, inv.cos3theta);
+    p.alpha * inv.j2 / (fcm * fcm) + lam * inv.j2.sqrt() / fcm + p.beta * inv.i1 / fcm - 1.0
+}
+
+/// Plane-stress derivatives of I1, J2 and J3 with respect to (σx, σy, τxy).
+fn invariant_gradients(s: &[f64; 3], inv: &Invariants) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let m = inv.i1 / 3.0;
+    let (sx, sy, t) = (s[0] - m, s[1] - m, s[2]);
+    let di1 = [1.0, 1.0, 0.0];
+    let dj2 = [sx, sy, 2.0 * t];
+    let q = 2.0 * inv.j2 / 3.0;
+    let dj3 = [
+        sx * sx + t * t - q,
+        sy * sy + t * t - q,
+        2.0 * t * (sx + sy),
+    ];
+    (di1, dj2, dj3)
+}
+
+/// Gradient ∂F/∂(σx, σy, τxy) [1/Pa] of [`criterion`] (MODEL.md §1.5). At σ = 0 (J2 = 0)
+/// the deviatoric part is undefined and only the hydrostatic part β/f·∂I1 is returned.
+pub fn criterion_gradient(p: &OttosenParams, fcm: f64, s: &[f64; 3]) -> [f64; 3] {
+    let inv = invariants(s);
+    let (di1, dj2, dj3) = invariant_gradients(s, &inv);
+    let f_i1 = p.beta / fcm;
+    if inv.j2 <= 0.0 {
+        return [f_i1 * di1[0], f_i1 * di1[1], 0.0];
+    }
+    let c = inv.cos3theta;
+    let (lam, dlam) = lambda(p, c);
+    let sj2 = inv.j2.sqrt();
+    let f_j2 =
+        p.alpha / (fcm * fcm) + lam / (2.0 * fcm * sj2) - 1.5 * c / inv.j2 * (sj2 / fcm) * dlam;
+    let f_j3 = 1.5 * 3f64.sqrt() * dlam / (fcm * inv.j2);
+    std::array::from_fn(|i| f_i1 * di1[i] + f_j2 * dj2[i] + f_j3 * dj3[i])
+}
+
+/// Equivalent stress σ_e(σ) [Pa]: the strength f for which F(σ; f) = 0 (MODEL.md §1.4),
+/// σ_e = ½[p + √(p² + 4αJ2)], p = λ√J2 + βI1. Positively homogeneous of degree 1;
+/// σ_e ≥ f_cm ⇔ F(σ; f_cm) ≥ 0.
+pub fn equivalent_stress(p: &OttosenParams, s: &[f64; 3]) -> f64 {
+    equivalent_stress_gradient(p, s).0
+}
+
+/// σ_e [Pa] and its gradient ∂σ_e/∂(σx, σy, τxy) [-]. At σ = 0 the gradient is that of
+/// the limit along the hydrostatic direction, (β, β, 0)·[I1 > 0], and is only used as a
+/// harmless placeholder (σ = 0 never lies on a loading surface with σ_c > 0).
+pub fn equivalent_stress_gradient(p: &OttosenParams, s: &[f64; 3]) -> (f64, [f64; 3]) {
+    let inv = invariants(s);
+    let (di1, dj2, dj3) = invariant_gradients(s, &inv);
+    if inv.j2 <= 0.0 {
+        let v = (p.beta * inv.i1).max(0.0);
+        let g = if v > 0.0 { p.beta } else { 0.0 };
+        return (v, [g, g, 0.0]);
+    }
+    let c = inv.cos3theta;
+    let (lam, dlam) = lambda(p, c);
+    let sj2 = inv.j2.sqrt();
+    let pp = lam * sj2 + p.beta * inv.i1;
+    let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
+    let se = 0.5 * (pp + root);
+    // ∂σ_e/∂p and ∂σ_e/∂J2 (explicit α-term)
+    let d_p = 0.5 * (1.0 + pp / root);
+    let d_j2_direct = p.alpha / root;
+    // p = λ(c) √J2 + β I1 with c = (3√3/2) J3 J2^(-3/2)
+    let dc_dj2 = -1.5 * c / inv.j2;
+    let dc_dj3 = 1.5 * 3f64.sqrt() / inv.j2.powf(1.5);
+    let p_j2 = lam / (2.0 * sj2) + sj2 * dlam * dc_dj2;
+    let p_j3 = sj2 * dlam * dc_dj3;
+    let p_i1 = p.beta;
+    let g_i1 = d_p * p_i1;
+    let g_j2 = d_p * p_j2 + d_j2_direct;
+    let g_j3 = d_p * p_j3;
+    let g = std::array::from_fn(|i| g_i1 * di1[i] + g_j2 * dj2[i] + g_j3 * dj3[i]);
+    (se, g)
+}
+
+/// Uniaxial-compression factor q_c = σ_e(−1, 0, 0) [-] (MODEL.md §1.4): σ_e of a uniaxial
+/// compression of magnitude f is q_c f.
+pub fn q_c(p: &OttosenParams) -> f64 {
+    equivalent_stress(p, &[-1.0, 0.0, 0.0])
+}
+
+/// Hessian ∂²σ_e/∂σ² [1/Pa] by central differences of the analytic gradient, step
+/// h = 1e-6 · max(|σ|, 1 Pa); relative accuracy ≈ 1e-9 (truncation O(h²), round-off
+/// O(ε_mach/h)), i.e. far below the return-mapping tolerance. Symmetrised.
+pub fn equivalent_stress_hessian(p: &OttosenParams, s: &[f64; 3]) -> [[f64; 3]; 3] {
+    let scale = s.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1.0);
+    let h = 1e-6 * scale;
+    let mut hm = [[0.0; 3]; 3];
+    for j in 0..3 {
+        let mut sp = *s;
+        let mut sm = *s;
+        sp[j] += h;
+        sm[j] -= h;
+        let gp = equivalent_stress_gradient(p, &sp).1;
+        let gm = equivalent_stress_gradient(p, &sm).1;
+        for (row, (a, b)) in hm.iter_mut().zip(gp.iter().zip(gm.iter())) {
+            row[j] = (a - b) / (2.0 * h);
+        }
+    }
+    for (i, j) in [(1, 0), (2, 0), (2, 1)] {
+        let a = 0.5 * (hm[i][j] + hm[j][i]);
+        hm[i][j] = a;
+        hm[j][i] = a;
+    }
+    hm
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::materials::mc90::OttosenParams;
+
+    const FCM: f64 = 45e6;
+    const FTM: f64 = 3.81595e6;
+
+    fn params() -> OttosenParams {
+        OttosenParams::from_k(FTM / FCM)
+    }
+
+    /// Principal plane-stress state (σ1, σ2) in x–y axes.
+    fn ps(a: f64, b: f64) -> [f64; 3] {
+        [a, b, 0.0]
+    }
+
+    /// MODEL.md §9 check 3: Lode angles, both conventions (1e-10 abs: exact states, only
+    /// round-off in acos/asin near ±1 — computed via clamp so exact).
+    #[test]
+    fn check3_lode_angles() {
+        let d = std::f64::consts::PI / 180.0;
+        let cases = [
+            (ps(1e6, 0.0), 0.0, -30.0, 1.0),
+            (ps(-1e6, 0.0), 60.0, 30.0, -1.0),
+            (ps(1e6, -1e6), 30.0, 0.0, 0.0),
+        ];
+        for (s, t_mc, t_oh, c) in cases {
+            assert!((invariants(&s).cos3theta - c).abs() < 1e-10);
+            assert!((lode_angle_mc90(&s) - t_mc * d).abs() < 1e-10, "{s:?}");
+            assert!(
+                (lode_angle_owen_hinton(&s) - t_oh * d).abs() < 1e-10,
+                "{s:?}"
+            );
+            assert!((lode_angle_mc90(&s) - lode_angle_owen_hinton(&s) - 30.0 * d).abs() < 1e-10);
+        }
+        // The atan2 form agrees with the definition via cos3θ at a generic state, and with
+        // the Owen–Hinton definition sin3θ_OH = −cos3θ (1e-12: both well conditioned here).
+        let s = [2e6, -25e6, 4e6];
+        let c = invariants(&s).cos3theta;
+        assert!((lode_angle_mc90(&s) - c.acos() / 3.0).abs() < 1e-12);
+        assert!(((3.0 * lode_angle_owen_hinton(&s)).sin() + c).abs() < 1e-12);
+        // Same states rotated by 30° in the plane must give the same angle (invariance).
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let rot = |a: f64, b: f64| {
+            [
+                a * c * c + b * s * s,
+                a * s * s + b * c * c,
+                (a - b) * s * c,
+            ]
+        };
+        assert!((lode_angle_mc90(&rot(-1e6, 0.0)) - 60.0 * d).abs() < 1e-8);
+    }
+
+    /// MODEL.md §9 check 4: I1, J2, cos3θ, λ, F at the §1.3 points (1e-5 abs on F and
+    /// cos3θ; λ to 1e-4 and J2 to 1e-3 MPa² because the table prints them to that many
+    /// decimals). Each principal triple (σ1, σ2, σ3) has one zero, so it is the plane-stress
+    /// state with the two non-zero values in x, y and σz = 0.
+    #[test]
+    fn check4_point_values() {
+        let p = params();
+        let table = [
+            ([0.0, -45.0], -45.0, 675.0, -1.0, 6.78774, 0.011657),
+            ([3.81595, 0.0], 3.81595, 4.85380, 1.0, 13.16069, -0.001336),
+            ([-20.0, -40.0], -60.0, 400.0, 0.0, 11.39938, -0.678007),
+            ([2.0, -30.0], -28.0, 321.333, -0.98601, 7.23862, -0.096742),
+        ];
+        for (s2, i1, j2, c, lam, f) in table {
+            let s = [s2[0] * 1e6, s2[1] * 1e6, 0.0];
+            let inv = invariants(&s);
+            assert!((inv.i1 / 1e6 - i1).abs() < 1e-5, "I1 {s2:?}");
+            assert!(
+                (inv.j2 / 1e12 - j2).abs() < 1e-3,
+                "J2 {s2:?}: {}",
+                inv.j2 / 1e12
+            );
+            assert!(
+                (inv.cos3theta - c).abs() < 1e-5,
+                "c {s2:?}: {}",
+                inv.cos3theta
+            );
+            let (l, _) = lambda(&p, inv.cos3theta);
+            assert!((l - lam).abs() < 1e-4, "λ {s2:?}: {l}");
+            let ff = criterion(&p, FCM, &s);
+            assert!((ff - f).abs() < 1e-5, "F {s2:?}: {ff}");
+        }
+    }
+
+    /// MODEL.md §9 check 5: strength ratios along radial paths (1e-4 rel). Uses the
+    /// homogeneity of σ_e: the radial strength along a unit direction d is f_cm/σ_e(d).
+    #[test]
+    fn check5_strength_ratios() {
+        for (k, table) in [
+            (0.084799, [0.99465, 0.08491, 1.19306, 1.33134, 0.08547]),
+            (0.074425, [0.99522, 0.07485, 1.20774, 1.33111, 0.07610]),
+        ] {
+            let p = OttosenParams::from_k(k);
+            let dirs = [
+                [-1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [-1.0, -1.0, 0.0],
+                [-1.0, -0.5, 0.0],
+                [1.0, -1.0, 0.0],
+            ];
+            for (d, want) in dirs.iter().zip(table) {
+                let ratio = 1.0 / equivalent_stress(&p, d);
+                assert!(((ratio - want) / want).abs() < 1e-4, "k={k} {d:?}: {ratio}");
+                // and F = 0 on the surface point (consistency of σ_e with F)
+                let s = d.map(|v| v * ratio * FCM);
+                assert!(criterion(&p, FCM, &s).abs() < 1e-10);
+            }
+        }
+    }
+
+    /// MODEL.md §9 check 6: q_c, σ_e homogeneity (1e-9 rel: pure round-off), and the
+    /// uniaxial tension ratio σ_e/σ1 = 11.77698 (1e-6 rel, table has 7 digits).
+    #[test]
+    fn check6_equivalent_stress() {
+        let p = OttosenParams::from_k(0.084799);
+        assert!((q_c(&p) - 1.0053828).abs() < 1e-6);
+        let (lc, _) = lambda(&p, -1.0);
+        assert!((lc - 6.787735).abs() < 1e-5);
+        assert!((equivalent_stress(&p, &[1.0, 0.0, 0.0]) - 11.77698).abs() < 1e-4);
+        for s in [[-30e6, -10e6, 5e6], [2e6, -25e6, 4e6], [1e6, 1e6, 0.0]] {
+            let a = equivalent_stress(&p, &s);
+            let b = equivalent_stress(&p, &s.map(|v| 2.0 * v));
+            assert!(((b - 2.0 * a) / a).abs() < 1e-9);
+        }
+    }
+
+    /// MODEL.md §9 check 7: ∂F/∂σ vs the table (values in 1/MPa, 1e-6 rel) and gradient of
+    /// F and σ_e vs central differences (1e-6 rel: FD truncation with h = 1e-4 MPa is 1e-10).
+    #[test]
+    fn check7_gradients() {
+        let p = params();
+        let table = [
+            (
+                [-30.0, -10.0, 5.0],
+                -0.798334,
+                [-0.02285331, 0.01234167, 0.01759749],
+            ),
+            (
+                [2.0, -25.0, 4.0],
+                -0.061236,
+                [0.26843418, -0.01926574, 0.08524442],
+            ),
+            (
+                [-20.0, -20.0, 8.0],
+                -0.905418,
+                [-0.00532319, -0.00532319, 0.02803170],
+            ),
+        ];
+        for (s_mpa, f, g) in table {
+            let s = s_mpa.map(|v| v * 1e6);
+            assert!((criterion(&p, FCM, &s) - f).abs() < 1e-6);
+            let a = criterion_gradient(&p, FCM, &s).map(|v| v * 1e6);
+            for i in 0..3 {
+                assert!(
+                    ((a[i] - g[i]) / g[i]).abs() < 2e-6,
+                    "{s_mpa:?} {i}: {}",
+                    a[i]
+                );
+            }
+            let h = 100.0;
+            let (_, ge) = equivalent_stress_gradient(&p, &s);
+            for i in 0..3 {
+                let mut sp = s;
+                let mut sm = s;
+                sp[i] += h;
+                sm[i] -= h;
+                let fd = (criterion(&p, FCM, &sp) - criterion(&p, FCM, &sm)) / (2.0 * h);
+                let an = criterion_gradient(&p, FCM, &s)[i];
+                assert!((fd - an).abs() < 1e-6 * an.abs().max(1e-9), "F grad {i}");
+                let fde = (equivalent_stress(&p, &sp) - equivalent_stress(&p, &sm)) / (2.0 * h);
+                assert!(
+                    (fde - ge[i]).abs() < 1e-6 * ge[i].abs().max(1e-3),
+                    "σe grad {i}"
+                );
+            }
+        }
+    }
+}

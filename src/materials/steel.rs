@@ -1,0 +1,245 @@
+//! Uniaxial steel laws for embedded bars and tendons (MODEL.md §2.3).
+//!
+//! One law covers both rebar and prestressing steel: linear elastic up to the yield stress
+//! f_y, then linear **kinematic** hardening with modulus H (H = 0: perfectly plastic),
+//! optionally capped so that the stress never exceeds f_u in magnitude (beyond the cap the
+//! law is perfectly plastic at ±f_u). Kinematic hardening was chosen because it reproduces
+//! the Bauschinger effect on load reversal and keeps the elastic range 2 f_y wide, which is
+//! the usual choice for bars under cyclic/reversed loading; for monotonic loading it is
+//! identical to isotropic hardening. Symmetric in tension and compression.
+//!
+//! Units: stresses and moduli in Pa, strains dimensionless. The strain passed to
+//! [`update_uniaxial`] is the total mechanical strain of the bar *including* any initial
+//! (prestressing) strain; the caller adds the prestrain.
+
+/// Parameters of the uniaxial steel law.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SteelParams {
+    /// Young's modulus E_s [Pa].
+    pub es: f64,
+    /// Yield stress f_y (rebar) or 0.9 f_ptk (prestressing steel) [Pa].
+    pub fy: f64,
+    /// Kinematic hardening modulus H (plastic modulus, dσ/dε_p) [Pa]; 0 = perfectly plastic.
+    /// The elastoplastic tangent is E_s H/(E_s + H).
+    pub hardening: f64,
+    /// Stress cap f_u ≥ f_y [Pa]; f64::INFINITY for no cap.
+    pub fu: f64,
+}
+
+impl SteelParams {
+    /// Reinforcing bar, elastic–perfectly plastic (seed): modulus `es` [Pa], yield `fy` [Pa].
+    pub fn rebar(es: f64, fy: f64) -> Self {
+        SteelParams {
+            es,
+            fy,
+            hardening: 0.0,
+            fu: f64::INFINITY,
+        }
+    }
+
+    /// Reinforcing bar with linear kinematic hardening of tangent modulus `et` [Pa]
+    /// (0 ≤ et < es) after yield; the plastic modulus is H = E_s E_t/(E_s − E_t).
+    pub fn rebar_hardening(es: f64, fy: f64, et: f64) -> Self {
+        SteelParams {
+            es,
+            fy,
+            hardening: es * et / (es - et),
+            fu: f64::INFINITY,
+        }
+    }
+
+    /// Prestressing steel (seed + MODEL.md §2.3 decision): linear elastic up to 0.9 f_ptk,
+    /// then perfectly plastic. `ep` [Pa], `fptk` [Pa].
+    pub fn prestressing(ep: f64, fptk: f64) -> Self {
+        SteelParams {
+            es: ep,
+            fy: 0.9 * fptk,
+            hardening: 0.0,
+            fu: f64::INFINITY,
+        }
+    }
+
+    /// Prestressing steel with linear hardening from (0.9 f_ptk/E_p, 0.9 f_ptk) to
+    /// (ε_uk, f_ptk), perfectly plastic at f_ptk beyond ε_uk (no rupture modelled).
+    /// `ep` [Pa], `fptk` [Pa], `eps_uk` [-] (> 0.9 f_ptk/E_p).
+    pub fn prestressing_hardening(ep: f64, fptk: f64, eps_uk: f64) -> Self {
+        let fy = 0.9 * fptk;
+        let eps_y = fy / ep;
+        let et = (fptk - fy) / (eps_uk - eps_y).max(f64::MIN_POSITIVE);
+        SteelParams {
+            es: ep,
+            fy,
+            hardening: ep * et / (ep - et),
+            fu: fptk,
+        }
+    }
+}
+
+/// State of a uniaxial steel point (committed or trial).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct SteelState {
+    /// Plastic strain ε_p [-].
+    pub plastic_strain: f64,
+    /// Back stress (centre of the elastic range) [Pa].
+    pub back_stress: f64,
+    /// Accumulated plastic strain Σ|Δε_p| [-].
+    pub acc_plastic: f64,
+}
+
+impl SteelState {
+    /// Virgin state (no plastic strain, no back stress).
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+/// Stress update of the uniaxial steel law (closed-form return mapping).
+///
+/// From the `committed` state and the total `strain` [-] returns the trial state, the stress
+/// [Pa] and the consistent tangent dσ/dε [Pa] (E_s elastic, E_s H/(E_s + H) hardening,
+/// 0 perfectly plastic or at the cap). Pure function; never panics for finite input.
+pub fn update_uniaxial(
+    p: &SteelParams,
+    committed: &SteelState,
+    strain: f64,
+) -> (SteelState, f64, f64) {
+    let e = p.es;
+    let sig_tr = e * (strain - committed.plastic_strain);
+    let xi = sig_tr - committed.back_stress;
+    let f = xi.abs() - p.fy;
+    if f <= 0.0 {
+        return (*committed, sig_tr, e);
+    }
+    let sgn = xi.signum();
+    let h = p.hardening.max(0.0);
+    // Room left for hardening in the flow direction before the back stress reaches the cap.
+    let alpha_max = (p.fu - p.fy).max(0.0);
+    let room = alpha_max - sgn * committed.back_stress;
+    let (dgamma, tangent, back) = if h > 0.0 && room > 0.0 {
+        let dg = f / (e + h);
+        if h * dg <= room {
+            (dg, e * h / (e + h), committed.back_stress + sgn * h * dg)
+        } else {
+            // Harden until the cap, then perfectly plastic.
+            let dg1 = room / h;
+            let rest = f - (e + h) * dg1;
+            (dg1 + rest / e, 0.0, sgn * alpha_max)
+        }
+    } else {
+        (f / e, 0.0, committed.back_stress)
+    };
+    let state = SteelState {
+        plastic_strain: committed.plastic_strain + sgn * dgamma,
+        back_stress: back,
+        acc_plastic: committed.acc_plastic + dgamma,
+    };
+    (state, sig_tr - sgn * e * dgamma, tangent)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ES: f64 = 200e9;
+    const FY: f64 = 500e6;
+
+    /// Drive a strain history, committing after each step; returns the stresses.
+    fn drive(p: &SteelParams, strains: &[f64]) -> Vec<(f64, f64, SteelState)> {
+        let mut st = SteelState::new();
+        strains
+            .iter()
+            .map(|&e| {
+                let (s, sig, et) = update_uniaxial(p, &st, e);
+                st = s;
+                (sig, et, s)
+            })
+            .collect()
+    }
+
+    /// Elastic–perfectly plastic rebar: yield at f_y, plateau, elastic unloading with E_s,
+    /// reverse yield at −f_y. Hand values; tolerance 1e-9 rel (closed form, round-off only).
+    #[test]
+    fn rebar_yield_unload_reverse() {
+        let p = SteelParams::rebar(ES, FY);
+        let r = drive(&p, &[0.001, 0.003, 0.01, 0.008, -0.01]);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+        assert!(close(r[0].0, 200e6) && close(r[0].1, ES));
+        assert!(close(r[1].0, FY) && r[1].1 == 0.0);
+        assert!(close(r[2].0, FY));
+        assert!(close(r[2].2.plastic_strain, 0.01 - 0.0025));
+        // unloading by 0.002 from the plateau: σ = f_y − E_s·0.002 = 100 MPa, elastic
+        assert!(close(r[3].0, FY - ES * 0.002) && close(r[3].1, ES));
+        // reverse: yields in compression at −f_y (elastic range 2 f_y)
+        assert!(close(r[4].0, -FY));
+        assert!(close(r[4].2.plastic_strain, -0.01 + 0.0025));
+    }
+
+    /// Kinematic hardening: E_t after yield, Bauschinger effect on reversal (reverse yield at
+    /// σ_max − 2 f_y, not at −σ_max as isotropic hardening would give). Hand values.
+    #[test]
+    fn rebar_kinematic_hardening() {
+        let et = 2e9; // 1 % of E_s
+        let p = SteelParams::rebar_hardening(ES, FY, et);
+        let eps_y = FY / ES;
+        let r = drive(&p, &[0.02, 0.0]);
+        let smax = FY + et * (0.02 - eps_y);
+        assert!(((r[0].0 - smax) / smax).abs() < 1e-12);
+        assert!(((r[0].1 - et) / et).abs() < 1e-12);
+        // unloading to ε = 0: elastic range from smax down to smax − 2 f_y = 25 MPa·… ;
+        // ε change to reach it: 2 f_y/E_s = 0.005 < 0.02 → reverse yielding happens
+        let rev_yield = smax - 2.0 * FY;
+        let eps_rev = 0.02 - 2.0 * FY / ES;
+        let want = rev_yield - et * (eps_rev - 0.0);
+        assert!(
+            ((r[1].0 - want) / want).abs() < 1e-12,
+            "{} vs {want}",
+            r[1].0
+        );
+    }
+
+    /// Prestressing steel: elastic to 0.9 f_ptk, plastic; hardening variant reaches f_ptk at
+    /// ε_uk and stays there. Hand values (1e-9 rel).
+    #[test]
+    fn prestressing_laws() {
+        let ep = 195e9;
+        let fptk = 1860e6;
+        let p = SteelParams::prestressing(ep, fptk);
+        let (_, s, t) = update_uniaxial(&p, &SteelState::new(), 0.007);
+        assert!((s - ep * 0.007).abs() < 1e-3 && t == ep);
+        let (_, s, t) = update_uniaxial(&p, &SteelState::new(), 0.02);
+        assert!((s - 0.9 * fptk).abs() < 1e-3 && t == 0.0);
+
+        let eps_uk = 0.035;
+        let ph = SteelParams::prestressing_hardening(ep, fptk, eps_uk);
+        let eps_y = 0.9 * fptk / ep;
+        let et = 0.1 * fptk / (eps_uk - eps_y);
+        let (_, s, t) = update_uniaxial(&ph, &SteelState::new(), 0.02);
+        let want = 0.9 * fptk + et * (0.02 - eps_y);
+        assert!(((s - want) / want).abs() < 1e-9 && ((t - et) / et).abs() < 1e-9);
+        let (st, s, t) = update_uniaxial(&ph, &SteelState::new(), eps_uk);
+        assert!(((s - fptk) / fptk).abs() < 1e-9, "{s}");
+        assert!(t > 0.0);
+        let (_, s, t) = update_uniaxial(&ph, &st, 0.05);
+        assert!(((s - fptk) / fptk).abs() < 1e-9 && t == 0.0);
+        // In two steps (with a commit in between) the same: path independence under
+        // monotonic loading.
+        let (st1, _, _) = update_uniaxial(&ph, &SteelState::new(), 0.01);
+        let (_, s2, _) = update_uniaxial(&ph, &st1, 0.02);
+        assert!(((s2 - want) / want).abs() < 1e-9);
+    }
+
+    /// Tangent equals the central difference of the stress away from kinks (1e-6 rel:
+    /// piecewise-linear law, FD exact up to round-off).
+    #[test]
+    fn steel_tangent_fd() {
+        let p = SteelParams::rebar_hardening(ES, FY, 5e9);
+        let (st, _, _) = update_uniaxial(&p, &SteelState::new(), 0.01);
+        for e in [0.012, 0.009, 0.0, -0.01] {
+            let (_, _, t) = update_uniaxial(&p, &st, e);
+            let h = 1e-8;
+            let fd =
+                (update_uniaxial(&p, &st, e + h).1 - update_uniaxial(&p, &st, e - h).1) / (2.0 * h);
+            assert!((fd - t).abs() < 1e-6 * ES, "{e}: {fd} vs {t}");
+        }
+    }
+}
