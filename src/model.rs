@@ -75,6 +75,8 @@ pub struct EdgeLoad {
     pub nodes: Vec<usize>,
     /// Force per unit length of edge [N/m].
     pub q: [f64; 2],
+    /// Loaded part of the edge in its natural coordinate, r ∈ [−1, 1].
+    pub range: [f64; 2],
 }
 
 /// A named load case; steps scale load cases by factors.
@@ -112,20 +114,20 @@ pub enum MonitorKind {
         /// Load case index.
         case: usize,
     },
-    /// Largest opening of a joint over its depth [m].
+    /// Largest opening of a joint over its depth, or of all joints (None) [m].
     JointOpening {
-        /// Joint index.
-        joint: usize,
+        /// Joint index, or None for the largest over all joints.
+        joint: Option<usize>,
     },
     /// Depth of a joint still in contact (closed) [m].
     JointContactDepth {
         /// Joint index.
         joint: usize,
     },
-    /// Largest slip (relative tangential displacement) of a joint [m].
+    /// Largest slip (relative tangential displacement) of a joint, or of all joints [m].
     JointSlip {
-        /// Joint index.
-        joint: usize,
+        /// Joint index, or None for the largest over all joints.
+        joint: Option<usize>,
     },
 }
 

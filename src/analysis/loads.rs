@@ -1,6 +1,6 @@
 //! External load vectors of the load cases (consistent nodal forces over all dofs).
 
-use crate::elements::continuum::{body_force, edge_force};
+use crate::elements::continuum::{body_force, edge_force_partial};
 use crate::model::{LoadCase, Model};
 
 /// Full-dof external force vector [N] of one load case at factor 1.
@@ -12,7 +12,7 @@ pub fn load_vector(model: &Model, case: &LoadCase) -> Vec<f64> {
     }
     for el in &case.edge_loads {
         let coords: Vec<[f64; 2]> = el.nodes.iter().map(|&n| model.nodes[n]).collect();
-        let fe = edge_force(&coords, el.q);
+        let fe = edge_force_partial(&coords, el.q, el.range[0], el.range[1]);
         for (a, &n) in el.nodes.iter().enumerate() {
             f[2 * n] += fe[2 * a];
             f[2 * n + 1] += fe[2 * a + 1];

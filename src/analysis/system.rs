@@ -223,7 +223,7 @@ impl<'m> System<'m> {
                     .iter()
                     .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
                     .collect();
-                el.response(&data.params, data.thickness, &ue, committed)
+                el.response_with(&data.params, data.thickness, &ue, committed, true)
             })
             .collect();
         let mut symmetrised = false;

@@ -151,10 +151,19 @@ pub fn body_force(kind: QuadKind, coords: &[[f64; 2]], thickness: f64, b: [f64; 
 /// Consistent nodal forces [N] of a uniform line load q [N/m] (per unit length of edge,
 /// thickness already included) on an edge with node coordinates ordered (start, end, [mid]).
 pub fn edge_force(edge_coords: &[[f64; 2]], q: [f64; 2]) -> Vec<f64> {
+    edge_force_partial(edge_coords, q, -1.0, 1.0)
+}
+
+/// As [`edge_force`], loading only the part r ∈ [r0, r1] of the edge (r ∈ [−1, 1] the edge's
+/// natural coordinate), for line loads that end inside an element edge.
+pub fn edge_force_partial(edge_coords: &[[f64; 2]], q: [f64; 2], r0: f64, r1: f64) -> Vec<f64> {
     let m = edge_coords.len();
     let mut f = vec![0.0; 2 * m];
     let r = gauss(3);
-    for (x, w) in r.points.iter().zip(&r.weights) {
+    let half = 0.5 * (r1 - r0);
+    for (xg, wg) in r.points.iter().zip(&r.weights) {
+        let x = &(r0 + half * (xg + 1.0));
+        let w = wg * half;
         let (nv, dn) = line_shape(m, *x);
         let (mut dx, mut dy) = (0.0, 0.0);
         for a in 0..m {

@@ -524,6 +524,21 @@ impl InterfaceElement {
         u: &[f64],
         committed: &[InterfacePointState],
     ) -> InterfaceResponse {
+        self.response_with(params, thickness, u, committed, false)
+    }
+
+    /// As [`Self::response`]; with `symmetric_tangent` the friction coupling term of sliding
+    /// points (∂τ/∂λ = μ K_n) is dropped, which keeps the tangent symmetric and positive
+    /// semi-definite for a Cholesky solver (MODEL.md §7.2); Newton then converges linearly
+    /// while points slide, to the same answer.
+    pub fn response_with(
+        &self,
+        params: &InterfaceParams,
+        thickness: f64,
+        u: &[f64],
+        committed: &[InterfacePointState],
+        symmetric_tangent: bool,
+    ) -> InterfaceResponse {
         let nd = self.n_dofs();
         assert_eq!(
             u.len(),
@@ -559,7 +574,11 @@ impl InterfaceElement {
                 }
             }
             let wb = p.weight * thickness;
-            let cm = r.tangent;
+            let mut cm = r.tangent;
+            if symmetric_tangent {
+                cm[0][1] = 0.0;
+                cm[1][0] = 0.0;
+            }
             if cm[0][1] != 0.0 || cm[1][0] != 0.0 {
                 symmetric = false;
             }

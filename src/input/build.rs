@@ -7,7 +7,9 @@ use super::schema::*;
 use crate::elements::continuum::{min_jacobian, Integration};
 use crate::fem::shape::QuadKind;
 use crate::materials::point::Material;
+use crate::elements::interface::{suggest_normal_stiffness, InterfaceElement, InterfaceParams, JointNeighbour};
 use crate::mesh::banded::{self, Band};
+use crate::mesh::segmental;
 use crate::model::*;
 use std::collections::HashMap;
 
@@ -175,12 +177,23 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         });
     }
     let region_names = || regions.iter().map(|r| r.name.as_str());
+    // Joint materials.
+    unique_names(ctx, "joint_materials", file.joint_materials.iter().map(|m| m.name.as_str()))?;
+    let mut joint_materials = Vec::new();
+    for (i, j) in file.joint_materials.iter().enumerate() {
+        joint_materials.push(joint_material(ctx, i, j)?);
+    }
     // Mesh.
     let mesh = file
         .mesh
         .as_ref()
         .ok_or_else(|| ctx.err("mesh", "missing: give a [mesh] table"))?;
-    let (nodes, elements) = build_mesh(mesh, ctx, &region_names)?;
+    let (nodes, elements, joints) = if mesh.kind == "segmental" {
+        build_segmental(mesh, ctx, &region_names)?
+    } else {
+        let (n, e) = build_mesh(mesh, ctx, &region_names)?;
+        (n, e, Vec::new())
+    };
     let mut model = Model {
         title: file.title.clone().unwrap_or_default(),
         nodes,
@@ -195,6 +208,9 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         steps: Vec::new(),
         controls: SolverControls::default(),
     };
+    if !joints.is_empty() {
+        add_joints(ctx, mesh, &mut model, &joints, &joint_materials)?;
+    }
     let mut used = vec![false; model.nodes.len()];
     for e in &model.elements {
         for &n in &e.nodes {
@@ -274,18 +290,22 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         }
         for (j, l) in c.line_loads.iter().enumerate() {
             let key = format!("load_cases[{i}].line_loads[{j}]");
-            let edges = locate::edges_on_segment(&model, l.line[0], l.line[1]);
-            if edges.is_empty() {
+            if l.q.iter().any(|v| !v.is_finite()) {
+                return Err(ctx.err(format!("{key}.q"), "must be finite numbers"));
+            }
+            let (edges, covered) = locate::edges_on_segment(&model, l.line[0], l.line[1]);
+            let [a, b] = l.line;
+            let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            if edges.is_empty() || (covered - length).abs() > 1e-6 * locate::model_size(&model) {
                 return Err(ctx.err(
                     format!("{key}.line"),
                     format!(
-                        "no element edge lies on the segment {:?}–{:?}",
-                        l.line[0], l.line[1]
+                        "the segment {a:?}–{b:?} must run along element edges over its whole length (edges cover {covered:.6} m of {length:.6} m)"
                     ),
                 ));
             }
-            for nodes in edges {
-                case.edge_loads.push(EdgeLoad { nodes, q: l.q });
+            for (nodes, range) in edges {
+                case.edge_loads.push(EdgeLoad { nodes, q: l.q, range });
             }
         }
         model.load_cases.push(case);
@@ -338,12 +358,37 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     )?,
                 }
             }
+            "joint_opening" | "joint_slip" | "joint_contact_depth" => {
+                let name = m.joint.as_deref().ok_or_else(|| {
+                    ctx.err(format!("{key}.joint"), "missing (a joint name such as J1, or \"all\")")
+                })?;
+                let joint = if name == "all" {
+                    if m.kind == "joint_contact_depth" {
+                        return Err(ctx.err(format!("{key}.joint"), "joint_contact_depth needs one joint, not \"all\""));
+                    }
+                    if model.joints.is_empty() {
+                        return Err(ctx.err(format!("{key}.joint"), "the model has no joints"));
+                    }
+                    None
+                } else {
+                    Some(index_by_name(
+                        ctx,
+                        &format!("{key}.joint"),
+                        "joint",
+                        model.joints.iter().map(|j| j.name.as_str()),
+                        name,
+                    )?)
+                };
+                match (m.kind.as_str(), joint) {
+                    ("joint_opening", j) => MonitorKind::JointOpening { joint: j },
+                    ("joint_slip", j) => MonitorKind::JointSlip { joint: j },
+                    (_, j) => MonitorKind::JointContactDepth { joint: j.expect("checked above") },
+                }
+            }
             o => {
                 return Err(ctx.err(
                     format!("{key}.kind"),
-                    format!(
-                    "unknown monitor kind '{o}' (expected displacement, reaction or load_factor)"
-                ),
+                    format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip or joint_contact_depth)"),
                 ))
             }
         };
@@ -575,7 +620,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
         }
         o => Err(ctx.err(
             "mesh.type",
-            format!("unknown mesh type '{o}' (expected banded or explicit)"),
+            format!("unknown mesh type '{o}' (expected banded, segmental or explicit)"),
         )),
     }
 }
@@ -636,9 +681,16 @@ fn check_rigid_body(ctx: &Ctx, model: &Model, used: &[bool]) -> R<()> {
         }
         i
     }
-    for e in &model.elements {
-        let r0 = find(&mut parent, e.nodes[0]);
-        for &n in &e.nodes[1..] {
+    // Joints and tendons tie parts together too (a joint can only hold a part while closed;
+    // the check is about supports, not about whether the joints stay closed).
+    let groups = model
+        .elements
+        .iter()
+        .map(|e| &e.nodes)
+        .chain(model.interfaces.iter().map(|i| &i.nodes));
+    for nodes in groups {
+        let r0 = find(&mut parent, nodes[0]);
+        for &n in &nodes[1..] {
             let r = find(&mut parent, n);
             parent[r] = r0;
         }
@@ -701,4 +753,221 @@ fn rank3(rows: &[[f64; 3]], size: f64) -> usize {
         rank += 1;
     }
     rank
+}
+
+/// A joint material from its table; penalties may be left for the mesh to resolve (kn = 0).
+fn joint_material(ctx: &Ctx, i: usize, j: &JointMaterialIn) -> R<(String, JointSpec)> {
+    let k = |f: &str| format!("joint_materials[{i}].{f}");
+    let nonneg = |key: String, v: Option<f64>| -> R<f64> {
+        let v = v.unwrap_or(0.0);
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(ctx.err(key, format!("must be zero or positive (got {v})")))
+        }
+    };
+    let friction = nonneg(k("friction"), j.friction)?;
+    let cohesion = nonneg(k("cohesion"), j.cohesion)?;
+    let ft = nonneg(k("tensile_strength"), j.tensile_strength)?;
+    let (keyed, tensile_strength) = match j.kind.as_str() {
+        "dry" => {
+            if ft > 0.0 {
+                return Err(ctx.err(k("tensile_strength"), "a dry joint has no tensile strength; use kind = \"epoxy\""));
+            }
+            (false, 0.0)
+        }
+        "keyed" => (true, 0.0),
+        "epoxy" => {
+            if ft <= 0.0 {
+                return Err(ctx.err(k("tensile_strength"), "an epoxy joint needs a positive tensile strength [Pa]"));
+            }
+            (false, ft)
+        }
+        o => return Err(ctx.err(k("kind"), format!("unknown joint kind '{o}' (expected dry, keyed or epoxy)"))),
+    };
+    let kn = match j.kn {
+        Some(v) => positive(ctx, &k("kn"), v)?,
+        None => 0.0,
+    };
+    let kt = match j.kt {
+        Some(v) => positive(ctx, &k("kt"), v)?,
+        None => 0.0,
+    };
+    let factor = match j.penalty_factor {
+        Some(v) => positive(ctx, &k("penalty_factor"), v)?,
+        None => crate::elements::interface::DEFAULT_PENALTY_FACTOR,
+    };
+    let residual = j.residual_stiffness_ratio.unwrap_or(1e-6);
+    if !(0.0..1.0).contains(&residual) {
+        return Err(ctx.err(k("residual_stiffness_ratio"), format!("must lie in [0, 1) (got {residual})")));
+    }
+    let lobatto = match j.integration.as_deref() {
+        None | Some("lobatto") => true,
+        Some("gauss") => false,
+        Some(o) => return Err(ctx.err(k("integration"), format!("unknown integration '{o}' (expected lobatto or gauss)"))),
+    };
+    Ok((
+        j.name.clone(),
+        JointSpec {
+            params: InterfaceParams {
+                kn,
+                kt,
+                friction,
+                cohesion,
+                tensile_strength,
+                keyed,
+                lobatto,
+                residual_ratio: residual,
+            },
+            factor,
+        },
+    ))
+}
+
+/// Joint parameters as given, with the penalty factor for automatic stiffnesses.
+#[derive(Debug, Clone)]
+struct JointSpec {
+    params: InterfaceParams,
+    factor: f64,
+}
+
+/// Segmental mesh: segments of given lengths (or equal ones), each a banded block.
+fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<(Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>)> {
+    let lengths: Vec<f64> = match (&mesh.segments, mesh.n_segments, mesh.length) {
+        (Some(l), None, None) => {
+            if l.is_empty() {
+                return Err(ctx.err("mesh.segments", "give at least one segment length"));
+            }
+            for (i, v) in l.iter().enumerate() {
+                positive(ctx, &format!("mesh.segments[{i}]"), *v)?;
+            }
+            l.clone()
+        }
+        (None, Some(n), Some(len)) => {
+            if n == 0 {
+                return Err(ctx.err("mesh.n_segments", "must be at least 1"));
+            }
+            let len = positive(ctx, "mesh.length", len)?;
+            vec![len / n as f64; n]
+        }
+        _ => {
+            return Err(ctx.err(
+                "mesh",
+                "a segmental mesh needs either segments = [lengths] or length and n_segments",
+            ))
+        }
+    };
+    let nx = mesh.nx_per_segment.ok_or_else(|| ctx.err("mesh.nx_per_segment", "missing"))?;
+    if nx == 0 {
+        return Err(ctx.err("mesh.nx_per_segment", "must be at least 1"));
+    }
+    if mesh.nx.is_some() || !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
+        return Err(ctx.err("mesh", "a segmental mesh takes nx_per_segment, not nx, nodes or blocks"));
+    }
+    let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
+    let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
+    let bands = bands_of(mesh, ctx, region_names)?;
+    let origin = mesh.origin.unwrap_or([0.0, 0.0]);
+    let g = segmental::generate_segments(origin[0], origin[1], &lengths, &vec![nx; lengths.len()], &bands, kind);
+    let elements = g
+        .elements
+        .into_iter()
+        .map(|(nodes, region, _segment)| Element { kind, nodes, region, integration: integ })
+        .collect();
+    Ok((g.nodes, elements, g.joints))
+}
+
+fn bands_of<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Vec<Band>> {
+    if mesh.bands.is_empty() {
+        return Err(ctx.err("mesh.bands", "needs at least one [[mesh.bands]]"));
+    }
+    let mut bands = Vec::new();
+    for (i, b) in mesh.bands.iter().enumerate() {
+        let region = index_by_name(ctx, &format!("mesh.bands[{i}].region"), "region", region_names(), &b.region)?;
+        let depth = positive(ctx, &format!("mesh.bands[{i}].depth"), b.depth)?;
+        if b.rows == 0 {
+            return Err(ctx.err(format!("mesh.bands[{i}].rows"), "must be at least 1"));
+        }
+        bands.push(Band { depth, rows: b.rows, region });
+    }
+    Ok(bands)
+}
+
+/// Create the interface elements of the generated joints with the mesh's joint material,
+/// resolving automatic penalty stiffnesses from the neighbouring elements.
+fn add_joints(
+    ctx: &Ctx,
+    mesh: &MeshIn,
+    model: &mut Model,
+    joints: &[segmental::Joint],
+    materials: &[(String, JointSpec)],
+) -> R<()> {
+    let name = mesh
+        .joint_material
+        .as_deref()
+        .ok_or_else(|| ctx.err("mesh.joint_material", "missing: name a [[joint_materials]] entry for the joints"))?;
+    let jm = index_by_name(
+        ctx,
+        "mesh.joint_material",
+        "joint material",
+        materials.iter().map(|m| m.0.as_str()),
+        name,
+    )?;
+    let spec = &materials[jm].1;
+    for (ji, j) in joints.iter().enumerate() {
+        let mut ids = Vec::new();
+        for f in &j.faces {
+            let region = &model.regions[f.region];
+            let e = model.materials[region.material].law.initial_modulus();
+            // Element size normal to the joint: width of the elements on each side.
+            let h = |nodes: &[usize]| -> f64 {
+                model
+                    .elements
+                    .iter()
+                    .find(|el| nodes.iter().all(|n| el.nodes.contains(n)))
+                    .map(|el| {
+                        let xs: Vec<f64> = el.nodes.iter().map(|&n| model.nodes[n][0]).collect();
+                        xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - xs.iter().cloned().fold(f64::INFINITY, f64::min)
+                    })
+                    .unwrap_or(1.0)
+            };
+            let mut params = spec.params.clone();
+            if params.kn == 0.0 {
+                let t = region.thickness;
+                params.kn = suggest_normal_stiffness(
+                    JointNeighbour { e, h: h(&f.a), thickness: t },
+                    JointNeighbour { e, h: h(&f.b), thickness: t },
+                    t,
+                    spec.factor,
+                );
+            }
+            if params.kt == 0.0 {
+                // Shear penalty as the shear/normal modulus ratio of the concrete (ν = 0.2).
+                params.kt = params.kn / (2.0 * 1.2);
+            }
+            let mut nodes = f.a.clone();
+            nodes.extend(&f.b);
+            let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| model.nodes[n]).collect();
+            InterfaceElement::new(&coords[..f.a.len()], &coords[f.a.len()..], &params)
+                .map_err(|e| ctx.err("mesh", format!("joint J{} at x = {}: {e}", ji + 1, j.x)))?;
+            ids.push(model.interfaces.len());
+            model.interfaces.push(InterfaceEl {
+                nodes,
+                n_a: f.a.len(),
+                thickness: region.thickness,
+                params,
+                joint: ji,
+            });
+        }
+        model.joints.push(Joint { name: format!("J{}", ji + 1), x: j.x, interfaces: ids });
+    }
+    Ok(())
 }

@@ -76,21 +76,45 @@ pub fn nodes_on_segment(model: &Model, used: &[bool], a: [f64; 2], b: [f64; 2]) 
         .collect()
 }
 
-/// Element edges (node lists start, end, [mid]) whose nodes all lie on the segment a–b.
-pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> Vec<Vec<usize>> {
+/// Element edges lying along the segment a–b: every node of the edge on the line through
+/// a and b (within 1e-6 × model size) and the edge overlapping the segment. Returns the edge
+/// nodes (start, end, [mid]) with the overlapped range of the edge's natural coordinate, and
+/// the total overlapped length [m]. Each geometric edge is taken once.
+pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> (Vec<(Vec<usize>, [f64; 2])>, f64) {
     let tol = 1e-6 * model_size(model);
+    let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+    let len = (ex * ex + ey * ey).sqrt();
     let mut out = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let mut covered = 0.0;
+    if len == 0.0 {
+        return (out, 0.0);
+    }
+    let param = |p: [f64; 2]| ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len; // [m] along a→b
+    let off_line = |p: [f64; 2]| ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex).abs() / len;
     for e in &model.elements {
         for k in 0..4 {
             let local = e.kind.edge_nodes(k);
             let nodes: Vec<usize> = local.iter().map(|&l| e.nodes[l]).collect();
-            if nodes
-                .iter()
-                .all(|&n| dist_to_segment(model.nodes[n], a, b) <= tol)
-            {
-                out.push(nodes);
+            if !nodes.iter().all(|&n| off_line(model.nodes[n]) <= tol) {
+                continue;
             }
+            let mut key = [nodes[0], nodes[1]];
+            key.sort_unstable();
+            if !seen.insert(key) {
+                continue;
+            }
+            let (s0, s1) = (param(model.nodes[nodes[0]]), param(model.nodes[nodes[1]]));
+            let (lo, hi) = (s0.min(s1).max(0.0), s0.max(s1).min(len));
+            if hi - lo <= tol {
+                continue;
+            }
+            // Straight edge: r is linear in the distance along it.
+            let to_r = |s: f64| -1.0 + 2.0 * (s - s0) / (s1 - s0);
+            let (r0, r1) = (to_r(lo), to_r(hi));
+            out.push((nodes, [r0.min(r1), r0.max(r1)]));
+            covered += hi - lo;
         }
     }
-    out
+    (out, covered)
 }

@@ -14,6 +14,8 @@ pub struct File {
     pub materials: Vec<MaterialIn>,
     #[serde(default)]
     pub regions: Vec<RegionIn>,
+    #[serde(default)]
+    pub joint_materials: Vec<JointMaterialIn>,
     pub mesh: Option<MeshIn>,
     #[serde(default)]
     pub supports: Vec<SupportIn>,
@@ -58,11 +60,31 @@ pub struct MeshIn {
     pub integration: Option<String>,
     #[serde(default)]
     pub bands: Vec<BandIn>,
+    // segmental
+    pub segments: Option<Vec<f64>>,
+    pub n_segments: Option<usize>,
+    pub nx_per_segment: Option<usize>,
+    pub joint_material: Option<String>,
     // explicit
     #[serde(default)]
     pub nodes: Vec<[f64; 2]>,
     #[serde(default)]
     pub blocks: Vec<BlockIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointMaterialIn {
+    pub name: String,
+    pub kind: String,
+    pub friction: Option<f64>,
+    pub cohesion: Option<f64>,
+    pub tensile_strength: Option<f64>,
+    pub kn: Option<f64>,
+    pub kt: Option<f64>,
+    pub penalty_factor: Option<f64>,
+    pub residual_stiffness_ratio: Option<f64>,
+    pub integration: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -129,6 +151,7 @@ pub struct MonitorIn {
     pub component: Option<String>,
     pub support: Option<String>,
     pub case: Option<String>,
+    pub joint: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

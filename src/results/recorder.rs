@@ -76,6 +76,13 @@ impl<'m> Recorder<'m> {
 
     fn monitor_values(&self, snap: &Snapshot) -> Vec<f64> {
         let u = &snap.system.u;
+        let n_joints = self.model.joints.len();
+        let joints_of = |j: Option<usize>| -> std::ops::Range<usize> {
+            match j {
+                Some(j) => j..j + 1,
+                None => 0..n_joints,
+            }
+        };
         self.model
             .monitors
             .iter()
@@ -91,11 +98,15 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
-                MonitorKind::JointOpening { joint } => summarise(snap.system, *joint).max_opening,
+                MonitorKind::JointOpening { joint } => joints_of(*joint)
+                    .map(|j| summarise(snap.system, j).max_opening)
+                    .fold(0.0, f64::max),
                 MonitorKind::JointContactDepth { joint } => {
                     summarise(snap.system, *joint).contact_depth
                 }
-                MonitorKind::JointSlip { joint } => summarise(snap.system, *joint).max_slip,
+                MonitorKind::JointSlip { joint } => joints_of(*joint)
+                    .map(|j| summarise(snap.system, j).max_slip)
+                    .fold(0.0, f64::max),
             })
             .collect()
     }

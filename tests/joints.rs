@@ -1,0 +1,228 @@
+//! Joint contact through the whole engine: two blocks pressed, pulled and sheared; the
+//! decompression moment of a segmental beam against beam theory; opening after it.
+
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::results::joints::summarise;
+
+/// Two 0.5 × 0.5 m blocks (thickness 0.2 m) side by side with a dry joint at x = 0.5.
+fn two_blocks(supports: &str, loads: &str, friction: f64) -> String {
+    format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.2
+[[joint_materials]]
+name = "j"
+kind = "dry"
+friction = {friction}
+kn = 1e12
+kt = 4e11
+residual_stiffness_ratio = 0.0
+[mesh]
+type = "segmental"
+segments = [0.5, 0.5]
+nx_per_segment = 2
+element = "Q8"
+joint_material = "j"
+bands = [{{ region = "r", depth = 0.5, rows = 2 }}]
+{supports}
+[[load_cases]]
+name = "N"
+{loads}
+[[steps]]
+name = "s"
+kind = "load"
+loads = {{ N = 1.0 }}
+"#
+    )
+}
+
+/// Keeps the last converged state's key numbers.
+#[derive(Default)]
+struct Keep {
+    u: Vec<f64>,
+    reaction_x_left: f64,
+    reaction_y_right: f64,
+    max_opening: f64,
+    max_slip: f64,
+    sliding: bool,
+}
+
+impl Observer for Keep {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let m = s.system.model;
+        self.u = s.system.u.clone();
+        let r = |name: &str, d: usize| -> f64 {
+            m.supports
+                .iter()
+                .filter(|sp| sp.name == name)
+                .flat_map(|sp| sp.dofs.iter())
+                .filter(|(_, dir, _)| dir.index() == d)
+                .map(|(n, dir, _)| s.f_int[2 * n + dir.index()] - s.f_ext[2 * n + dir.index()])
+                .sum()
+        };
+        self.reaction_x_left = r("left", 0);
+        self.reaction_y_right = r("right", 1);
+        let j = summarise(s.system, 0);
+        self.max_opening = j.max_opening;
+        self.max_slip = j.max_slip;
+        self.sliding = s.system.iface_committed.iter().flatten().any(|p| p.sliding);
+        Ok(())
+    }
+}
+
+fn run(text: &str) -> (segfem::model::Model, Keep) {
+    let model = segfem::input::parse(text, "two-blocks.toml").unwrap().model;
+    let mut k = Keep::default();
+    steps::run(&model, &mut k).unwrap();
+    (model, k)
+}
+
+const SIGMA: f64 = 5e6; // normal stress across the joint [Pa]
+const KN: f64 = 1e12;
+const B: f64 = 0.2;
+const L: f64 = 0.5;
+
+/// Uniform compression σ: penetration σ/K_n at every joint node, resultant σ b L.
+#[test]
+fn pressed_blocks_transmit_the_load_with_penetration_sigma_over_kn() {
+    let supports = r#"
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.5]]
+ux = 0.0
+[[supports]]
+name = "pin"
+point = [0.0, 0.0]
+uy = 0.0
+"#;
+    let loads = format!("line_loads = [{{ line = [[1.0, 0.0], [1.0, 0.5]], q = [{}, 0.0] }}]", -SIGMA * B);
+    let (m, k) = run(&two_blocks(supports, &loads, 0.7));
+    // Resultant: the left reaction balances σ b L (equilibrium, round-off).
+    assert!((k.reaction_x_left - SIGMA * B * L).abs() < 1e-9 * SIGMA * B * L, "{}", k.reaction_x_left);
+    let face = &m.interfaces;
+    for i in face {
+        for a in 0..i.n_a {
+            let (na, nb) = (i.nodes[a], i.nodes[i.n_a + a]);
+            let pen = k.u[2 * na] - k.u[2 * nb];
+            // Uniform stress is exact in the continuum; only round-off of the stiff penalty.
+            assert!((pen - SIGMA / KN).abs() < 1e-6 * SIGMA / KN, "penetration {pen}");
+        }
+    }
+    assert_eq!(k.max_opening, 0.0);
+}
+
+/// Pulled apart by a prescribed displacement, the joint opens and transmits nothing.
+#[test]
+fn pulled_blocks_open_and_transmit_nothing() {
+    let supports = r#"
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.5]]
+ux = 0.0
+[[supports]]
+name = "pin"
+point = [0.0, 0.0]
+uy = 0.0
+[[supports]]
+name = "right"
+line = [[1.0, 0.0], [1.0, 0.5]]
+ux = 1e-4
+[[supports]]
+name = "pin_right"
+point = [1.0, 0.0]
+uy = 0.0
+"#;
+    let (_, k) = run(&two_blocks(supports, "", 0.7));
+    // Below 1e-9 of the compression test's load σ b L.
+    assert!(k.reaction_x_left.abs() < 1e-9 * SIGMA * B * L, "{}", k.reaction_x_left);
+    assert!((k.max_opening - 1e-4).abs() < 1e-12, "opening {}", k.max_opening);
+}
+
+/// A block pushed sideways under normal stress sticks below μσ_n and slides at μσ_n.
+#[test]
+fn sheared_joint_sticks_below_and_slides_at_the_friction_limit() {
+    let mu = 0.7;
+    let shear = |delta: f64| {
+        // The right face is fully prescribed: pushed in by 0.1 mm (normal force N, read from
+        // its reaction) and moved up by δ; the support takes the couple of the shear.
+        let supports = format!(
+            r#"
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.5]]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "right"
+line = [[1.0, 0.0], [1.0, 0.5]]
+ux = -1e-4
+uy = {delta}
+"#
+        );
+        run(&two_blocks(&supports, "", mu)).1
+    };
+    // Stick: a tiny δ gives a shear far below μN.
+    let stick = shear(1e-7);
+    let n = stick.reaction_x_left.abs();
+    assert!(n > 1e5, "normal force {n}");
+    assert!(!stick.sliding);
+    assert!(stick.reaction_y_right.abs() < 0.5 * mu * n && stick.reaction_y_right.abs() > 0.0);
+    // Slide: δ = 1 mm cannot be taken by sticking; every closed point slides and the joint
+    // carries exactly μ times the normal force (round-off of the penalty terms).
+    let slide = shear(1e-3);
+    let n = slide.reaction_x_left.abs();
+    assert!(slide.sliding);
+    assert!((slide.reaction_y_right.abs() - mu * n).abs() < 1e-6 * mu * n, "{} vs {}", slide.reaction_y_right, mu * n);
+    // Part of δ goes into the blocks' shear and bending; the joint slip takes the rest, far
+    // more than the elastic slip of the sticking case.
+    assert!(slide.max_slip > 100.0 * stick.max_slip, "slip {} vs {}", slide.max_slip, stick.max_slip);
+}
+
+/// Records, per increment, the Q factor, the bottom normal stress of joint J1, the largest
+/// opening and J1's contact depth.
+#[derive(Default)]
+struct Decompression {
+    rows: Vec<(f64, f64, f64, f64)>,
+}
+
+impl Observer for Decompression {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let j = summarise(s.system, 0);
+        let bottom = j.profile.first().expect("points").normal_stress;
+        let open = (0..s.system.model.joints.len()).map(|k| summarise(s.system, k).max_opening).fold(0.0, f64::max);
+        self.rows.push((s.factors[1], bottom, open, j.contact_depth));
+        Ok(())
+    }
+}
+
+/// The bottom fibre of the joints decompresses at M = P (h/6 + e) (beam theory, within 2 %);
+/// the joint then opens, the opening grows and the compressed depth shrinks with the load.
+#[test]
+fn segmental_beam_decompresses_at_the_beam_theory_moment_then_opens() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/segmental-decompression.toml")).unwrap();
+    let model = segfem::input::parse(&text, "segmental-decompression.toml").unwrap().model;
+    let mut d = Decompression::default();
+    steps::run(&model, &mut d).unwrap();
+    // Beam theory: P = 600 kN at e = 0.05 m; h = 0.5 m; the joints lie in the constant-moment
+    // zone, 1 m (two depths, so St Venant effects of the loads have died out) from the loads.
+    let q_dec = 600e3 * (0.5 / 6.0 + 0.05) / 1.0 / 1e3; // load factor (kN per point)
+    // While closed the joint is linear: extrapolate the bottom stress to zero from two states.
+    let closed: Vec<_> = d.rows.iter().filter(|r| r.0 > 0.0 && r.2 == 0.0).collect();
+    let (a, b) = (closed[0], closed[closed.len() - 1]);
+    let q0 = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
+    assert!(((q0 - q_dec) / q_dec).abs() < 0.02, "decompression at Q = {q0:.2} kN, beam theory {q_dec:.2} kN");
+    // After opening: opening increases and contact depth decreases monotonically.
+    let open: Vec<_> = d.rows.iter().filter(|r| r.2 > 0.0).collect();
+    assert!(open.len() >= 5);
+    for w in open.windows(2) {
+        assert!(w[1].2 > w[0].2 && w[1].3 <= w[0].3, "{w:?}");
+    }
+    assert!(open.last().unwrap().3 < 0.5 * 0.5, "compressed depth should fall below half the depth");
+}
