@@ -849,3 +849,37 @@ loads = { P = 1.0 }
     let s: serde_json::Value = serde_json::from_str(&read(&tmp.join("out/summary.json"))).unwrap();
     assert_eq!(s["status"], "failed");
 }
+
+#[test]
+fn every_schema_key_is_documented() {
+    // Each field of the serde schema (under its TOML name) appears as `key` in docs/input.md.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let schema = read(&root.join("src/input/schema.rs"));
+    let docs = read(&root.join("docs/input.md"));
+    let mut rename: Option<String> = None;
+    let mut keys = Vec::new();
+    for line in schema.lines().map(str::trim) {
+        if let Some(r) = line.strip_prefix("#[serde(rename = \"") {
+            rename = r.split('"').next().map(str::to_string);
+        } else if let Some(f) = line.strip_prefix("pub ") {
+            if let Some((name, _)) = f.split_once(':') {
+                if !name.contains(' ') {
+                    keys.push(rename.take().unwrap_or_else(|| name.to_string()));
+                }
+            }
+            rename = None;
+        }
+    }
+    assert!(keys.len() > 40, "schema fields found: {keys:?}");
+    let missing: Vec<&String> = keys
+        .iter()
+        .filter(|k| {
+            // `key`, or the last part of a documented path such as `bands[].depth`.
+            !docs.contains(&format!("`{k}`")) && !docs.contains(&format!(".{k}`"))
+        })
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "keys missing from docs/input.md: {missing:?}"
+    );
+}
