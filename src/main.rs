@@ -15,6 +15,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/cantilever.toml"),
     ),
     (
+        "segmental-decompression",
+        "three dry-jointed segments, eccentric axial force, bent until the joints open",
+        include_str!("../examples/segmental-decompression.toml"),
+    ),
+    (
         "box-beam",
         "7.2 m box-section beam (banded), self weight then two point loads",
         include_str!("../examples/box-beam.toml"),

@@ -544,7 +544,6 @@ fn unknown_output_value() {
 // ---------------------------------------------------------------------------------------
 
 #[test]
-#[ignore = "src/input/mod.rs:35-40: for a type error the key slot shows the span text (the value), not the key"]
 fn wrong_value_type_names_the_key() {
     let model = edit(EXPLICIT, "thickness = 0.2", "thickness = \"0.2\"");
     let line = rejects_any_key(&model);
@@ -554,14 +553,12 @@ fn wrong_value_type_names_the_key() {
 }
 
 #[test]
-#[ignore = "src/input/build.rs:262: gravity is not checked for finite values (check accepts, run exits 3 with NaN residuals)"]
 fn non_finite_gravity() {
     let model = edit(EXPLICIT, "gravity = [0.0, -9.81]", "gravity = [nan, -9.81]");
     rejects(&model, "load_cases[0].gravity", &["finite"]);
 }
 
 #[test]
-#[ignore = "src/input/build.rs:273-286: line_loads q is not checked for finite values (check accepts, run exits 3)"]
 fn non_finite_line_load() {
     let model = edit(
         BANDED,
@@ -572,14 +569,12 @@ fn non_finite_line_load() {
 }
 
 #[test]
-#[ignore = "src/input/build.rs:226-231: ux/uy of a support are not checked for finite values (nan is accepted; run exits 0 after a spurious cut that drops the prescribed value)"]
 fn non_finite_prescribed_displacement() {
     let model = edit(BANDED, "ux = 0.0", "ux = nan");
     rejects(&model, "supports[0].ux", &["finite"]);
 }
 
 #[test]
-#[ignore = "src/input/build.rs:485: mesh.origin is not checked; a nan origin is reported as 'supports[0].point ... lies outside the mesh'"]
 fn non_finite_origin_is_named() {
     let model = edit(BANDED, "nx = 8", "nx = 8\norigin = [nan, 0.0]");
     rejects(&model, "mesh.origin", &["finite"]);

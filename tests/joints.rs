@@ -102,17 +102,27 @@ name = "pin"
 point = [0.0, 0.0]
 uy = 0.0
 "#;
-    let loads = format!("line_loads = [{{ line = [[1.0, 0.0], [1.0, 0.5]], q = [{}, 0.0] }}]", -SIGMA * B);
+    let loads = format!(
+        "line_loads = [{{ line = [[1.0, 0.0], [1.0, 0.5]], q = [{}, 0.0] }}]",
+        -SIGMA * B
+    );
     let (m, k) = run(&two_blocks(supports, &loads, 0.7));
     // Resultant: the left reaction balances σ b L (equilibrium, round-off).
-    assert!((k.reaction_x_left - SIGMA * B * L).abs() < 1e-9 * SIGMA * B * L, "{}", k.reaction_x_left);
+    assert!(
+        (k.reaction_x_left - SIGMA * B * L).abs() < 1e-9 * SIGMA * B * L,
+        "{}",
+        k.reaction_x_left
+    );
     let face = &m.interfaces;
     for i in face {
         for a in 0..i.n_a {
             let (na, nb) = (i.nodes[a], i.nodes[i.n_a + a]);
             let pen = k.u[2 * na] - k.u[2 * nb];
             // Uniform stress is exact in the continuum; only round-off of the stiff penalty.
-            assert!((pen - SIGMA / KN).abs() < 1e-6 * SIGMA / KN, "penetration {pen}");
+            assert!(
+                (pen - SIGMA / KN).abs() < 1e-6 * SIGMA / KN,
+                "penetration {pen}"
+            );
         }
     }
     assert_eq!(k.max_opening, 0.0);
@@ -141,8 +151,16 @@ uy = 0.0
 "#;
     let (_, k) = run(&two_blocks(supports, "", 0.7));
     // Below 1e-9 of the compression test's load σ b L.
-    assert!(k.reaction_x_left.abs() < 1e-9 * SIGMA * B * L, "{}", k.reaction_x_left);
-    assert!((k.max_opening - 1e-4).abs() < 1e-12, "opening {}", k.max_opening);
+    assert!(
+        k.reaction_x_left.abs() < 1e-9 * SIGMA * B * L,
+        "{}",
+        k.reaction_x_left
+    );
+    assert!(
+        (k.max_opening - 1e-4).abs() < 1e-12,
+        "opening {}",
+        k.max_opening
+    );
 }
 
 /// A block pushed sideways under normal stress sticks below μσ_n and slides at μσ_n.
@@ -179,10 +197,20 @@ uy = {delta}
     let slide = shear(1e-3);
     let n = slide.reaction_x_left.abs();
     assert!(slide.sliding);
-    assert!((slide.reaction_y_right.abs() - mu * n).abs() < 1e-6 * mu * n, "{} vs {}", slide.reaction_y_right, mu * n);
+    assert!(
+        (slide.reaction_y_right.abs() - mu * n).abs() < 1e-6 * mu * n,
+        "{} vs {}",
+        slide.reaction_y_right,
+        mu * n
+    );
     // Part of δ goes into the blocks' shear and bending; the joint slip takes the rest, far
     // more than the elastic slip of the sticking case.
-    assert!(slide.max_slip > 100.0 * stick.max_slip, "slip {} vs {}", slide.max_slip, stick.max_slip);
+    assert!(
+        slide.max_slip > 100.0 * stick.max_slip,
+        "slip {} vs {}",
+        slide.max_slip,
+        stick.max_slip
+    );
 }
 
 /// Records, per increment, the Q factor, the bottom normal stress of joint J1, the largest
@@ -196,8 +224,11 @@ impl Observer for Decompression {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         let j = summarise(s.system, 0);
         let bottom = j.profile.first().expect("points").normal_stress;
-        let open = (0..s.system.model.joints.len()).map(|k| summarise(s.system, k).max_opening).fold(0.0, f64::max);
-        self.rows.push((s.factors[1], bottom, open, j.contact_depth));
+        let open = (0..s.system.model.joints.len())
+            .map(|k| summarise(s.system, k).max_opening)
+            .fold(0.0, f64::max);
+        self.rows
+            .push((s.factors[1], bottom, open, j.contact_depth));
         Ok(())
     }
 }
@@ -206,23 +237,35 @@ impl Observer for Decompression {
 /// the joint then opens, the opening grows and the compressed depth shrinks with the load.
 #[test]
 fn segmental_beam_decompresses_at_the_beam_theory_moment_then_opens() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/segmental-decompression.toml")).unwrap();
-    let model = segfem::input::parse(&text, "segmental-decompression.toml").unwrap().model;
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/segmental-decompression.toml"
+    ))
+    .unwrap();
+    let model = segfem::input::parse(&text, "segmental-decompression.toml")
+        .unwrap()
+        .model;
     let mut d = Decompression::default();
     steps::run(&model, &mut d).unwrap();
     // Beam theory: P = 600 kN at e = 0.05 m; h = 0.5 m; the joints lie in the constant-moment
     // zone, 1 m (two depths, so St Venant effects of the loads have died out) from the loads.
     let q_dec = 600e3 * (0.5 / 6.0 + 0.05) / 1.0 / 1e3; // load factor (kN per point)
-    // While closed the joint is linear: extrapolate the bottom stress to zero from two states.
+                                                        // While closed the joint is linear: extrapolate the bottom stress to zero from two states.
     let closed: Vec<_> = d.rows.iter().filter(|r| r.0 > 0.0 && r.2 == 0.0).collect();
     let (a, b) = (closed[0], closed[closed.len() - 1]);
     let q0 = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
-    assert!(((q0 - q_dec) / q_dec).abs() < 0.02, "decompression at Q = {q0:.2} kN, beam theory {q_dec:.2} kN");
+    assert!(
+        ((q0 - q_dec) / q_dec).abs() < 0.02,
+        "decompression at Q = {q0:.2} kN, beam theory {q_dec:.2} kN"
+    );
     // After opening: opening increases and contact depth decreases monotonically.
     let open: Vec<_> = d.rows.iter().filter(|r| r.2 > 0.0).collect();
     assert!(open.len() >= 5);
     for w in open.windows(2) {
         assert!(w[1].2 > w[0].2 && w[1].3 <= w[0].3, "{w:?}");
     }
-    assert!(open.last().unwrap().3 < 0.5 * 0.5, "compressed depth should fall below half the depth");
+    assert!(
+        open.last().unwrap().3 < 0.5 * 0.5,
+        "compressed depth should fall below half the depth"
+    );
 }

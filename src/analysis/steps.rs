@@ -152,6 +152,9 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                 Err(failure) => {
                     // Throw the trial state away and retry with half the increment.
                     u.copy_from_slice(&sys.u);
+                    for &(d, v) in &sys.dofs.prescribed {
+                        u[d] = v;
+                    }
                     if cuts >= model.controls.max_cuts || step.kind == StepKind::Linear {
                         return Err(AnalysisError::NotConverged {
                             step: step.name.clone(),

@@ -5,9 +5,11 @@ use super::error::{Ctx, InputError};
 use super::locate;
 use super::schema::*;
 use crate::elements::continuum::{min_jacobian, Integration};
+use crate::elements::interface::{
+    suggest_normal_stiffness, InterfaceElement, InterfaceParams, JointNeighbour,
+};
 use crate::fem::shape::QuadKind;
 use crate::materials::point::Material;
-use crate::elements::interface::{suggest_normal_stiffness, InterfaceElement, InterfaceParams, JointNeighbour};
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
 use crate::model::*;
@@ -178,7 +180,11 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     }
     let region_names = || regions.iter().map(|r| r.name.as_str());
     // Joint materials.
-    unique_names(ctx, "joint_materials", file.joint_materials.iter().map(|m| m.name.as_str()))?;
+    unique_names(
+        ctx,
+        "joint_materials",
+        file.joint_materials.iter().map(|m| m.name.as_str()),
+    )?;
     let mut joint_materials = Vec::new();
     for (i, j) in file.joint_materials.iter().enumerate() {
         joint_materials.push(joint_material(ctx, i, j)?);
@@ -238,6 +244,11 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     }
     for (i, s) in file.supports.iter().enumerate() {
         let key = format!("supports[{i}]");
+        for (name, v) in [("ux", s.ux), ("uy", s.uy)] {
+            if v.is_some_and(|v| !v.is_finite()) {
+                return Err(ctx.err(format!("{key}.{name}"), "must be a finite number [m]"));
+            }
+        }
         let nodes = locate_nodes(ctx, &key, &model, &used, s.node, s.point, s.line)?;
         let mut dofs = Vec::new();
         for n in nodes {
@@ -275,6 +286,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         file.load_cases.iter().map(|c| c.name.as_str()),
     )?;
     for (i, c) in file.load_cases.iter().enumerate() {
+        if c.gravity.is_some_and(|g| g.iter().any(|v| !v.is_finite())) {
+            return Err(ctx.err(
+                format!("load_cases[{i}].gravity"),
+                "must be finite numbers [m/s²]",
+            ));
+        }
         let mut case = LoadCase {
             name: c.name.clone(),
             gravity: c.gravity,
@@ -305,7 +322,11 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 ));
             }
             for (nodes, range) in edges {
-                case.edge_loads.push(EdgeLoad { nodes, q: l.q, range });
+                case.edge_loads.push(EdgeLoad {
+                    nodes,
+                    q: l.q,
+                    range,
+                });
             }
         }
         model.load_cases.push(case);
@@ -482,6 +503,9 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
 
 type Mesh = (Vec<[f64; 2]>, Vec<Element>);
 
+/// Nodes, elements and joints of a segmental mesh.
+type SegMesh = (Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>);
+
 fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
     mesh: &MeshIn,
     ctx: &Ctx,
@@ -529,7 +553,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                     region,
                 });
             }
-            let origin = mesh.origin.unwrap_or([0.0, 0.0]);
+            let origin = origin_of(mesh, ctx)?;
             let g = banded::generate(origin, length, nx, &bands, kind);
             let elements = g
                 .elements
@@ -544,6 +568,24 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
             Ok((g.nodes, elements))
         }
         "explicit" => {
+            let banded_keys = [
+                ("length", mesh.length.is_some()),
+                ("origin", mesh.origin.is_some()),
+                ("nx", mesh.nx.is_some()),
+                ("element", mesh.element.is_some()),
+                ("integration", mesh.integration.is_some()),
+                ("bands", !mesh.bands.is_empty()),
+                ("segments", mesh.segments.is_some()),
+                ("n_segments", mesh.n_segments.is_some()),
+                ("nx_per_segment", mesh.nx_per_segment.is_some()),
+                ("joint_material", mesh.joint_material.is_some()),
+            ];
+            if let Some((k, _)) = banded_keys.iter().find(|(_, given)| *given) {
+                return Err(ctx.err(
+                    format!("mesh.{k}"),
+                    "not used by an explicit mesh (element types and integration go in each block)",
+                ));
+            }
             if mesh.nodes.is_empty() {
                 return Err(ctx.err("mesh.nodes", "an explicit mesh needs nodes"));
             }
@@ -772,18 +814,29 @@ fn joint_material(ctx: &Ctx, i: usize, j: &JointMaterialIn) -> R<(String, JointS
     let (keyed, tensile_strength) = match j.kind.as_str() {
         "dry" => {
             if ft > 0.0 {
-                return Err(ctx.err(k("tensile_strength"), "a dry joint has no tensile strength; use kind = \"epoxy\""));
+                return Err(ctx.err(
+                    k("tensile_strength"),
+                    "a dry joint has no tensile strength; use kind = \"epoxy\"",
+                ));
             }
             (false, 0.0)
         }
         "keyed" => (true, 0.0),
         "epoxy" => {
             if ft <= 0.0 {
-                return Err(ctx.err(k("tensile_strength"), "an epoxy joint needs a positive tensile strength [Pa]"));
+                return Err(ctx.err(
+                    k("tensile_strength"),
+                    "an epoxy joint needs a positive tensile strength [Pa]",
+                ));
             }
             (false, ft)
         }
-        o => return Err(ctx.err(k("kind"), format!("unknown joint kind '{o}' (expected dry, keyed or epoxy)"))),
+        o => {
+            return Err(ctx.err(
+                k("kind"),
+                format!("unknown joint kind '{o}' (expected dry, keyed or epoxy)"),
+            ))
+        }
     };
     let kn = match j.kn {
         Some(v) => positive(ctx, &k("kn"), v)?,
@@ -799,12 +852,20 @@ fn joint_material(ctx: &Ctx, i: usize, j: &JointMaterialIn) -> R<(String, JointS
     };
     let residual = j.residual_stiffness_ratio.unwrap_or(1e-6);
     if !(0.0..1.0).contains(&residual) {
-        return Err(ctx.err(k("residual_stiffness_ratio"), format!("must lie in [0, 1) (got {residual})")));
+        return Err(ctx.err(
+            k("residual_stiffness_ratio"),
+            format!("must lie in [0, 1) (got {residual})"),
+        ));
     }
     let lobatto = match j.integration.as_deref() {
         None | Some("lobatto") => true,
         Some("gauss") => false,
-        Some(o) => return Err(ctx.err(k("integration"), format!("unknown integration '{o}' (expected lobatto or gauss)"))),
+        Some(o) => {
+            return Err(ctx.err(
+                k("integration"),
+                format!("unknown integration '{o}' (expected lobatto or gauss)"),
+            ))
+        }
     };
     Ok((
         j.name.clone(),
@@ -836,7 +897,7 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
     mesh: &MeshIn,
     ctx: &Ctx,
     region_names: &dyn Fn() -> I,
-) -> R<(Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>)> {
+) -> R<SegMesh> {
     let lengths: Vec<f64> = match (&mesh.segments, mesh.n_segments, mesh.length) {
         (Some(l), None, None) => {
             if l.is_empty() {
@@ -861,22 +922,39 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
             ))
         }
     };
-    let nx = mesh.nx_per_segment.ok_or_else(|| ctx.err("mesh.nx_per_segment", "missing"))?;
+    let nx = mesh
+        .nx_per_segment
+        .ok_or_else(|| ctx.err("mesh.nx_per_segment", "missing"))?;
     if nx == 0 {
         return Err(ctx.err("mesh.nx_per_segment", "must be at least 1"));
     }
     if mesh.nx.is_some() || !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
-        return Err(ctx.err("mesh", "a segmental mesh takes nx_per_segment, not nx, nodes or blocks"));
+        return Err(ctx.err(
+            "mesh",
+            "a segmental mesh takes nx_per_segment, not nx, nodes or blocks",
+        ));
     }
     let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
     let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
     let bands = bands_of(mesh, ctx, region_names)?;
-    let origin = mesh.origin.unwrap_or([0.0, 0.0]);
-    let g = segmental::generate_segments(origin[0], origin[1], &lengths, &vec![nx; lengths.len()], &bands, kind);
+    let origin = origin_of(mesh, ctx)?;
+    let g = segmental::generate_segments(
+        origin[0],
+        origin[1],
+        &lengths,
+        &vec![nx; lengths.len()],
+        &bands,
+        kind,
+    );
     let elements = g
         .elements
         .into_iter()
-        .map(|(nodes, region, _segment)| Element { kind, nodes, region, integration: integ })
+        .map(|(nodes, region, _segment)| Element {
+            kind,
+            nodes,
+            region,
+            integration: integ,
+        })
         .collect();
     Ok((g.nodes, elements, g.joints))
 }
@@ -891,12 +969,22 @@ fn bands_of<'a, I: Iterator<Item = &'a str> + Clone>(
     }
     let mut bands = Vec::new();
     for (i, b) in mesh.bands.iter().enumerate() {
-        let region = index_by_name(ctx, &format!("mesh.bands[{i}].region"), "region", region_names(), &b.region)?;
+        let region = index_by_name(
+            ctx,
+            &format!("mesh.bands[{i}].region"),
+            "region",
+            region_names(),
+            &b.region,
+        )?;
         let depth = positive(ctx, &format!("mesh.bands[{i}].depth"), b.depth)?;
         if b.rows == 0 {
             return Err(ctx.err(format!("mesh.bands[{i}].rows"), "must be at least 1"));
         }
-        bands.push(Band { depth, rows: b.rows, region });
+        bands.push(Band {
+            depth,
+            rows: b.rows,
+            region,
+        });
     }
     Ok(bands)
 }
@@ -910,10 +998,12 @@ fn add_joints(
     joints: &[segmental::Joint],
     materials: &[(String, JointSpec)],
 ) -> R<()> {
-    let name = mesh
-        .joint_material
-        .as_deref()
-        .ok_or_else(|| ctx.err("mesh.joint_material", "missing: name a [[joint_materials]] entry for the joints"))?;
+    let name = mesh.joint_material.as_deref().ok_or_else(|| {
+        ctx.err(
+            "mesh.joint_material",
+            "missing: name a [[joint_materials]] entry for the joints",
+        )
+    })?;
     let jm = index_by_name(
         ctx,
         "mesh.joint_material",
@@ -935,7 +1025,8 @@ fn add_joints(
                     .find(|el| nodes.iter().all(|n| el.nodes.contains(n)))
                     .map(|el| {
                         let xs: Vec<f64> = el.nodes.iter().map(|&n| model.nodes[n][0]).collect();
-                        xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - xs.iter().cloned().fold(f64::INFINITY, f64::min)
+                        xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+                            - xs.iter().cloned().fold(f64::INFINITY, f64::min)
                     })
                     .unwrap_or(1.0)
             };
@@ -943,8 +1034,16 @@ fn add_joints(
             if params.kn == 0.0 {
                 let t = region.thickness;
                 params.kn = suggest_normal_stiffness(
-                    JointNeighbour { e, h: h(&f.a), thickness: t },
-                    JointNeighbour { e, h: h(&f.b), thickness: t },
+                    JointNeighbour {
+                        e,
+                        h: h(&f.a),
+                        thickness: t,
+                    },
+                    JointNeighbour {
+                        e,
+                        h: h(&f.b),
+                        thickness: t,
+                    },
                     t,
                     spec.factor,
                 );
@@ -967,7 +1066,19 @@ fn add_joints(
                 joint: ji,
             });
         }
-        model.joints.push(Joint { name: format!("J{}", ji + 1), x: j.x, interfaces: ids });
+        model.joints.push(Joint {
+            name: format!("J{}", ji + 1),
+            x: j.x,
+            interfaces: ids,
+        });
     }
     Ok(())
+}
+
+fn origin_of(mesh: &MeshIn, ctx: &Ctx) -> R<[f64; 2]> {
+    let o = mesh.origin.unwrap_or([0.0, 0.0]);
+    if o.iter().any(|v| !v.is_finite()) {
+        return Err(ctx.err("mesh.origin", "must be finite numbers [m]"));
+    }
+    Ok(o)
 }

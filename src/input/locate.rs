@@ -76,11 +76,14 @@ pub fn nodes_on_segment(model: &Model, used: &[bool], a: [f64; 2], b: [f64; 2]) 
         .collect()
 }
 
+/// An element edge (nodes start, end, [mid]) and the loaded range of its natural coordinate.
+pub type EdgePart = (Vec<usize>, [f64; 2]);
+
 /// Element edges lying along the segment a–b: every node of the edge on the line through
 /// a and b (within 1e-6 × model size) and the edge overlapping the segment. Returns the edge
 /// nodes (start, end, [mid]) with the overlapped range of the edge's natural coordinate, and
 /// the total overlapped length [m]. Each geometric edge is taken once.
-pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> (Vec<(Vec<usize>, [f64; 2])>, f64) {
+pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> (Vec<EdgePart>, f64) {
     let tol = 1e-6 * model_size(model);
     let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
     let len = (ex * ex + ey * ey).sqrt();

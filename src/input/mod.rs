@@ -31,11 +31,25 @@ pub fn parse(text: &str, label: &str) -> Result<Built, InputError> {
         let line = e
             .span()
             .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-        let key = e
+        // The key: the span's text when it is a key (unknown field), otherwise the key
+        // written before '=' on the error's line (wrong value type, bad number).
+        let span_text = e
             .span()
             .map(|s| text.get(s.clone()).unwrap_or("").trim().to_string())
-            .filter(|k| !k.is_empty() && k.len() < 60 && !k.contains('\n'))
             .unwrap_or_default();
+        let line_text = line
+            .and_then(|l| text.lines().nth(l - 1))
+            .unwrap_or("")
+            .trim();
+        let key = match line_text.split_once('=') {
+            Some((k, _)) if !k.trim_start().starts_with('[') && !k.contains('{') => {
+                k.trim().to_string()
+            }
+            _ if !span_text.is_empty() && span_text.len() < 60 && !span_text.contains('\n') => {
+                span_text
+            }
+            _ => String::new(),
+        };
         InputError {
             file: label.to_string(),
             line,
