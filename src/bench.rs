@@ -81,6 +81,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         }],
         interfaces: vec![],
         joints: vec![],
+        tendons: vec![],
         supports: vec![],
         load_cases: vec![],
         monitors: vec![],

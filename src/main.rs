@@ -15,6 +15,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/cantilever.toml"),
     ),
     (
+        "seed-beam",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon (VALIDATION.md §1)",
+        include_str!("../examples/seed-beam.toml"),
+    ),
+    (
         "segmental-decompression",
         "three dry-jointed segments, eccentric axial force, bent until the joints open",
         include_str!("../examples/segmental-decompression.toml"),

@@ -3,6 +3,7 @@
 
 use crate::elements::continuum::Integration;
 use crate::elements::interface::InterfaceParams;
+use crate::elements::tendon::DeviatorMode;
 use crate::fem::shape::QuadKind;
 use crate::materials::point::Material;
 use serde::Serialize;
@@ -124,6 +125,16 @@ pub enum MonitorKind {
         /// Joint index.
         joint: usize,
     },
+    /// Largest span stress of a tendon [Pa].
+    TendonStress {
+        /// Tendon index.
+        tendon: usize,
+    },
+    /// Largest span force of a tendon [N].
+    TendonForce {
+        /// Tendon index.
+        tendon: usize,
+    },
     /// Largest slip (relative tangential displacement) of a joint, or of all joints [m].
     JointSlip {
         /// Joint index, or None for the largest over all joints.
@@ -150,6 +161,8 @@ impl Monitor {
             MonitorKind::JointOpening { .. }
             | MonitorKind::JointContactDepth { .. }
             | MonitorKind::JointSlip { .. } => "m",
+            MonitorKind::TendonStress { .. } => "Pa",
+            MonitorKind::TendonForce { .. } => "N",
         }
     }
 }
@@ -241,6 +254,28 @@ pub struct Joint {
     pub interfaces: Vec<usize>,
 }
 
+/// An external (unbonded) tendon tied to the concrete at its anchors and deviators.
+#[derive(Debug, Clone, Serialize)]
+pub struct TendonEl {
+    /// User name.
+    pub name: String,
+    /// Concrete nodes the tendon is tied to (anchor, deviators…, anchor).
+    pub nodes: Vec<usize>,
+    /// Steel area A_p [m²].
+    pub area: f64,
+    /// Modulus E_p [Pa].
+    pub ep: f64,
+    /// Characteristic tensile strength f_ptk [Pa] (yield at 0.9 f_ptk).
+    pub fptk: f64,
+    /// Stress of each span just after stressing (friction losses included) [Pa].
+    pub span_stress: Vec<f64>,
+    /// Deviator behaviour.
+    #[serde(skip)]
+    pub mode: DeviatorMode,
+    /// Index of the step at whose start the tendon is stressed.
+    pub stressed_in_step: usize,
+}
+
 /// The complete validated model.
 #[derive(Debug, Clone, Serialize)]
 pub struct Model {
@@ -258,6 +293,8 @@ pub struct Model {
     pub interfaces: Vec<InterfaceEl>,
     /// Joints (groups of interface elements).
     pub joints: Vec<Joint>,
+    /// External tendons.
+    pub tendons: Vec<TendonEl>,
     /// Supports.
     pub supports: Vec<Support>,
     /// Load cases.

@@ -66,6 +66,7 @@ fn model_from_mesh(
         }],
         interfaces: vec![],
         joints: vec![],
+        tendons: vec![],
         supports: vec![],
         load_cases: vec![LoadCase {
             name: "P".into(),

@@ -98,6 +98,7 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
     }
     let mut factored_linear = false;
     for (si, step) in model.steps.iter().enumerate() {
+        sys.stress_tendons(si);
         let start = factors.clone();
         let n_inc = step.increments.max(1);
         let mut level = 0.0; // fraction of the step reached

@@ -3,6 +3,7 @@
 
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
+use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
 use crate::materials::point::{PointState, UpdateError};
@@ -43,6 +44,14 @@ pub struct System<'m> {
     pub iface_trial: Vec<Vec<InterfacePointState>>,
     /// True if the last assembled tangent was made symmetric (friction slip).
     pub symmetrised: bool,
+    /// External tendons, built when stressed (None before).
+    pub tendons: Vec<Option<ExternalTendon>>,
+    /// Displacements of each tendon's nodes when it was stressed [m].
+    pub tendon_u0: Vec<Vec<[f64; 2]>>,
+    /// Committed tendon states.
+    pub tendon_committed: Vec<Option<TendonState>>,
+    /// Trial tendon states.
+    pub tendon_trial: Vec<Option<TendonState>>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -81,6 +90,7 @@ impl<'m> System<'m> {
             .iter()
             .map(|e| e.nodes.clone())
             .chain(model.interfaces.iter().map(|i| i.nodes.clone()))
+            .chain(model.tendons.iter().map(|t| t.nodes.clone()))
             .collect();
         let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
         let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
@@ -126,6 +136,10 @@ impl<'m> System<'m> {
             iface_committed,
             interfaces,
             symmetrised: false,
+            tendons: vec![None; model.tendons.len()],
+            tendon_u0: vec![Vec::new(); model.tendons.len()],
+            tendon_committed: vec![None; model.tendons.len()],
+            tendon_trial: vec![None; model.tendons.len()],
         }
     }
 
@@ -245,8 +259,71 @@ impl<'m> System<'m> {
             }
             self.iface_trial[i] = r.states;
         }
+        // External tendons (corotational: their forces follow the deformed geometry).
+        let n_before = n_cont + self.interfaces.len();
+        for (t, tendon) in self.tendons.iter().enumerate() {
+            let (Some(el), Some(committed)) = (tendon, &self.tendon_committed[t]) else {
+                continue;
+            };
+            let nodes = &model.tendons[t].nodes;
+            let ut: Vec<[f64; 2]> = nodes
+                .iter()
+                .zip(&self.tendon_u0[t])
+                .map(|(&n, u0)| [u[2 * n] - u0[0], u[2 * n + 1] - u0[1]])
+                .collect();
+            let r = el.response(&ut, committed);
+            for (a, &n) in nodes.iter().enumerate() {
+                f_int[2 * n] += r.f_int[2 * a];
+                f_int[2 * n + 1] += r.f_int[2 * a + 1];
+            }
+            if let Some(k) = k_values.as_mut() {
+                let mut ke = r.k;
+                if !r.symmetric {
+                    symmetrise(&mut ke, 2 * nodes.len());
+                    symmetrised = true;
+                }
+                self.asm.add_matrix(n_before + t, &ke, k);
+            }
+            self.tendon_trial[t] = Some(r.state);
+        }
         self.symmetrised = symmetrised;
         Ok(Assembled { f_int, k_values })
+    }
+
+    /// Stress the tendons assigned to step `step`: each is built on the current deformed
+    /// geometry with its span stresses (post-tensioning against the concrete as it stands).
+    pub fn stress_tendons(&mut self, step: usize) {
+        for (t, data) in self.model.tendons.iter().enumerate() {
+            if data.stressed_in_step != step || self.tendons[t].is_some() {
+                continue;
+            }
+            let u0: Vec<[f64; 2]> = data
+                .nodes
+                .iter()
+                .map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+                .collect();
+            let x: Vec<[f64; 2]> = data
+                .nodes
+                .iter()
+                .zip(&u0)
+                .map(|(&n, d)| [self.model.nodes[n][0] + d[0], self.model.nodes[n][1] + d[1]])
+                .collect();
+            let el = ExternalTendon::new(
+                &x,
+                data.area,
+                data.ep,
+                data.span_stress[0],
+                TendonLaw::prestressing_steel(data.fptk),
+                data.mode,
+            )
+            .and_then(|e| e.with_span_initial_stresses(data.span_stress.clone()))
+            .expect("tendon geometry checked at input");
+            let st = el.initial_state();
+            self.tendon_committed[t] = Some(st.clone());
+            self.tendon_trial[t] = Some(st);
+            self.tendons[t] = Some(el);
+            self.tendon_u0[t] = u0;
+        }
     }
 
     /// Accept the trial states of the last assembly and the displacements `u`.
@@ -256,6 +333,7 @@ impl<'m> System<'m> {
         self.trial.clone_from(&self.committed);
         std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
         self.iface_committed.clone_from(&self.iface_trial);
+        self.tendon_committed.clone_from(&self.tendon_trial);
     }
 
     /// Gather the free-equation part of a full dof vector.

@@ -8,11 +8,13 @@ use crate::elements::continuum::{min_jacobian, Integration};
 use crate::elements::interface::{
     suggest_normal_stiffness, InterfaceElement, InterfaceParams, JointNeighbour,
 };
+use crate::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
 use crate::fem::shape::QuadKind;
 use crate::materials::point::Material;
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
 use crate::model::*;
+use crate::prestress::friction::{jacking_profile, FrictionParams, Jacking, TendonPath};
 use std::collections::HashMap;
 
 /// A validated model and the warnings met on the way (suspicious but legal values).
@@ -208,6 +210,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         materials,
         interfaces: Vec::new(),
         joints: Vec::new(),
+        tendons: Vec::new(),
         supports: Vec::new(),
         load_cases: Vec::new(),
         monitors: Vec::new(),
@@ -266,6 +269,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             name: s.name.clone(),
             dofs,
         });
+    }
+    // Tendons (the step they are stressed in is resolved with the steps below).
+    unique_names(ctx, "tendons", file.tendons.iter().map(|t| t.name.as_str()))?;
+    for (i, t) in file.tendons.iter().enumerate() {
+        let tendon = build_tendon(ctx, i, t, &model, &used, &mut warnings)?;
+        model.tendons.push(tendon);
     }
     // Unused nodes are held so that they add no zero pivots.
     let held: Vec<(usize, Dir, f64)> = (0..model.nodes.len())
@@ -379,6 +388,24 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     )?,
                 }
             }
+            "tendon_stress" | "tendon_force" => {
+                let name = m
+                    .tendon
+                    .as_deref()
+                    .ok_or_else(|| ctx.err(format!("{key}.tendon"), "missing (a tendon name)"))?;
+                let tendon = index_by_name(
+                    ctx,
+                    &format!("{key}.tendon"),
+                    "tendon",
+                    model.tendons.iter().map(|t| t.name.as_str()),
+                    name,
+                )?;
+                if m.kind == "tendon_stress" {
+                    MonitorKind::TendonStress { tendon }
+                } else {
+                    MonitorKind::TendonForce { tendon }
+                }
+            }
             "joint_opening" | "joint_slip" | "joint_contact_depth" => {
                 let name = m.joint.as_deref().ok_or_else(|| {
                     ctx.err(format!("{key}.joint"), "missing (a joint name such as J1, or \"all\")")
@@ -409,7 +436,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             o => {
                 return Err(ctx.err(
                     format!("{key}.kind"),
-                    format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip or joint_contact_depth)"),
+                    format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip, joint_contact_depth, tendon_stress or tendon_force)"),
                 ))
             }
         };
@@ -482,6 +509,17 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             increments,
             output_every_increment,
         });
+    }
+    for (i, t) in file.tendons.iter().enumerate() {
+        if let Some(name) = &t.stressed_in_step {
+            model.tendons[i].stressed_in_step = index_by_name(
+                ctx,
+                &format!("tendons[{i}].stressed_in_step"),
+                "step",
+                model.steps.iter().map(|s| s.name.as_str()),
+                name,
+            )?;
+        }
     }
     if let Some(sv) = &file.solver {
         let c = &mut model.controls;
@@ -729,7 +767,8 @@ fn check_rigid_body(ctx: &Ctx, model: &Model, used: &[bool]) -> R<()> {
         .elements
         .iter()
         .map(|e| &e.nodes)
-        .chain(model.interfaces.iter().map(|i| &i.nodes));
+        .chain(model.interfaces.iter().map(|i| &i.nodes))
+        .chain(model.tendons.iter().map(|t| &t.nodes));
     for nodes in groups {
         let r0 = find(&mut parent, nodes[0]);
         for &n in &nodes[1..] {
@@ -1081,4 +1120,163 @@ fn origin_of(mesh: &MeshIn, ctx: &Ctx) -> R<[f64; 2]> {
         return Err(ctx.err("mesh.origin", "must be finite numbers [m]"));
     }
     Ok(o)
+}
+
+/// An external tendon: points snapped to the nearest concrete nodes, span stresses after
+/// friction losses.
+fn build_tendon(
+    ctx: &Ctx,
+    i: usize,
+    t: &TendonIn,
+    model: &Model,
+    used: &[bool],
+    warnings: &mut Vec<String>,
+) -> R<TendonEl> {
+    let k = |f: &str| format!("tendons[{i}].{f}");
+    if t.kind != "external" {
+        return Err(ctx.err(k("kind"), format!("unknown tendon kind '{}' (expected external; bonded tendons are [[bars]] with an initial stress)", t.kind)));
+    }
+    if t.points.len() < 2 {
+        return Err(ctx.err(k("points"), "needs at least the two anchors"));
+    }
+    let area = positive(ctx, &k("area"), t.area)?;
+    let ep = positive(ctx, &k("Ep"), t.ep)?;
+    let fptk = positive(ctx, &k("fptk"), t.fptk)?;
+    if ep < 1e9 {
+        warnings.push(format!(
+            "{}: {}: Ep = {ep} Pa looks like MPa or GPa; segfem works in Pa",
+            ctx.file,
+            k("Ep")
+        ));
+    }
+    let size = locate::model_size(model);
+    let mut nodes = Vec::new();
+    for (j, p) in t.points.iter().enumerate() {
+        if !p.iter().all(|v| v.is_finite()) {
+            return Err(ctx.err(
+                format!("{}[{j}]", k("points")),
+                "must be finite numbers [m]",
+            ));
+        }
+        if !locate::inside_mesh(model, *p) {
+            return Err(ctx.err(
+                format!("{}[{j}]", k("points")),
+                format!("point {p:?} lies outside the mesh"),
+            ));
+        }
+        let n = locate::nearest_node(model, used, *p);
+        let q = model.nodes[n];
+        let d = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt();
+        if d > 1e-6 * size {
+            warnings.push(format!(
+                "{}: {}[{j}]: tendon point {p:?} tied to the nearest node at {q:?} ({d:.4} m away)",
+                ctx.file,
+                k("points")
+            ));
+        }
+        if nodes.last() == Some(&n) {
+            return Err(ctx.err(
+                format!("{}[{j}]", k("points")),
+                "two consecutive tendon points fall on the same node",
+            ));
+        }
+        nodes.push(n);
+    }
+    let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| model.nodes[n]).collect();
+    let n_spans = coords.len() - 1;
+    let span_stress = match (t.initial_stress, t.jacking_stress) {
+        (Some(s), None) => {
+            if !(s.is_finite() && s >= 0.0 && s < 0.9 * fptk) {
+                return Err(ctx.err(
+                    k("initial_stress"),
+                    format!("must lie in [0, 0.9 fptk) (got {s} Pa)"),
+                ));
+            }
+            if t.friction.is_some() || t.wobble.is_some() || t.jacking.is_some() {
+                return Err(ctx.err(
+                    k("friction"),
+                    "friction, wobble and jacking go with jacking_stress, not initial_stress",
+                ));
+            }
+            vec![s; n_spans]
+        }
+        (None, Some(s)) => {
+            if !(s.is_finite() && s > 0.0 && s < 0.9 * fptk) {
+                return Err(ctx.err(
+                    k("jacking_stress"),
+                    format!("must lie in (0, 0.9 fptk) (got {s} Pa)"),
+                ));
+            }
+            let mu = t.friction.unwrap_or(0.0);
+            let wobble = t.wobble.unwrap_or(crate::prestress::friction::SEED_WOBBLE);
+            if !(mu >= 0.0 && mu.is_finite() && wobble >= 0.0 && wobble.is_finite()) {
+                return Err(ctx.err(
+                    k("friction"),
+                    "friction and wobble must be zero or positive",
+                ));
+            }
+            let jacking = match t.jacking.as_deref() {
+                None | Some("both") => Jacking::Both,
+                Some("start") => Jacking::Start,
+                Some("end") => Jacking::End,
+                Some(o) => {
+                    return Err(ctx.err(
+                        k("jacking"),
+                        format!("unknown value '{o}' (expected start, end or both)"),
+                    ))
+                }
+            };
+            let path = TendonPath::from_points(&coords)
+                .map_err(|e| ctx.err(k("points"), e.to_string()))?;
+            jacking_profile(&path, s, &FrictionParams { mu, wobble }, jacking).segment_means()
+        }
+        _ => {
+            return Err(ctx.err(
+                k("initial_stress"),
+                "give exactly one of initial_stress or jacking_stress [Pa]",
+            ))
+        }
+    };
+    let mode = match t.deviators.as_deref() {
+        None | Some("held") => DeviatorMode::Held,
+        Some("frictionless") => DeviatorMode::Frictionless,
+        Some("friction") => {
+            let mu = t.deviator_friction.ok_or_else(|| {
+                ctx.err(
+                    k("deviator_friction"),
+                    "missing for deviators = \"friction\"",
+                )
+            })?;
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(ctx.err(k("deviator_friction"), "must be zero or positive"));
+            }
+            DeviatorMode::Friction { mu }
+        }
+        Some(o) => {
+            return Err(ctx.err(
+                k("deviators"),
+                format!("unknown value '{o}' (expected held, frictionless or friction)"),
+            ))
+        }
+    };
+    // Check the element can be built (zero-length spans, etc.).
+    ExternalTendon::new(
+        &coords,
+        area,
+        ep,
+        span_stress[0],
+        TendonLaw::prestressing_steel(fptk),
+        mode,
+    )
+    .map_err(|e| ctx.err(k("points"), e.to_string()))?;
+    Ok(TendonEl {
+        name: t.name.clone(),
+        nodes,
+        area,
+        ep,
+        fptk,
+        span_stress,
+        mode,
+        stressed_in_step: 0,
+    })
 }

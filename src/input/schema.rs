@@ -18,6 +18,8 @@ pub struct File {
     pub joint_materials: Vec<JointMaterialIn>,
     pub mesh: Option<MeshIn>,
     #[serde(default)]
+    pub tendons: Vec<TendonIn>,
+    #[serde(default)]
     pub supports: Vec<SupportIn>,
     #[serde(default)]
     pub load_cases: Vec<LoadCaseIn>,
@@ -89,6 +91,26 @@ pub struct JointMaterialIn {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+pub struct TendonIn {
+    pub name: String,
+    pub kind: String,
+    pub points: Vec<[f64; 2]>,
+    pub area: f64,
+    #[serde(rename = "Ep")]
+    pub ep: f64,
+    pub fptk: f64,
+    pub initial_stress: Option<f64>,
+    pub jacking_stress: Option<f64>,
+    pub jacking: Option<String>,
+    pub friction: Option<f64>,
+    pub wobble: Option<f64>,
+    pub deviators: Option<String>,
+    pub deviator_friction: Option<f64>,
+    pub stressed_in_step: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BandIn {
     pub region: String,
     pub depth: f64,
@@ -152,6 +174,7 @@ pub struct MonitorIn {
     pub support: Option<String>,
     pub case: Option<String>,
     pub joint: Option<String>,
+    pub tendon: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -98,6 +98,14 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
+                MonitorKind::TendonStress { tendon } => snap.system.tendon_committed[*tendon]
+                    .as_ref()
+                    .map(|st| st.stresses().into_iter().fold(0.0, f64::max))
+                    .unwrap_or(0.0),
+                MonitorKind::TendonForce { tendon } => snap.system.tendon_committed[*tendon]
+                    .as_ref()
+                    .map(|st| st.forces().into_iter().fold(0.0, f64::max))
+                    .unwrap_or(0.0),
                 MonitorKind::JointOpening { joint } => joints_of(*joint)
                     .map(|j| summarise(snap.system, j).max_opening)
                     .fold(0.0, f64::max),
