@@ -261,8 +261,8 @@ fn unknown_key_is_named_with_its_line() {
 
 #[test]
 fn unknown_top_level_table_is_named() {
-    let model = format!("{EXPLICIT}\n[[tendons]]\nname = \"t1\"\n");
-    rejects(&model, "tendons", &["unknown field"]);
+    let model = format!("{EXPLICIT}\n[[cables]]\nname = \"t1\"\n");
+    rejects(&model, "cables", &["unknown field"]);
 }
 
 // ---------------------------------------------------------------------------------------
