@@ -31,7 +31,7 @@ pub struct Recorder<'m> {
     dir: PathBuf,
     /// Recorded rows.
     pub rows: Vec<Row>,
-    pvd: Vec<(f64, String)>,
+    pvd: Vec<(f64, usize, String)>,
     write_fields: bool,
 }
 
@@ -207,7 +207,17 @@ impl<'m> Recorder<'m> {
         );
         let name = format!("step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
         write_atomic(&self.dir.join(&name), doc.as_bytes())?;
-        self.pvd.push((self.rows.len() as f64, name));
+        let t = self.rows.len() as f64;
+        self.pvd.push((t, 0, name));
+        if let Some(lines) = render_lines(snap, &disp) {
+            let name = format!(
+                "lines_step{:03}_inc{:04}.vtu",
+                snap.step + 1,
+                snap.increment
+            );
+            write_atomic(&self.dir.join(&name), lines.as_bytes())?;
+            self.pvd.push((t, 1, name));
+        }
         write_atomic(
             &self.dir.join("results.pvd"),
             render_pvd(&self.pvd).as_bytes(),
@@ -234,4 +244,89 @@ impl Observer for Recorder<'_> {
         }
         Ok(())
     }
+}
+
+/// Joints and tendons as line cells in a second piece (part 1 of the .pvd): joint elements
+/// as face-A lines with their opening and mean tractions, tendon spans with stress and force.
+/// None when the model has neither.
+fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
+    let sys = snap.system;
+    let model = sys.model;
+    if model.interfaces.is_empty() && model.tendons.is_empty() {
+        return None;
+    }
+    let mut cells = Vec::new();
+    let mut types = Vec::new();
+    let mut kind = Vec::new();
+    let (mut opening, mut sn, mut tau, mut t_stress, mut t_force) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    for (i, el) in model.interfaces.iter().enumerate() {
+        let face: Vec<usize> = el.nodes[..el.n_a].to_vec();
+        types.push(if face.len() == 3 { 21u8 } else { 3u8 });
+        cells.push(face);
+        kind.push(1);
+        let st = &sys.iface_committed[i];
+        let n = st.len().max(1) as f64;
+        opening.push(st.iter().map(|p| p.opening()).fold(0.0, f64::max));
+        sn.push(st.iter().map(|p| p.normal_stress()).sum::<f64>() / n);
+        tau.push(st.iter().map(|p| p.shear_stress()).sum::<f64>() / n);
+        t_stress.push(0.0);
+        t_force.push(0.0);
+    }
+    for (t, data) in model.tendons.iter().enumerate() {
+        let state = sys.tendon_committed[t].as_ref();
+        for (k, w) in data.nodes.windows(2).enumerate() {
+            cells.push(w.to_vec());
+            types.push(3);
+            kind.push(2);
+            opening.push(0.0);
+            sn.push(0.0);
+            tau.push(0.0);
+            t_stress.push(state.map(|s| s.spans[k].stress).unwrap_or(0.0));
+            t_force.push(state.map(|s| s.spans[k].force).unwrap_or(0.0));
+        }
+    }
+    Some(render(
+        &Grid {
+            points: &model.nodes,
+            cells: &cells,
+            types: &types,
+        },
+        &[Array::F64 {
+            name: "displacement",
+            components: 3,
+            values: disp,
+        }],
+        &[
+            Array::I32 {
+                name: "cell_kind",
+                values: &kind,
+            },
+            Array::F64 {
+                name: "joint_opening",
+                components: 1,
+                values: &opening,
+            },
+            Array::F64 {
+                name: "joint_normal_stress",
+                components: 1,
+                values: &sn,
+            },
+            Array::F64 {
+                name: "joint_shear_stress",
+                components: 1,
+                values: &tau,
+            },
+            Array::F64 {
+                name: "tendon_stress",
+                components: 1,
+                values: &t_stress,
+            },
+            Array::F64 {
+                name: "tendon_force",
+                components: 1,
+                values: &t_force,
+            },
+        ],
+    ))
 }

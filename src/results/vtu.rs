@@ -133,13 +133,14 @@ pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String 
     s
 }
 
-/// Render a .pvd collection of (time, file name) entries.
-pub fn render_pvd(entries: &[(f64, String)]) -> String {
+/// Render a .pvd collection of (time, part, file name) entries; part 0 is the continuum,
+/// part 1 the line cells (joints, tendons) of the same instant.
+pub fn render_pvd(entries: &[(f64, usize, String)]) -> String {
     let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
-    for (t, f) in entries {
+    for (t, part, f) in entries {
         let _ = writeln!(
             s,
-            r#"<DataSet timestep="{t}" group="" part="0" file="{f}"/>"#
+            r#"<DataSet timestep="{t}" group="" part="{part}" file="{f}"/>"#
         );
     }
     s.push_str("</Collection>\n</VTKFile>\n");
