@@ -1,0 +1,102 @@
+//! The seed's validation beam (VALIDATION.md §1): a 7.2 m dry-jointed segmental box beam
+//! with one external tendon, from the bundled example. Checks the behaviour the seed reports
+//! (joints closed at service load, first opening between 56 and 70 kN, tendon stress rising
+//! faster once joints open) and compares deflections and the largest opening with the
+//! seed's computed values.
+
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::results::joints::summarise;
+
+/// One row per converged increment: Q [kN], midspan deflection [m], tendon stress [Pa],
+/// largest opening [m], all joint points closed and compressed.
+#[derive(Default)]
+struct Rows(Vec<(f64, f64, f64, f64, bool)>);
+
+impl Observer for Rows {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let m = s.system.model;
+        let mid = m
+            .nodes
+            .iter()
+            .position(|p| (p[0] - 3.6).abs() < 1e-9 && p[1].abs() < 1e-9)
+            .expect("midspan soffit node");
+        let stress = s.system.tendon_committed[0]
+            .as_ref()
+            .map(|t| t.stresses()[1])
+            .unwrap_or(0.0);
+        let mut open = 0.0f64;
+        let mut compressed = true;
+        for j in 0..m.joints.len() {
+            let sm = summarise(s.system, j);
+            open = open.max(sm.max_opening);
+            compressed &= sm.profile.iter().all(|p| p.closed && p.normal_stress > 0.0);
+        }
+        self.0.push((
+            s.factors[1],
+            s.system.u[2 * mid + 1],
+            stress,
+            open,
+            compressed,
+        ));
+        Ok(())
+    }
+}
+
+fn at(rows: &[(f64, f64, f64, f64, bool)], q: f64) -> (f64, f64, f64, f64, bool) {
+    *rows
+        .iter()
+        .min_by(|a, b| (a.0 - q).abs().total_cmp(&(b.0 - q).abs()))
+        .unwrap()
+}
+
+#[test]
+fn seed_beam_behaves_as_the_seed_reports() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/seed-beam.toml"
+    ))
+    .unwrap();
+    let model = segfem::input::parse(&text, "seed-beam.toml").unwrap().model;
+    let mut rows = Rows::default();
+    steps::run(&model, &mut rows).unwrap();
+    let r = &rows.0;
+    let u0 = r[0].1; // after self weight and prestress (Q = 0)
+                     // Service load: every joint closed with compression over its whole depth.
+    let s56 = at(r, 56.0);
+    assert!(
+        (s56.0 - 56.0).abs() < 1e-9 && s56.4,
+        "joints must be closed and compressed at Q = 56 kN"
+    );
+    // Elastic deflection from Q = 56 kN against the hand value of VALIDATION.md §1 (1.7 mm,
+    // beam theory without shear deformation: the FE value is a few per cent larger).
+    let d56 = u0 - s56.1;
+    assert!(
+        (d56 - 1.7e-3).abs() < 0.1 * 1.7e-3,
+        "deflection at 56 kN: {d56}"
+    );
+    // A joint open by Q = 70 kN.
+    assert!(at(r, 70.0).3 > 0.0, "a joint must be open at Q = 70 kN");
+    // Tendon stress grows markedly faster once the joints open.
+    let rate = |a: f64, b: f64| (at(r, b).2 - at(r, a).2) / (b - a);
+    assert!(
+        rate(100.0, 140.0) > 10.0 * rate(14.0, 56.0),
+        "{} vs {}",
+        rate(100.0, 140.0),
+        rate(14.0, 56.0)
+    );
+    // The seed's computed values at the highest loads (VALIDATION.md §1: 25 % because part of
+    // the geometry is assumed). Lower loads are reported in docs/validation.md: the model is
+    // stiffer there (elastic concrete; see the account there).
+    for (q, seed_mm) in [(126.0, 36.08), (140.0, 41.85)] {
+        let d = (u0 - at(r, q).1) * 1e3;
+        assert!(
+            ((d - seed_mm) / seed_mm).abs() < 0.25,
+            "Q = {q}: {d:.2} mm vs seed {seed_mm} mm"
+        );
+    }
+    let open140 = at(r, 140.0).3 * 1e3;
+    assert!(
+        ((open140 - 6.0) / 6.0).abs() < 0.25,
+        "largest opening at 140 kN: {open140:.2} mm vs 6 mm"
+    );
+}
