@@ -19,9 +19,17 @@ pub enum Integration {
 
 /// The Gauss points of an element kind under a rule.
 pub fn rule(kind: QuadKind, integration: Integration) -> Vec<Point2> {
+    rule_points(kind, integration).to_vec()
+}
+
+/// The Gauss points of an element kind under a rule, from tables built once (the element
+/// loop must not allocate).
+pub fn rule_points(kind: QuadKind, integration: Integration) -> &'static [Point2] {
+    static RULES: std::sync::OnceLock<[Vec<Point2>; 2]> = std::sync::OnceLock::new();
+    let r = RULES.get_or_init(|| [gauss_square(2), gauss_square(3)]);
     match (kind, integration) {
-        (QuadKind::Q4, _) | (_, Integration::Reduced) => gauss_square(2),
-        _ => gauss_square(3),
+        (QuadKind::Q4, _) | (_, Integration::Reduced) => &r[0],
+        _ => &r[1],
     }
 }
 
@@ -85,9 +93,18 @@ pub fn response(
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);
     k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
-    let h = area(kind, coords).sqrt();
-    for (g, p) in rule(kind, integration).iter().enumerate() {
-        let (dn, wdet) = point_derivatives(kind, coords, p);
+    // Geometry of every Gauss point first: the element area (Σ w det J) gives the
+    // characteristic length the material update may need.
+    let pts = rule_points(kind, integration);
+    let mut geo = [([[0.0; 2]; MAX_NODES], 0.0); 9];
+    let mut area = 0.0;
+    for (g, p) in pts.iter().enumerate() {
+        geo[g] = point_derivatives(kind, coords, p);
+        area += geo[g].1;
+    }
+    let h = area.sqrt();
+    for g in 0..pts.len() {
+        let (dn, wdet) = geo[g];
         let mut eps = [0.0; 3];
         for a in 0..n {
             let (ux, uy) = (u[2 * a], u[2 * a + 1]);

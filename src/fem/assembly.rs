@@ -3,6 +3,7 @@
 //! refilling values is a scatter with no search and no allocation.
 
 use super::dofs::{DofMap, CONSTRAINED};
+use rayon::prelude::*;
 use crate::analysis::solver::LowerPattern;
 
 /// Position marker for an element matrix entry that is not assembled (constrained dof or
@@ -68,7 +69,7 @@ impl Assembler {
             row_idx,
         };
         let scatter = elem_nodes
-            .iter()
+            .par_iter()
             .map(|nodes| {
                 let eqs: Vec<usize> = nodes
                     .iter()
