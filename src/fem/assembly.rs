@@ -3,8 +3,8 @@
 //! refilling values is a scatter with no search and no allocation.
 
 use super::dofs::{DofMap, CONSTRAINED};
-use rayon::prelude::*;
 use crate::analysis::solver::LowerPattern;
+use rayon::prelude::*;
 
 /// Position marker for an element matrix entry that is not assembled (constrained dof or
 /// strictly upper triangle).

@@ -2,6 +2,7 @@
 //! found in the mesh. Every problem is an [`InputError`] naming the key.
 
 use super::error::{Ctx, InputError};
+use super::gmsh_mesh;
 use super::locate;
 use super::schema::*;
 use crate::elements::continuum::{min_jacobian, Integration};
@@ -196,8 +197,14 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .mesh
         .as_ref()
         .ok_or_else(|| ctx.err("mesh", "missing: give a [mesh] table"))?;
+    let mut groups = gmsh_mesh::Groups::default();
     let (nodes, elements, joints) = if mesh.kind == "segmental" {
         build_segmental(mesh, ctx, &region_names)?
+    } else if mesh.kind == "gmsh" {
+        let names: Vec<&str> = region_names().collect();
+        let g = gmsh_mesh::build_gmsh(mesh, ctx, &names)?;
+        groups = g.groups;
+        (g.nodes, g.elements, g.joints)
     } else {
         let (n, e) = build_mesh(mesh, ctx, &region_names)?;
         (n, e, Vec::new())
@@ -252,7 +259,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 return Err(ctx.err(format!("{key}.{name}"), "must be a finite number [m]"));
             }
         }
-        let nodes = locate_nodes(ctx, &key, &model, &used, s.node, s.point, s.line)?;
+        let nodes = match &s.group {
+            Some(g) => {
+                if s.node.is_some() || s.point.is_some() || s.line.is_some() {
+                    return Err(ctx.err(&key, "give exactly one of node, point, line or group"));
+                }
+                groups.nodes.get(g).cloned().ok_or_else(|| {
+                    ctx.err(
+                        format!("{key}.group"),
+                        format!("no physical group named '{g}' (groups come from a gmsh mesh)"),
+                    )
+                })?
+            }
+            None => locate_nodes(ctx, &key, &model, &used, s.node, s.point, s.line)?,
+        };
         let mut dofs = Vec::new();
         for n in nodes {
             if let Some(v) = s.ux {
@@ -319,17 +339,36 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             if l.q.iter().any(|v| !v.is_finite()) {
                 return Err(ctx.err(format!("{key}.q"), "must be finite numbers"));
             }
-            let (edges, covered) = locate::edges_on_segment(&model, l.line[0], l.line[1]);
-            let [a, b] = l.line;
-            let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-            if edges.is_empty() || (covered - length).abs() > 1e-6 * locate::model_size(&model) {
-                return Err(ctx.err(
-                    format!("{key}.line"),
-                    format!(
-                        "the segment {a:?}–{b:?} must run along element edges over its whole length (edges cover {covered:.6} m of {length:.6} m)"
-                    ),
-                ));
-            }
+            let edges = match (&l.line, &l.group) {
+                (Some([a, b]), None) => {
+                    let (edges, covered) = locate::edges_on_segment(&model, *a, *b);
+                    let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                    if edges.is_empty()
+                        || (covered - length).abs() > 1e-6 * locate::model_size(&model)
+                    {
+                        return Err(ctx.err(
+                            format!("{key}.line"),
+                            format!(
+                                "the segment {a:?}–{b:?} must run along element edges over its whole length (edges cover {covered:.6} m of {length:.6} m)"
+                            ),
+                        ));
+                    }
+                    edges
+                }
+                (None, Some(g)) => groups
+                    .edges
+                    .get(g)
+                    .ok_or_else(|| {
+                        ctx.err(
+                            format!("{key}.group"),
+                            format!("no physical curve named '{g}' (groups come from a gmsh mesh)"),
+                        )
+                    })?
+                    .iter()
+                    .map(|e| (e.clone(), [-1.0, 1.0]))
+                    .collect(),
+                _ => return Err(ctx.err(&key, "give exactly one of line or group")),
+            };
             for (nodes, range) in edges {
                 case.edge_loads.push(EdgeLoad {
                     nodes,
@@ -700,7 +739,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
         }
         o => Err(ctx.err(
             "mesh.type",
-            format!("unknown mesh type '{o}' (expected banded, segmental or explicit)"),
+            format!("unknown mesh type '{o}' (expected banded, segmental, gmsh or explicit)"),
         )),
     }
 }

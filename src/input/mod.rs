@@ -59,3 +59,4 @@ pub fn parse(text: &str, label: &str) -> Result<Built, InputError> {
     })?;
     build::build(file, &ctx)
 }
+pub mod gmsh_mesh;

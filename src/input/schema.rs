@@ -67,6 +67,10 @@ pub struct MeshIn {
     pub n_segments: Option<usize>,
     pub nx_per_segment: Option<usize>,
     pub joint_material: Option<String>,
+    // gmsh
+    pub file: Option<String>,
+    #[serde(default)]
+    pub joints: Vec<GmshJointIn>,
     // explicit
     #[serde(default)]
     pub nodes: Vec<[f64; 2]>,
@@ -87,6 +91,13 @@ pub struct JointMaterialIn {
     pub penalty_factor: Option<f64>,
     pub residual_stiffness_ratio: Option<f64>,
     pub integration: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GmshJointIn {
+    pub a: String,
+    pub b: String,
 }
 
 #[derive(Debug, Deserialize)]
@@ -133,6 +144,7 @@ pub struct SupportIn {
     pub node: Option<i64>,
     pub point: Option<[f64; 2]>,
     pub line: Option<[[f64; 2]; 2]>,
+    pub group: Option<String>,
     pub ux: Option<f64>,
     pub uy: Option<f64>,
 }
@@ -159,7 +171,8 @@ pub struct PointLoadIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LineLoadIn {
-    pub line: [[f64; 2]; 2],
+    pub line: Option<[[f64; 2]; 2]>,
+    pub group: Option<String>,
     pub q: [f64; 2],
 }
 
