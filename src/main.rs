@@ -76,6 +76,13 @@ enum Command {
         /// Element kinds, comma separated (Q4, Q8, Q9).
         #[arg(long, value_delimiter = ',', default_values_t = vec!["Q4".to_string(), "Q8".to_string()])]
         element: Vec<String>,
+        /// Benchmark: "linear" (banded beams of --dofs) or "seed" (the seed beam through joint
+        /// opening, refined by each factor of --refine).
+        #[arg(long, default_value = "linear")]
+        case: String,
+        /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 4])]
+        refine: Vec<usize>,
     },
 }
 
@@ -89,7 +96,19 @@ fn main() -> ExitCode {
         } => run(model, output, quiet),
         Command::Check { model } => check(model),
         Command::Example { name, output } => example(name, output),
-        Command::Bench { dofs, element } => bench(dofs, element),
+        Command::Bench {
+            dofs,
+            element,
+            case,
+            refine,
+        } => match case.as_str() {
+            "linear" => bench(dofs, element),
+            "seed" => bench_seed(refine),
+            o => {
+                eprintln!("error: --case: unknown case '{o}' (linear or seed)");
+                ExitCode::from(2)
+            }
+        },
     }
 }
 
@@ -288,6 +307,42 @@ fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
                     eprintln!("error: {err}");
                     return ExitCode::from(3);
                 }
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+fn bench_seed(refine: Vec<usize>) -> ExitCode {
+    println!(
+        "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10} {:>9} {:>8} {:>13}",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "factors",
+        "factor ms",
+        "assemb s",
+        "total s",
+        "midspan uy [m]"
+    );
+    for r in refine {
+        match segfem::bench::seed_case(r) {
+            Ok(x) => println!(
+                "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10.2} {:>9.3} {:>8.3} {:>13.5e}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.factorisations,
+                x.factor_mean_s * 1e3,
+                x.assembly_s,
+                x.total_s,
+                x.result
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
             }
         }
     }

@@ -426,7 +426,9 @@ impl InterfaceElement {
                 if !zeta.is_finite() || zeta.abs() > 1e3 {
                     return Err(InterfaceError::NoProjection { point: g, zeta });
                 }
-                if dz.abs() < 1e-14 && dl.abs() <= 1e-14 * scale {
+                // Round-off floor: coordinates of size |x| carry ~1e-16 |x| noise, which on a
+                // short face is ~1e-13 in ζ; 1e-11 is far below any geometric meaning.
+                if dz.abs() < 1e-11 && dl.abs() <= 1e-11 * scale {
                     converged = true;
                     break;
                 }
