@@ -1,11 +1,13 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
 
+use crate::elements::bar::bar_strain_vector;
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
 use crate::materials::point::{PointState, UpdateError};
+use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::Model;
 use rayon::prelude::*;
 
@@ -43,6 +45,30 @@ pub struct System<'m> {
     pub iface_trial: Vec<Vec<InterfacePointState>>,
     /// True if the last assembled tangent was made symmetric (friction slip).
     pub symmetrised: bool,
+    /// Embedded-bar integration points sorted by host element: (bar index, point index in
+    /// the bar). Element e owns `bar_gps[bar_offset[e]..bar_offset[e + 1]]`.
+    pub bar_gps: Vec<(usize, usize)>,
+    /// Offsets of each element's bar points in `bar_gps` and the bar state arrays.
+    pub bar_offset: Vec<usize>,
+    /// Committed steel states of the bar points (order of `bar_gps`).
+    pub bar_committed: Vec<SteelState>,
+    /// Trial steel states (of the last assembly).
+    pub bar_trial: Vec<SteelState>,
+    /// Committed bar outputs (order of `bar_gps`).
+    pub bar_out: Vec<BarOutput>,
+    /// Trial bar outputs.
+    pub bar_out_trial: Vec<BarOutput>,
+}
+
+/// Values at one bar integration point for output.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BarOutput {
+    /// Total bar strain including the prestrain σ_b,0/E_s [-].
+    pub strain: f64,
+    /// Bar stress [Pa].
+    pub stress: f64,
+    /// Plastic strain [-].
+    pub plastic_strain: f64,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -94,8 +120,9 @@ impl<'m> System<'m> {
             }
             gp_offset.push(committed.len());
         }
-        let linear =
-            model.materials.iter().all(|m| m.law.is_linear()) && model.interfaces.is_empty();
+        let linear = model.materials.iter().all(|m| m.law.is_linear())
+            && model.interfaces.is_empty()
+            && model.bars.is_empty();
         let n_gp = committed.len();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
@@ -111,6 +138,22 @@ impl<'m> System<'m> {
             .zip(&model.interfaces)
             .map(|(el, i)| el.initial_states(&i.params))
             .collect();
+        // Bar points grouped by host element (stable: path order within an element).
+        let mut bar_gps: Vec<(usize, usize)> = model
+            .bars
+            .iter()
+            .enumerate()
+            .flat_map(|(b, bar)| (0..bar.points.len()).map(move |p| (b, p)))
+            .collect();
+        bar_gps.sort_by_key(|&(b, p)| model.bars[b].points[p].element);
+        let mut bar_offset = vec![0; model.elements.len() + 1];
+        for &(b, p) in &bar_gps {
+            bar_offset[model.bars[b].points[p].element + 1] += 1;
+        }
+        for e in 0..model.elements.len() {
+            bar_offset[e + 1] += bar_offset[e];
+        }
+        let n_bp = bar_gps.len();
         Self {
             model,
             dofs,
@@ -126,6 +169,12 @@ impl<'m> System<'m> {
             iface_committed,
             interfaces,
             symmetrised: false,
+            bar_gps,
+            bar_offset,
+            bar_committed: vec![SteelState::new(); n_bp],
+            bar_trial: vec![SteelState::new(); n_bp],
+            bar_out: vec![BarOutput::default(); n_bp],
+            bar_out_trial: vec![BarOutput::default(); n_bp],
         }
     }
 
@@ -153,6 +202,12 @@ impl<'m> System<'m> {
             let gout = &mut self.gauss_trial[g0..g1];
             let committed = &self.committed[g0..g1];
             let gp_offset = &self.gp_offset;
+            let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
+            let bar_committed = &self.bar_committed[b0..b1];
+            let bar_gps = &self.bar_gps;
+            let bar_offset = &self.bar_offset;
+            let (mut bt_rest, mut bo_rest) =
+                (&mut self.bar_trial[b0..b1], &mut self.bar_out_trial[b0..b1]);
             // Per-element slices.
             let mut pieces = Vec::with_capacity(end - start);
             let (mut t_rest, mut o_rest) = (trial, gout);
@@ -162,11 +217,16 @@ impl<'m> System<'m> {
                 let (o, or) = o_rest.split_at_mut(ngp);
                 t_rest = tr;
                 o_rest = or;
-                pieces.push((e, t, o));
+                let nb = bar_offset[e + 1] - bar_offset[e];
+                let (bt, btr) = bt_rest.split_at_mut(nb);
+                let (bo, bor) = bo_rest.split_at_mut(nb);
+                bt_rest = btr;
+                bo_rest = bor;
+                pieces.push((e, t, o, (bt, bo)));
             }
             let results: Vec<ElementResult> = pieces
                 .into_par_iter()
-                .map(|(e, t, o)| {
+                .map(|(e, t, o, (bt, bo))| {
                     let el = &model.elements[e];
                     let region = &model.regions[el.region];
                     let mat = &model.materials[region.material].law;
@@ -194,6 +254,39 @@ impl<'m> System<'m> {
                         o,
                     )
                     .map_err(|err| (e, err))?;
+                    // Embedded bars hosted by this element: uniaxial steel at each point,
+                    // ε_b = T(φ) B u_e + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
+                    let bc0 = bar_offset[e] - b0;
+                    for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
+                        .iter()
+                        .zip(bt.iter_mut().zip(bo.iter_mut()))
+                        .enumerate()
+                    {
+                        let bar = &model.bars[b];
+                        let bp = &bar.points[p].point;
+                        let g = bar_strain_vector(el.kind, &coords, bp);
+                        let eps =
+                            g.iter().zip(&ue).map(|(a, b)| a * b).sum::<f64>() + bar.prestrain();
+                        let (s_new, sig, et) =
+                            update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
+                        *st = s_new;
+                        *out = BarOutput {
+                            strain: eps,
+                            stress: sig,
+                            plastic_strain: s_new.plastic_strain,
+                        };
+                        let fs = sig * bar.area * bp.weight_length;
+                        let ks = et * bar.area * bp.weight_length;
+                        for r in 0..nd {
+                            fe[r] += g[r] * fs;
+                            let gr = g[r] * ks;
+                            if gr != 0.0 {
+                                for c in 0..nd {
+                                    ke[r * nd + c] += gr * g[c];
+                                }
+                            }
+                        }
+                    }
                     Ok((fe, ke))
                 })
                 .collect();
@@ -256,6 +349,8 @@ impl<'m> System<'m> {
         self.trial.clone_from(&self.committed);
         std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
         self.iface_committed.clone_from(&self.iface_trial);
+        self.bar_committed.clone_from(&self.bar_trial);
+        self.bar_out.clone_from(&self.bar_out_trial);
     }
 
     /// Gather the free-equation part of a full dof vector.

@@ -23,6 +23,12 @@ pub struct Row {
     pub factors: Vec<f64>,
     /// Monitor values, in model order.
     pub monitors: Vec<f64>,
+    /// Negative pivots of the last tangent (limit point passed when > 0).
+    pub negative_pivots: usize,
+    /// Arc-length load factor λ (NaN outside arc-length steps).
+    pub arc_length_factor: f64,
+    /// Force of the displacement control [N] (NaN outside displacement steps).
+    pub control_force: f64,
 }
 
 /// Records history and writes outputs into a directory.
@@ -58,11 +64,30 @@ impl<'m> Recorder<'m> {
         for m in &self.model.monitors {
             s.push_str(&format!(",{} [{}]", m.name, m.unit()));
         }
+        let (nonlinear, disp, arc) = path_columns(self.model);
+        if nonlinear {
+            s.push_str(",negative_pivots [-]");
+        }
+        if disp {
+            s.push_str(",control_force [N]");
+        }
+        if arc {
+            s.push_str(",arc_length_factor [-]");
+        }
         s.push('\n');
         for r in &self.rows {
             s.push_str(&format!("{},{},{}", r.step + 1, r.increment, r.iterations));
             for v in r.factors.iter().chain(&r.monitors) {
                 s.push_str(&format!(",{v:e}"));
+            }
+            if nonlinear {
+                s.push_str(&format!(",{}", r.negative_pivots));
+            }
+            if disp {
+                s.push_str(&format!(",{:e}", r.control_force));
+            }
+            if arc {
+                s.push_str(&format!(",{:e}", r.arc_length_factor));
             }
             s.push('\n');
         }
@@ -96,6 +121,16 @@ impl<'m> Recorder<'m> {
                     summarise(snap.system, *joint).contact_depth
                 }
                 MonitorKind::JointSlip { joint } => summarise(snap.system, *joint).max_slip,
+                MonitorKind::BarStress { bar, point } => bar_stress(snap, *bar, *point),
+                MonitorKind::MaxCrackStrain { region } => {
+                    point_extreme(snap, *region, |p| p.crack_strain())
+                }
+                MonitorKind::MaxPlasticStrain { region } => {
+                    point_extreme(snap, *region, |p| p.equivalent_plastic_strain())
+                }
+                MonitorKind::CrushedPoints { region } => {
+                    point_extreme_sum(snap, *region, |p| p.is_crushed() as u8 as f64)
+                }
             })
             .collect()
     }
@@ -205,6 +240,9 @@ impl Observer for Recorder<'_> {
             iterations: snap.iterations,
             factors: snap.factors.to_vec(),
             monitors,
+            negative_pivots: snap.negative_pivots,
+            arc_length_factor: snap.arc_length_factor.unwrap_or(f64::NAN),
+            control_force: snap.control_force.unwrap_or(f64::NAN),
         });
         let step = &self.model.steps[snap.step];
         if self.write_fields && (snap.end_of_step || step.output_every_increment) {
@@ -215,4 +253,72 @@ impl Observer for Recorder<'_> {
         }
         Ok(())
     }
+}
+
+/// Stress of a bar [Pa] at one of its points, or the value of largest magnitude.
+fn bar_stress(snap: &Snapshot, bar: usize, point: Option<usize>) -> f64 {
+    let sys = snap.system;
+    let mut best: f64 = 0.0;
+    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
+        if b != bar {
+            continue;
+        }
+        let s = sys.bar_out[i].stress;
+        match point {
+            Some(q) if q == p => return s,
+            Some(_) => {}
+            None => {
+                if s.abs() > best.abs() {
+                    best = s;
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Committed point states of the elements of a region (all if None).
+fn region_points<'a>(
+    snap: &'a Snapshot,
+    region: Option<usize>,
+) -> impl Iterator<Item = &'a crate::materials::point::PointState> + 'a {
+    let sys = snap.system;
+    sys.model
+        .elements
+        .iter()
+        .enumerate()
+        .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
+        .flat_map(move |(i, _)| &sys.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]])
+}
+
+fn point_extreme(
+    snap: &Snapshot,
+    region: Option<usize>,
+    f: impl Fn(&crate::materials::point::PointState) -> f64,
+) -> f64 {
+    region_points(snap, region).map(f).fold(0.0, f64::max)
+}
+
+fn point_extreme_sum(
+    snap: &Snapshot,
+    region: Option<usize>,
+    f: impl Fn(&crate::materials::point::PointState) -> f64,
+) -> f64 {
+    region_points(snap, region).map(f).sum()
+}
+
+/// Which extra history columns a model has: negative pivots (nonlinear models), control
+/// force (displacement steps), arc-length factor (arc-length steps).
+fn path_columns(model: &Model) -> (bool, bool, bool) {
+    use crate::model::StepKind;
+    let has = |k: StepKind| model.steps.iter().any(|s| s.kind == k);
+    let nonlinear = !model.materials.iter().all(|m| m.law.is_linear())
+        || !model.bars.is_empty()
+        || has(StepKind::Displacement)
+        || has(StepKind::ArcLength);
+    (
+        nonlinear,
+        has(StepKind::Displacement),
+        has(StepKind::ArcLength),
+    )
 }
