@@ -49,6 +49,7 @@ impl PathContext<'_, '_> {
             .sys
             .assemble(u, true)
             .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+        self.sys.latch_cracks();
         self.timings.assembly_s += t.elapsed().as_secs_f64();
         Ok((a.f_int, a.k_values.expect("tangent requested")))
     }
@@ -219,6 +220,7 @@ fn displacement_step(
             }
             Err(f) => {
                 ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
                 if cuts >= ctx.sys.model.controls.max_cuts {
                     return Err(not_converged(ctx, step, increment + 1, target, cuts, &f));
                 }
@@ -348,6 +350,7 @@ fn arc_length_step(
             .map(|(h, r)| h + lam * r)
             .collect()
     };
+    let mut failed_dl: Option<f64> = None;
     while increment < a.max_increments {
         match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
             Ok(inc) => {
@@ -431,11 +434,25 @@ fn arc_length_step(
             }
             Err(f) => {
                 ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
                 if cuts >= max_cuts || dl.is_none() {
                     return Err(not_converged(ctx, step, increment + 1, lambda, cuts, &f));
                 }
+                if cuts == 0 {
+                    failed_dl = dl;
+                }
+                // Retry with Δl × ½, 2, ¼, 4, … of the failed length: a material jump (a crack
+                // forming, the stress dropping at fixed strain) leaves a gap in the path that
+                // a shorter arc cannot cross when the last point sits just before it; a
+                // longer one steps over it.
                 cuts += 1;
-                dl = dl.map(|l| 0.5 * l);
+                let k = cuts.div_ceil(2) as i32;
+                let factor = if cuts % 2 == 1 {
+                    0.5_f64.powi(k)
+                } else {
+                    2.0_f64.powi(k)
+                };
+                dl = failed_dl.map(|l| factor * l);
             }
         }
     }
@@ -552,10 +569,21 @@ fn arc_increment(
                     .map(|((wi, ti), di)| (wi + r * ti) * di)
                     .sum::<f64>()
             };
-            if cosang(r1) >= cosang(r2) {
-                r1
+            let (near, far) = if cosang(r1) >= cosang(r2) {
+                (r1, r2)
             } else {
-                r2
+                (r2, r1)
+            };
+            // Stagnation (the residual not falling over two iterations) means Newton cycles
+            // across a kink of the response — typically at a crack that snaps back, where the
+            // root nearest the predictor lies on the wrong side of the peak: take the other
+            // root then.
+            let n = history.len();
+            let stagnating = n >= 3 && history[n - 1] >= 0.9 * history[n - 3];
+            if stagnating {
+                far
+            } else {
+                near
             }
         };
         let corr: Vec<f64> = dur.iter().zip(&dut).map(|(r, t)| r + dlam * t).collect();

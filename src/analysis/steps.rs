@@ -186,6 +186,7 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                 Err(failure) => {
                     // Throw the trial state away and retry with half the increment.
                     u.copy_from_slice(&sys.u);
+                    sys.unlatch();
                     if cuts >= model.controls.max_cuts || step.kind == StepKind::Linear {
                         return Err(AnalysisError::NotConverged {
                             step: step.name.clone(),
@@ -273,6 +274,7 @@ pub(super) fn newton(
         let a = sys
             .assemble(u, need_k)
             .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+        sys.latch_cracks();
         timings.assembly_s += t.elapsed().as_secs_f64();
         let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
         let rf = sys.to_free(&r);

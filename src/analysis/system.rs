@@ -6,7 +6,7 @@ use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{PointState, UpdateError};
+use crate::materials::point::{crack_base, PointState, UpdateError};
 use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::Model;
 use rayon::prelude::*;
@@ -58,6 +58,10 @@ pub struct System<'m> {
     pub bar_out: Vec<BarOutput>,
     /// Trial bar outputs.
     pub bar_out_trial: Vec<BarOutput>,
+    /// Points whose crack formed during the current increment, with the state their
+    /// updates start from until the increment ends (sorted by point index; see
+    /// [`crate::materials::point::crack_base`]).
+    pub latched: Vec<(usize, PointState)>,
 }
 
 /// Values at one bar integration point for output.
@@ -175,7 +179,39 @@ impl<'m> System<'m> {
             bar_trial: vec![SteelState::new(); n_bp],
             bar_out: vec![BarOutput::default(); n_bp],
             bar_out_trial: vec![BarOutput::default(); n_bp],
+            latched: Vec::new(),
         }
+    }
+
+    /// Latch the cracks that formed in the last assembly (kept until `commit` or
+    /// `unlatch`). Returns the number of newly latched points.
+    pub fn latch_cracks(&mut self) -> usize {
+        let model = self.model;
+        let mut new = Vec::new();
+        for (e, el) in model.elements.iter().enumerate() {
+            let mat = &model.materials[model.regions[el.region].material].law;
+            if mat.is_linear() {
+                continue;
+            }
+            for g in self.gp_offset[e]..self.gp_offset[e + 1] {
+                if let Some(b) = crack_base(mat, &self.committed[g], &self.trial[g]) {
+                    if self.latched.binary_search_by_key(&g, |x| x.0).is_err() {
+                        new.push((g, b));
+                    }
+                }
+            }
+        }
+        let n = new.len();
+        if n > 0 {
+            self.latched.extend(new);
+            self.latched.sort_by_key(|x| x.0);
+        }
+        n
+    }
+
+    /// Forget latched cracks (the increment is thrown away).
+    pub fn unlatch(&mut self) {
+        self.latched.clear();
     }
 
     /// Internal forces and (optionally) tangent at displacements `u` from the committed
@@ -205,6 +241,7 @@ impl<'m> System<'m> {
             let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
             let bar_committed = &self.bar_committed[b0..b1];
             let bar_gps = &self.bar_gps;
+            let latched = &self.latched;
             let bar_offset = &self.bar_offset;
             let (mut bt_rest, mut bo_rest) =
                 (&mut self.bar_trial[b0..b1], &mut self.bar_out_trial[b0..b1]);
@@ -240,13 +277,30 @@ impl<'m> System<'m> {
                     let mut fe = vec![0.0; nd];
                     let mut ke = vec![0.0; nd * nd];
                     let c0 = gp_offset[e] - g0;
+                    // Start from the latched crack states where a crack formed in this
+                    // increment, from the committed states elsewhere.
+                    let base = &committed[c0..c0 + t.len()];
+                    let first = latched.partition_point(|x| x.0 < gp_offset[e]);
+                    let owned: Option<Vec<PointState>> = latched
+                        .get(first)
+                        .filter(|x| x.0 < gp_offset[e + 1])
+                        .map(|_| {
+                            let mut v = base.to_vec();
+                            for (g, st) in latched[first..]
+                                .iter()
+                                .take_while(|x| x.0 < gp_offset[e + 1])
+                            {
+                                v[g - gp_offset[e]] = st.clone();
+                            }
+                            v
+                        });
                     continuum::response(
                         el.kind,
                         el.integration,
                         &coords,
                         region.thickness,
                         mat,
-                        &committed[c0..c0 + t.len()],
+                        owned.as_deref().unwrap_or(base),
                         &ue,
                         &mut fe,
                         &mut ke,
@@ -351,6 +405,7 @@ impl<'m> System<'m> {
         self.iface_committed.clone_from(&self.iface_trial);
         self.bar_committed.clone_from(&self.bar_trial);
         self.bar_out.clone_from(&self.bar_out_trial);
+        self.latched.clear();
     }
 
     /// Gather the free-equation part of a full dof vector.

@@ -160,3 +160,33 @@ pub fn update(
         )),
     }
 }
+
+/// The state an update should start from for the rest of an increment once a crack has
+/// formed at this point in one of its iterations ("crack latching"): the committed state
+/// with the trial's first crack (direction fixed, nothing opened yet). Returns None when
+/// nothing is to be latched (elastic point, no new crack, already cracked or crushed).
+///
+/// Crack formation is a jump in stress at fixed strain; without latching, Newton can cycle
+/// between an iterate that cracks (softening tangent, which pulls the strain back) and one
+/// that does not. With the crack kept, the remaining iterations see one smooth law.
+pub fn crack_base(
+    mat: &Material,
+    committed: &PointState,
+    trial: &PointState,
+) -> Option<PointState> {
+    match (mat, committed, trial) {
+        (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t))
+            if c.n_cracks == 0 && t.n_cracks > 0 && !c.crushed && !t.crushed =>
+        {
+            let mut b = (**c).clone();
+            let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
+            b.n_cracks = 1;
+            b.crack_angle = t.crack_angle;
+            b.crack_max = [0.0; 2];
+            b.dir_ebar = [ebar_n; 2];
+            b.dir_plastic = [0.0; 2];
+            Some(PointState::Concrete(Box::new(b)))
+        }
+        _ => None,
+    }
+}
