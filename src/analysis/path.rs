@@ -302,6 +302,13 @@ fn newton_controlled(
             .map_err(NewtonFailure::Singular)?;
         let mut du = rf.clone();
         ctx.solver.solve_in_place(&mut du);
+        // Damping when the residual stagnates over two iterations: Newton cycles between
+        // two sides of a kink of the material response (a crack closing/reopening, a point
+        // switching between elastic and plastic); a shorter step lands between them.
+        let damp = damping(&history);
+        if damp < 1.0 {
+            du.iter_mut().for_each(|v| *v *= damp);
+        }
         if it > 0 {
             let energy = du.iter().zip(&rf).map(|(a, b)| a * b).sum::<f64>().abs();
             first_energy.get_or_insert(energy);
@@ -493,8 +500,10 @@ fn arc_increment(
     let l = *dl.get_or_insert(a.initial_increment * nt);
     // Direction: keep going the way the previous increment went (Feng's criterion
     // Δu_prev · δu_t > 0), which follows snap-backs where the load must decrease.
+    // With a positive-definite tangent the load must grow (sign of det K); past a limit
+    // point (negative pivots) the previous direction decides.
     let sign = match du_prev {
-        Some(p) if dot(p, &dut) < 0.0 => -1.0,
+        Some(p) if ctx.solver.negative_pivots > 0 && dot(p, &dut) < 0.0 => -1.0,
         _ => 1.0,
     };
     let mut d_lambda = sign * l / nt;
@@ -597,4 +606,17 @@ fn arc_increment(
         ctx.add_free(&mut u, &corr, 1.0);
     }
     Err(NewtonFailure::Diverged(history))
+}
+
+/// Correction scale from the residual history: 1, or ½, ¼, … (at least 1/16) while the
+/// relative residual has not fallen by 10 % over the last two iterations.
+pub(super) fn damping(history: &[f64]) -> f64 {
+    let n = history.len();
+    let mut k = 0;
+    let mut i = n;
+    while i >= 3 && history[i - 1] >= 0.9 * history[i - 3] && k < 4 {
+        k += 1;
+        i -= 1;
+    }
+    0.5_f64.powi(k)
 }

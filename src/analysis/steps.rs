@@ -312,6 +312,12 @@ pub(super) fn newton(
         }
         let mut du = rf;
         solver.solve_in_place(&mut du);
+        // Damped correction while the residual stagnates (cycling across a kink of the
+        // material response); see `path::damping`.
+        let damp = super::path::damping(&history);
+        if damp < 1.0 {
+            du.iter_mut().for_each(|v| *v *= damp);
+        }
         let energy = du
             .iter()
             .zip(&sys.to_free(&r))

@@ -5,7 +5,7 @@
 use super::atomic::write_atomic;
 use super::fields::{principal, recover};
 use super::joints::summarise;
-use super::vtu::{render, render_pvd, Array, Grid};
+use super::vtu::{render, render_pvd, render_pvd_parts, Array, Grid};
 use crate::analysis::steps::{Observer, Snapshot};
 use crate::model::{Model, MonitorKind};
 use std::path::PathBuf;
@@ -39,6 +39,7 @@ pub struct Recorder<'m> {
     pub rows: Vec<Row>,
     pvd: Vec<(f64, String)>,
     write_fields: bool,
+    bar_pvd: Vec<(f64, String)>,
 }
 
 impl<'m> Recorder<'m> {
@@ -52,6 +53,7 @@ impl<'m> Recorder<'m> {
             rows: Vec::new(),
             pvd: Vec::new(),
             write_fields,
+            bar_pvd: Vec::new(),
         })
     }
 
@@ -164,6 +166,7 @@ impl<'m> Recorder<'m> {
         let cs = flat(&f.cell_stress);
         let ce = flat(&f.cell_strain);
         let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
+        let st = cell_states(snap);
         let mut reaction = vec![0.0; 3 * model.nodes.len()];
         for s in &model.supports {
             for &(n, d, _) in &s.dofs {
@@ -219,14 +222,46 @@ impl<'m> Recorder<'m> {
                     components: 3,
                     values: &ce,
                 },
+                Array::I32 {
+                    name: "cracks",
+                    values: &st.cracks,
+                },
+                Array::F64 {
+                    name: "crack_angle",
+                    components: 1,
+                    values: &st.angle,
+                },
+                Array::F64 {
+                    name: "crack_strain",
+                    components: 1,
+                    values: &st.crack_strain,
+                },
+                Array::F64 {
+                    name: "plastic_strain",
+                    components: 1,
+                    values: &st.plastic,
+                },
+                Array::I32 {
+                    name: "crushed",
+                    values: &st.crushed,
+                },
             ],
         );
         let name = format!("step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
         write_atomic(&self.dir.join(&name), doc.as_bytes())?;
         self.pvd.push((self.rows.len() as f64, name));
+        if model.bars.is_empty() {
+            return write_atomic(
+                &self.dir.join("results.pvd"),
+                render_pvd(&self.pvd).as_bytes(),
+            );
+        }
+        let bname = format!("bars_step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
+        write_atomic(&self.dir.join(&bname), bars_vtu(snap).as_bytes())?;
+        self.bar_pvd.push((self.rows.len() as f64, bname));
         write_atomic(
             &self.dir.join("results.pvd"),
-            render_pvd(&self.pvd).as_bytes(),
+            render_pvd_parts(&self.pvd, &self.bar_pvd).as_bytes(),
         )
     }
 }
@@ -320,5 +355,124 @@ fn path_columns(model: &Model) -> (bool, bool, bool) {
         nonlinear,
         has(StepKind::Displacement),
         has(StepKind::ArcLength),
+    )
+}
+
+/// Cell values of the concrete states (Gauss points of each element).
+struct CellStates {
+    /// Largest number of cracks at a point [-].
+    cracks: Vec<i32>,
+    /// Crack-normal angle from x [deg] at the point with the largest crack strain.
+    angle: Vec<f64>,
+    /// Largest crack-opening strain [-].
+    crack_strain: Vec<f64>,
+    /// Largest equivalent plastic strain [-].
+    plastic: Vec<f64>,
+    /// Number of crushed points [-].
+    crushed: Vec<i32>,
+}
+
+fn cell_states(snap: &Snapshot) -> CellStates {
+    let sys = snap.system;
+    let n = sys.model.elements.len();
+    let mut c = CellStates {
+        cracks: Vec::with_capacity(n),
+        angle: Vec::with_capacity(n),
+        crack_strain: Vec::with_capacity(n),
+        plastic: Vec::with_capacity(n),
+        crushed: Vec::with_capacity(n),
+    };
+    for e in 0..n {
+        let pts = &sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+        c.cracks
+            .push(pts.iter().map(|p| p.n_cracks()).max().unwrap_or(0) as i32);
+        let widest = pts
+            .iter()
+            .filter(|p| p.n_cracks() > 0)
+            .max_by(|a, b| a.crack_strain().total_cmp(&b.crack_strain()));
+        c.angle
+            .push(widest.map_or(0.0, |p| p.crack_angle().to_degrees()));
+        c.crack_strain
+            .push(pts.iter().map(|p| p.crack_strain()).fold(0.0, f64::max));
+        c.plastic.push(
+            pts.iter()
+                .map(|p| p.equivalent_plastic_strain())
+                .fold(0.0, f64::max),
+        );
+        c.crushed
+            .push(pts.iter().filter(|p| p.is_crushed()).count() as i32);
+    }
+    c
+}
+
+/// The bars as a .vtu of poly-lines: one cell per piece (entry, its Gauss points, exit);
+/// point data = stress, strain and plastic strain (the entry/exit points take the values of
+/// the nearest Gauss point); cell data = bar index.
+fn bars_vtu(snap: &Snapshot) -> String {
+    let sys = snap.system;
+    let model = sys.model;
+    // Output values per (bar, point) from the element-sorted arrays.
+    let mut vals: Vec<Vec<crate::analysis::system::BarOutput>> = model
+        .bars
+        .iter()
+        .map(|b| vec![Default::default(); b.points.len()])
+        .collect();
+    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
+        vals[b][p] = sys.bar_out[i];
+    }
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let mut cells: Vec<Vec<usize>> = Vec::new();
+    let mut bar_id: Vec<i32> = Vec::new();
+    let (mut stress, mut strain, mut plastic) = (Vec::new(), Vec::new(), Vec::new());
+    for (b, bar) in model.bars.iter().enumerate() {
+        for (k, &(p0, p1)) in bar.piece_points.iter().enumerate() {
+            if p1 == p0 {
+                continue;
+            }
+            let mut cell = Vec::with_capacity(p1 - p0 + 2);
+            let mut push = |x: [f64; 2], o: &crate::analysis::system::BarOutput| {
+                cell.push(points.len());
+                points.push(x);
+                stress.push(o.stress);
+                strain.push(o.strain);
+                plastic.push(o.plastic_strain);
+            };
+            push(bar.piece_ends[k][0], &vals[b][p0]);
+            for p in p0..p1 {
+                push(bar.points[p].point.x, &vals[b][p]);
+            }
+            push(bar.piece_ends[k][1], &vals[b][p1 - 1]);
+            cells.push(cell);
+            bar_id.push(b as i32);
+        }
+    }
+    let types = vec![4u8; cells.len()]; // VTK_POLY_LINE
+    render(
+        &Grid {
+            points: &points,
+            cells: &cells,
+            types: &types,
+        },
+        &[
+            Array::F64 {
+                name: "bar_stress",
+                components: 1,
+                values: &stress,
+            },
+            Array::F64 {
+                name: "bar_strain",
+                components: 1,
+                values: &strain,
+            },
+            Array::F64 {
+                name: "bar_plastic_strain",
+                components: 1,
+                values: &plastic,
+            },
+        ],
+        &[Array::I32 {
+            name: "bar",
+            values: &bar_id,
+        }],
     )
 }

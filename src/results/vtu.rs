@@ -146,6 +146,22 @@ pub fn render_pvd(entries: &[(f64, String)]) -> String {
     s
 }
 
+/// Render a .pvd collection with two parts per time: the continuum (part 0) and the bars
+/// (part 1). `bars` may be empty.
+pub fn render_pvd_parts(entries: &[(f64, String)], bars: &[(f64, String)]) -> String {
+    let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
+    for (part, list) in [entries, bars].iter().enumerate() {
+        for (t, f) in list.iter() {
+            let _ = writeln!(
+                s,
+                r#"<DataSet timestep="{t}" group="" part="{part}" file="{f}"/>"#
+            );
+        }
+    }
+    s.push_str("</Collection>\n</VTKFile>\n");
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
