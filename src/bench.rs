@@ -91,8 +91,10 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
             factors: vec![1.0],
             increments: 1,
             output_every_increment: false,
+            path: None,
         }],
         controls: SolverControls::default(),
+        bars: Vec::new(),
     };
     let wall: Vec<(usize, Dir, f64)> = model
         .nodes

@@ -29,6 +29,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         "7.2 m box-section beam (banded), self weight then two point loads",
         include_str!("../examples/box-beam.toml"),
     ),
+    (
+        "rc-beam",
+        "RC beam in four-point bending to failure (concrete, embedded bars, displacement control)",
+        include_str!("../examples/rc-beam.toml"),
+    ),
 ];
 
 #[derive(Parser)]

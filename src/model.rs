@@ -140,6 +140,29 @@ pub enum MonitorKind {
         /// Joint index, or None for the largest over all joints.
         joint: Option<usize>,
     },
+    /// Stress of an embedded bar [Pa]: at the integration point nearest a point, or the
+    /// value of largest magnitude along the bar.
+    BarStress {
+        /// Bar index.
+        bar: usize,
+        /// Index into the bar's points, or None for the extreme value.
+        point: Option<usize>,
+    },
+    /// Largest crack-opening strain over the concrete points of a region (all if None) [-].
+    MaxCrackStrain {
+        /// Region index.
+        region: Option<usize>,
+    },
+    /// Largest equivalent plastic strain over the concrete points of a region [-].
+    MaxPlasticStrain {
+        /// Region index.
+        region: Option<usize>,
+    },
+    /// Number of crushed concrete integration points in a region [-].
+    CrushedPoints {
+        /// Region index.
+        region: Option<usize>,
+    },
 }
 
 /// A named monitor: one column of `history.csv`.
@@ -163,6 +186,10 @@ impl Monitor {
             | MonitorKind::JointSlip { .. } => "m",
             MonitorKind::TendonStress { .. } => "Pa",
             MonitorKind::TendonForce { .. } => "N",
+            MonitorKind::BarStress { .. } => "Pa",
+            MonitorKind::MaxCrackStrain { .. }
+            | MonitorKind::MaxPlasticStrain { .. }
+            | MonitorKind::CrushedPoints { .. } => "-",
         }
     }
 }
@@ -174,6 +201,10 @@ pub enum StepKind {
     Linear,
     /// Incremental load control with Newton–Raphson.
     Load,
+    /// Displacement control of one dof (see [`PathControl::Displacement`]).
+    Displacement,
+    /// Arc-length path following (see [`ArcLengthControl`]).
+    ArcLength,
 }
 
 /// An analysis step: load factors are the totals reached at the end of the step, reached
@@ -190,6 +221,8 @@ pub struct Step {
     pub increments: usize,
     /// Write field output (VTU) at every increment, not only at the end of the step.
     pub output_every_increment: bool,
+    /// Path-following control (displacement and arc-length steps).
+    pub path: Option<PathControl>,
 }
 
 /// Newton and step-cutting controls.
@@ -305,6 +338,8 @@ pub struct Model {
     pub steps: Vec<Step>,
     /// Solver controls.
     pub controls: SolverControls,
+    /// Embedded bars and bonded tendons.
+    pub bars: Vec<Bar>,
 }
 
 impl Model {
@@ -317,4 +352,80 @@ impl Model {
     pub fn n_dofs(&self) -> usize {
         2 * self.nodes.len()
     }
+}
+
+/// One integration point of an embedded bar in its host element (perfect bond).
+#[derive(Debug, Clone, Serialize)]
+pub struct BarGaussPoint {
+    /// Host element index.
+    pub element: usize,
+    /// Position in the host (natural coordinates), direction, weight [m], arc length [m].
+    pub point: crate::elements::bar::BarPoint,
+}
+
+/// An embedded bar or bonded tendon, cut through the mesh at input.
+#[derive(Debug, Clone, Serialize)]
+pub struct Bar {
+    /// User name.
+    pub name: String,
+    /// Cross-section area A_b [m²].
+    pub area: f64,
+    /// Uniaxial steel law (moduli and stresses in Pa).
+    pub steel: crate::materials::steel::SteelParams,
+    /// Initial (prestressing) stress σ_b,0 [Pa], present from the first increment on.
+    pub initial_stress: f64,
+    /// Integration points along the bar, in path order.
+    pub points: Vec<BarGaussPoint>,
+    /// Number of pieces (host elements crossed).
+    pub n_pieces: usize,
+    /// Global end points of each piece (entry, exit) [m], for output.
+    pub piece_ends: Vec<[[f64; 2]; 2]>,
+    /// Range of `points` belonging to each piece.
+    pub piece_points: Vec<(usize, usize)>,
+}
+
+impl Bar {
+    /// Initial strain ε_b,0 = σ_b,0/E_s [-] added to the bond strain (the bar carries σ_b,0
+    /// at zero displacement).
+    pub fn prestrain(&self) -> f64 {
+        self.initial_stress / self.steel.es
+    }
+}
+
+/// How a path-following step is controlled.
+#[derive(Debug, Clone, Serialize)]
+pub enum PathControl {
+    /// Displacement control: one dof (or the same component of all nodes on a line, moved
+    /// together) is driven linearly from its value at the start of the step to `value`; the
+    /// reaction of the control is the load.
+    Displacement {
+        /// Controlled nodes (one for a point; all nodes on a line).
+        nodes: Vec<usize>,
+        /// Component.
+        dir: Dir,
+        /// Total displacement of the dof at the end of the step [m].
+        value: f64,
+    },
+    /// Crisfield's cylindrical arc-length method with the step's load cases as reference
+    /// load f_ref = Σ_c loads_c f_c (added to the loads held from earlier steps).
+    ArcLength(ArcLengthControl),
+}
+
+/// Arc-length controls and stop criteria (first one reached ends the step).
+#[derive(Debug, Clone, Serialize)]
+pub struct ArcLengthControl {
+    /// Load-factor increment of the first increment Δλ₀ [-] (sets the arc length).
+    pub initial_increment: f64,
+    /// Desired Newton iterations per increment (step-size adaptation) [-].
+    pub desired_iterations: usize,
+    /// Maximum arc length as a multiple of the first one [-].
+    pub max_growth: f64,
+    /// Stop when λ reaches this value [-].
+    pub target_factor: Option<f64>,
+    /// Stop when this dof's displacement reaches the value [m] (node, direction, value).
+    pub target_displacement: Option<(usize, Dir, f64)>,
+    /// Maximum number of increments.
+    pub max_increments: usize,
+    /// Reference load factors per load case (the step's `loads`) [-].
+    pub reference: Vec<f64>,
 }

@@ -499,7 +499,7 @@ fn unknown_step_kind() {
     rejects(
         &model,
         "steps[0].kind",
-        &["unknown step kind 'dynamic'", "linear or load"],
+        &["unknown step kind 'dynamic'", "linear", "load"],
     );
 }
 

@@ -79,8 +79,10 @@ fn model_from_mesh(
             factors: vec![1.0],
             increments: 1,
             output_every_increment: false,
+            path: None,
         }],
         controls: SolverControls::default(),
+        bars: Vec::new(),
     }
 }
 

@@ -3,11 +3,13 @@
 //! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -23,6 +25,10 @@ pub enum SolverError {
     /// Out of memory or another failure inside the sparse library.
     #[error("sparse factorisation failed: {0}")]
     Internal(String),
+    /// LDLᵀ met a zero (or non-finite) pivot: the tangent is singular (exactly at a limit
+    /// point, or a mechanism).
+    #[error("stiffness matrix is singular (zero pivot in LDLᵀ)")]
+    Singular,
 }
 
 /// Compressed sparse column pattern of the lower triangle of a symmetric matrix.
@@ -80,6 +86,16 @@ pub struct SolverStats {
     pub factorisations: usize,
     /// Stored values of the factor.
     pub factor_nnz: usize,
+    /// Numeric factorisations that fell back to LDLᵀ (indefinite tangent).
+    pub ldlt_factorisations: usize,
+}
+
+/// Which factor the solver holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Factor {
+    None,
+    Llt,
+    Ldlt,
 }
 
 /// Sparse symmetric positive-definite solver with a reusable symbolic factorisation.
@@ -87,7 +103,9 @@ pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     mem: MemBuffer,
-    factored: bool,
+    factor: Factor,
+    /// Negative pivots of the last successful factorisation (0 after LLᵀ).
+    pub negative_pivots: usize,
     /// Accumulated timings.
     pub stats: SolverStats,
 }
@@ -95,16 +113,29 @@ pub struct SparseCholesky {
 impl SparseCholesky {
     /// Ordering (AMD) and symbolic analysis of `pattern`; done once per pattern.
     pub fn new(pattern: &LowerPattern) -> Result<Self, SolverError> {
+        Self::with_threshold(pattern, SupernodalThreshold::AUTO)
+    }
+
+    /// As [`SparseCholesky::new`], choosing simplicial or supernodal factorisation by
+    /// `threshold` (faer's flop-ratio rule; AUTO in production, forced in tests).
+    pub fn with_threshold(
+        pattern: &LowerPattern,
+        threshold: SupernodalThreshold,
+    ) -> Result<Self, SolverError> {
         let t = std::time::Instant::now();
         let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
             SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: threshold,
+                ..Default::default()
+            },
         )
         .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
         let req = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()))
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let mem = MemBuffer::try_new(req).map_err(|e| SolverError::Internal(format!("{e:?}")))?;
         let l_values = vec![0.0; symbolic.len_val()];
@@ -117,7 +148,8 @@ impl SparseCholesky {
             symbolic,
             l_values,
             mem,
-            factored: false,
+            factor: Factor::None,
+            negative_pivots: 0,
             stats,
         })
     }
@@ -125,7 +157,7 @@ impl SparseCholesky {
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
         let t = std::time::Instant::now();
-        self.factored = false;
+        self.factor = Factor::None;
         let a = SparseColMatRef::new(pattern.symbolic(), values);
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_llt(
@@ -141,7 +173,8 @@ impl SparseCholesky {
         self.stats.factorisations += 1;
         match res {
             Ok(_) => {
-                self.factored = true;
+                self.factor = Factor::Llt;
+                self.negative_pivots = 0;
                 Ok(())
             }
             Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => {
@@ -161,20 +194,103 @@ impl SparseCholesky {
         }
     }
 
-    /// Solve A x = b in place (b is overwritten by x). Requires a successful `factorize`.
+    /// Solve A x = b in place (b is overwritten by x). Requires a successful `factorize`
+    /// or `factorize_indefinite`.
     pub fn solve_in_place(&mut self, b: &mut [f64]) {
-        assert!(self.factored, "solve called without a valid factorisation");
+        assert!(
+            self.factor != Factor::None,
+            "solve called without a valid factorisation"
+        );
         let t = std::time::Instant::now();
         let n = b.len();
-        let llt = LltRef::new(&self.symbolic, &self.l_values);
         let stack = MemStack::new(&mut self.mem);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(b, n, 1),
+        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        if self.factor == Factor::Llt {
+            LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+                Conj::No,
+                rhs,
+                Par::Seq,
+                stack,
+            );
+        } else {
+            LdltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+                Conj::No,
+                rhs,
+                Par::Seq,
+                stack,
+            );
+        }
+        self.stats.solve_s += t.elapsed().as_secs_f64();
+    }
+
+    /// Factorise a symmetric matrix that may be indefinite: LLᵀ first; if it meets a
+    /// non-positive pivot, LDLᵀ (no pivoting, same symbolic analysis and ordering). Returns
+    /// the number of negative pivots of D (the inertia index: 0 for a positive-definite
+    /// matrix; ≥ 1 past a limit point or bifurcation). A zero or non-finite pivot is
+    /// [`SolverError::Singular`].
+    pub fn factorize_indefinite(
+        &mut self,
+        pattern: &LowerPattern,
+        values: &[f64],
+    ) -> Result<usize, SolverError> {
+        match self.factorize(pattern, values) {
+            Ok(()) => return Ok(0),
+            Err(SolverError::NotPositiveDefinite { .. }) => {}
+            Err(e) => return Err(e),
+        }
+        let t = std::time::Instant::now();
+        let a = SparseColMatRef::new(pattern.symbolic(), values);
+        let stack = MemStack::new(&mut self.mem);
+        let res = self.symbolic.factorize_numeric_ldlt(
+            &mut self.l_values,
+            a,
+            Side::Lower,
+            LdltRegularization::default(),
             Par::Seq,
             stack,
+            Default::default(),
         );
-        self.stats.solve_s += t.elapsed().as_secs_f64();
+        self.stats.numeric_s += t.elapsed().as_secs_f64();
+        self.stats.factorisations += 1;
+        self.stats.ldlt_factorisations += 1;
+        if res.is_err() {
+            return Err(SolverError::Singular);
+        }
+        let d = self.ldlt_diagonal();
+        // Pivots below this relative size are treated as zero (singular tangent).
+        let scale = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if d.iter().any(|v| !v.is_finite() || v.abs() <= 1e-14 * scale) {
+            return Err(SolverError::Singular);
+        }
+        self.factor = Factor::Ldlt;
+        self.negative_pivots = d.iter().filter(|v| **v < 0.0).count();
+        Ok(self.negative_pivots)
+    }
+
+    /// Diagonal D of the last LDLᵀ factor (permuted order).
+    fn ldlt_diagonal(&self) -> Vec<f64> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                // Column j of L starts with its diagonal entry, which holds D_j.
+                let cp = s.col_ptr();
+                (0..s.nrows()).map(|j| self.l_values[cp[j]]).collect()
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                // Each supernode is a dense column-major block (rows × cols) whose leading
+                // square part has D on its diagonal.
+                let mut d = Vec::with_capacity(s.nrows());
+                let (begin, end, cpv) =
+                    (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+                for k in 0..s.n_supernodes() {
+                    let ncols = end[k] - begin[k];
+                    let nrows = (cpv[k + 1] - cpv[k]) / ncols.max(1);
+                    for c in 0..ncols {
+                        d.push(self.l_values[cpv[k] + c * nrows + c]);
+                    }
+                }
+                d
+            }
+        }
     }
 }
 
@@ -213,6 +329,117 @@ mod tests {
         // Condition number ~ n², so round-off residual ~1e-12 is generous.
         for i in 0..n {
             assert!((ax[i] - b[i]).abs() < 1e-10);
+        }
+    }
+
+    /// An indefinite matrix falls back to LDLᵀ, solves, and reports its negative pivots.
+    #[test]
+    fn ldlt_fallback_counts_negative_pivots() {
+        // Tridiagonal (d_j, −1) with two negative diagonal entries far apart: exactly two
+        // negative eigenvalues (the off-diagonals are small against |d|).
+        let n = 40;
+        let mut col_ptr = vec![0];
+        let mut row_idx = vec![];
+        let mut vals = vec![];
+        for j in 0..n {
+            row_idx.push(j);
+            vals.push(if j == 7 || j == 30 { -10.0 } else { 10.0 });
+            if j + 1 < n {
+                row_idx.push(j + 1);
+                vals.push(-1.0);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let p = LowerPattern {
+            n,
+            col_ptr,
+            row_idx,
+        };
+        let mut s = SparseCholesky::new(&p).unwrap();
+        assert_eq!(s.factorize_indefinite(&p, &vals).unwrap(), 2);
+        let b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x);
+        let mut ax = vec![0.0; n];
+        p.sym_mul(&vals, &x, &mut ax);
+        for i in 0..n {
+            assert!((ax[i] - b[i]).abs() < 1e-12);
+        }
+        // A positive-definite matrix goes through LLᵀ with zero negative pivots.
+        let pos: Vec<f64> = vals.iter().map(|v| v.abs()).collect();
+        assert_eq!(s.factorize_indefinite(&p, &pos).unwrap(), 0);
+        assert_eq!(s.stats.ldlt_factorisations, 1);
+    }
+
+    /// Supernodal LDLᵀ: the 9-point matrix 9I − T⊗T of an m×m grid (T = tridiag(1, 1, 1),
+    /// the stencil of a Q4 mesh) shifted by σ has exactly as many negative pivots as
+    /// eigenvalues 9 − (1 + 2cos jh)(1 + 2cos kh), h = π/(m+1), below σ (Sylvester).
+    #[test]
+    fn ldlt_inertia_of_shifted_laplacian() {
+        let m = 40;
+        let n = m * m;
+        let sigma = 0.37;
+        let mut col_ptr = vec![0];
+        let mut row_idx = vec![];
+        let mut vals = vec![];
+        for j in 0..n {
+            let (x, y) = (j % m, j / m);
+            row_idx.push(j);
+            vals.push(8.0 - sigma);
+            if x + 1 < m {
+                row_idx.push(j + 1);
+                vals.push(-1.0);
+            }
+            if y + 1 < m {
+                if x > 0 {
+                    row_idx.push(j + m - 1);
+                    vals.push(-1.0);
+                }
+                row_idx.push(j + m);
+                vals.push(-1.0);
+                if x + 1 < m {
+                    row_idx.push(j + m + 1);
+                    vals.push(-1.0);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let p = LowerPattern {
+            n,
+            col_ptr,
+            row_idx,
+        };
+        let h = std::f64::consts::PI / (m + 1) as f64;
+        let mut expected = 0;
+        for j in 1..=m {
+            for k in 1..=m {
+                let t = (1.0 + 2.0 * (j as f64 * h).cos()) * (1.0 + 2.0 * (k as f64 * h).cos());
+                if 9.0 - t < sigma {
+                    expected += 1;
+                }
+            }
+        }
+        assert!(expected > 5);
+        for th in [
+            SupernodalThreshold::FORCE_SUPERNODAL,
+            SupernodalThreshold::FORCE_SIMPLICIAL,
+        ] {
+            let mut s = SparseCholesky::with_threshold(&p, th).unwrap();
+            let supernodal = matches!(s.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
+            assert_eq!(supernodal, th.0 == 0.0);
+            assert_eq!(s.factorize_indefinite(&p, &vals).unwrap(), expected);
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+            let mut x = b.clone();
+            s.solve_in_place(&mut x);
+            let mut ax = vec![0.0; n];
+            p.sym_mul(&vals, &x, &mut ax);
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, c)| (a - c).abs())
+                .fold(0.0, f64::max);
+            // Indefinite, condition ~1e3–1e4 near σ: 1e-9 leaves room for round-off growth.
+            assert!(err < 1e-9, "residual {err}");
         }
     }
 

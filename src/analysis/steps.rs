@@ -26,6 +26,13 @@ pub struct Snapshot<'a, 's> {
     pub f_ext: &'a [f64],
     /// Newton iterations used.
     pub iterations: usize,
+    /// Negative pivots of the last tangent factorised (0 if positive definite; > 0 past a
+    /// limit point or bifurcation).
+    pub negative_pivots: usize,
+    /// Arc-length load factor λ of the step's reference load (arc-length steps).
+    pub arc_length_factor: Option<f64>,
+    /// Force [N] the displacement control applies at its dof (displacement steps).
+    pub control_force: Option<f64>,
 }
 
 /// Receives converged increments (history, field output, progress).
@@ -74,6 +81,9 @@ pub struct Timings {
     pub increments: usize,
     /// Newton iterations in all.
     pub iterations: usize,
+    /// Limit points or bifurcations passed (the number of negative pivots changed), one
+    /// message each.
+    pub limit_points: Vec<String>,
 }
 
 /// Run all steps of the model, reporting to `obs`. Returns the timings.
@@ -97,8 +107,22 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
         u[d] = v;
     }
     let mut factored_linear = false;
+    let mut neg_pivots = 0;
     for (si, step) in model.steps.iter().enumerate() {
         sys.stress_tendons(si);
+        if matches!(step.kind, StepKind::Displacement | StepKind::ArcLength) {
+            let mut ctx = super::path::PathContext {
+                sys: &mut sys,
+                solver: &mut solver,
+                cases: &cases,
+                factors: &mut factors,
+                u: &mut u,
+                timings: &mut timings,
+                neg_pivots: &mut neg_pivots,
+            };
+            super::path::run_step(&mut ctx, si, step, obs)?;
+            continue;
+        }
         let start = factors.clone();
         let n_inc = step.increments.max(1);
         let mut level = 0.0; // fraction of the step reached
@@ -134,6 +158,13 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     factors = lam;
                     timings.increments += 1;
                     timings.iterations += iterations;
+                    note_limit_point(
+                        &mut timings,
+                        &mut neg_pivots,
+                        solver.negative_pivots,
+                        &step.name,
+                        increment,
+                    );
                     let t = Instant::now();
                     obs.increment(&Snapshot {
                         system: &sys,
@@ -144,6 +175,9 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                         f_int: &f_int,
                         f_ext: &f_ext,
                         iterations,
+                        negative_pivots: solver.negative_pivots,
+                        arc_length_factor: None,
+                        control_force: None,
                     })?;
                     timings.output_s += t.elapsed().as_secs_f64();
                 }
@@ -156,6 +190,7 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     for &(d, v) in &sys.dofs.prescribed {
                         u[d] = v;
                     }
+                    sys.unlatch();
                     if cuts >= model.controls.max_cuts || step.kind == StepKind::Linear {
                         return Err(AnalysisError::NotConverged {
                             step: step.name.clone(),
@@ -175,14 +210,35 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
     Ok(timings)
 }
 
-enum NewtonFailure {
+/// Record a change of the number of negative pivots between converged increments.
+pub(super) fn note_limit_point(
+    timings: &mut Timings,
+    last: &mut usize,
+    now: usize,
+    step: &str,
+    increment: usize,
+) {
+    if now != *last {
+        timings.limit_points.push(format!(
+            "step '{step}' increment {increment}: negative pivots {last} -> {now} ({})",
+            if now > *last {
+                "limit point or bifurcation passed"
+            } else {
+                "stiffness regained"
+            }
+        ));
+        *last = now;
+    }
+}
+
+pub(super) enum NewtonFailure {
     Singular(SolverError),
     Material(usize, String),
     Diverged(Vec<f64>),
 }
 
 impl NewtonFailure {
-    fn describe(&self, sys: &System) -> String {
+    pub(super) fn describe(&self, sys: &System) -> String {
         match self {
             NewtonFailure::Singular(e) => mechanism(sys, e.clone()).to_string(),
             NewtonFailure::Material(e, m) => format!("element {} material: {m}", e + 1),
@@ -198,7 +254,7 @@ impl NewtonFailure {
 }
 
 /// Newton–Raphson for one increment: returns the converged internal forces and iterations.
-fn newton(
+pub(super) fn newton(
     sys: &mut System,
     solver: &mut SparseCholesky,
     u: &mut [f64],
@@ -222,6 +278,7 @@ fn newton(
         let a = sys
             .assemble(u, need_k)
             .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+        sys.latch_cracks();
         timings.assembly_s += t.elapsed().as_secs_f64();
         let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
         let rf = sys.to_free(&r);
@@ -245,13 +302,26 @@ fn newton(
             break;
         }
         if let Some(k) = a.k_values {
-            solver
-                .factorize(&sys.asm.pattern, &k)
-                .map_err(NewtonFailure::Singular)?;
+            if sys.linear {
+                solver
+                    .factorize(&sys.asm.pattern, &k)
+                    .map_err(NewtonFailure::Singular)?;
+            } else {
+                // Nonlinear tangents may be indefinite (softening): LDLᵀ fallback.
+                solver
+                    .factorize_indefinite(&sys.asm.pattern, &k)
+                    .map_err(NewtonFailure::Singular)?;
+            }
             *factored_linear = sys.linear;
         }
         let mut du = rf;
         solver.solve_in_place(&mut du);
+        // Damped correction while the residual stagnates (cycling across a kink of the
+        // material response); see `path::damping`.
+        let damp = super::path::damping(&history);
+        if damp < 1.0 {
+            du.iter_mut().for_each(|v| *v *= damp);
+        }
         let energy = du
             .iter()
             .zip(&sys.to_free(&r))
@@ -269,12 +339,12 @@ fn newton(
     Err(NewtonFailure::Diverged(history))
 }
 
-fn norm(v: &[f64]) -> f64 {
+pub(super) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Turn a solver failure into a message naming the node and dof.
-fn mechanism(sys: &System, e: SolverError) -> AnalysisError {
+pub(super) fn mechanism(sys: &System, e: SolverError) -> AnalysisError {
     match e {
         SolverError::NotPositiveDefinite { equation } => {
             let dof = sys.dofs.eq.iter().position(|&q| q == equation).unwrap_or(0);
@@ -295,5 +365,9 @@ fn mechanism(sys: &System, e: SolverError) -> AnalysisError {
             ))
         }
         SolverError::Internal(m) => AnalysisError::Mechanism(m),
+        SolverError::Singular => AnalysisError::Mechanism(
+            "the tangent stiffness is singular (zero pivot): a mechanism, or exactly at a limit point"
+                .into(),
+        ),
     }
 }

@@ -1,12 +1,14 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
 
+use crate::elements::bar::bar_strain_vector;
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{PointState, UpdateError};
+use crate::materials::point::{crack_base, PointState, UpdateError};
+use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::Model;
 use rayon::prelude::*;
 
@@ -52,6 +54,34 @@ pub struct System<'m> {
     pub tendon_committed: Vec<Option<TendonState>>,
     /// Trial tendon states.
     pub tendon_trial: Vec<Option<TendonState>>,
+    /// Embedded-bar integration points sorted by host element: (bar index, point index in
+    /// the bar). Element e owns `bar_gps[bar_offset[e]..bar_offset[e + 1]]`.
+    pub bar_gps: Vec<(usize, usize)>,
+    /// Offsets of each element's bar points in `bar_gps` and the bar state arrays.
+    pub bar_offset: Vec<usize>,
+    /// Committed steel states of the bar points (order of `bar_gps`).
+    pub bar_committed: Vec<SteelState>,
+    /// Trial steel states (of the last assembly).
+    pub bar_trial: Vec<SteelState>,
+    /// Committed bar outputs (order of `bar_gps`).
+    pub bar_out: Vec<BarOutput>,
+    /// Trial bar outputs.
+    pub bar_out_trial: Vec<BarOutput>,
+    /// Points whose crack formed during the current increment, with the state their
+    /// updates start from until the increment ends (sorted by point index; see
+    /// [`crate::materials::point::crack_base`]).
+    pub latched: Vec<(usize, PointState)>,
+}
+
+/// Values at one bar integration point for output.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BarOutput {
+    /// Total bar strain including the prestrain σ_b,0/E_s [-].
+    pub strain: f64,
+    /// Bar stress [Pa].
+    pub stress: f64,
+    /// Plastic strain [-].
+    pub plastic_strain: f64,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -104,8 +134,9 @@ impl<'m> System<'m> {
             }
             gp_offset.push(committed.len());
         }
-        let linear =
-            model.materials.iter().all(|m| m.law.is_linear()) && model.interfaces.is_empty();
+        let linear = model.materials.iter().all(|m| m.law.is_linear())
+            && model.interfaces.is_empty()
+            && model.bars.is_empty();
         let n_gp = committed.len();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
@@ -121,6 +152,22 @@ impl<'m> System<'m> {
             .zip(&model.interfaces)
             .map(|(el, i)| el.initial_states(&i.params))
             .collect();
+        // Bar points grouped by host element (stable: path order within an element).
+        let mut bar_gps: Vec<(usize, usize)> = model
+            .bars
+            .iter()
+            .enumerate()
+            .flat_map(|(b, bar)| (0..bar.points.len()).map(move |p| (b, p)))
+            .collect();
+        bar_gps.sort_by_key(|&(b, p)| model.bars[b].points[p].element);
+        let mut bar_offset = vec![0; model.elements.len() + 1];
+        for &(b, p) in &bar_gps {
+            bar_offset[model.bars[b].points[p].element + 1] += 1;
+        }
+        for e in 0..model.elements.len() {
+            bar_offset[e + 1] += bar_offset[e];
+        }
+        let n_bp = bar_gps.len();
         Self {
             model,
             dofs,
@@ -140,7 +187,45 @@ impl<'m> System<'m> {
             tendon_u0: vec![Vec::new(); model.tendons.len()],
             tendon_committed: vec![None; model.tendons.len()],
             tendon_trial: vec![None; model.tendons.len()],
+            bar_gps,
+            bar_offset,
+            bar_committed: vec![SteelState::new(); n_bp],
+            bar_trial: vec![SteelState::new(); n_bp],
+            bar_out: vec![BarOutput::default(); n_bp],
+            bar_out_trial: vec![BarOutput::default(); n_bp],
+            latched: Vec::new(),
         }
+    }
+
+    /// Latch the cracks that formed in the last assembly (kept until `commit` or
+    /// `unlatch`). Returns the number of newly latched points.
+    pub fn latch_cracks(&mut self) -> usize {
+        let model = self.model;
+        let mut new = Vec::new();
+        for (e, el) in model.elements.iter().enumerate() {
+            let mat = &model.materials[model.regions[el.region].material].law;
+            if mat.is_linear() {
+                continue;
+            }
+            for g in self.gp_offset[e]..self.gp_offset[e + 1] {
+                if let Some(b) = crack_base(mat, &self.committed[g], &self.trial[g]) {
+                    if self.latched.binary_search_by_key(&g, |x| x.0).is_err() {
+                        new.push((g, b));
+                    }
+                }
+            }
+        }
+        let n = new.len();
+        if n > 0 {
+            self.latched.extend(new);
+            self.latched.sort_by_key(|x| x.0);
+        }
+        n
+    }
+
+    /// Forget latched cracks (the increment is thrown away).
+    pub fn unlatch(&mut self) {
+        self.latched.clear();
     }
 
     /// Internal forces and (optionally) tangent at displacements `u` from the committed
@@ -167,6 +252,13 @@ impl<'m> System<'m> {
             let gout = &mut self.gauss_trial[g0..g1];
             let committed = &self.committed[g0..g1];
             let gp_offset = &self.gp_offset;
+            let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
+            let bar_committed = &self.bar_committed[b0..b1];
+            let bar_gps = &self.bar_gps;
+            let latched = &self.latched;
+            let bar_offset = &self.bar_offset;
+            let (mut bt_rest, mut bo_rest) =
+                (&mut self.bar_trial[b0..b1], &mut self.bar_out_trial[b0..b1]);
             // Per-element slices.
             let mut pieces = Vec::with_capacity(end - start);
             let (mut t_rest, mut o_rest) = (trial, gout);
@@ -176,11 +268,16 @@ impl<'m> System<'m> {
                 let (o, or) = o_rest.split_at_mut(ngp);
                 t_rest = tr;
                 o_rest = or;
-                pieces.push((e, t, o));
+                let nb = bar_offset[e + 1] - bar_offset[e];
+                let (bt, btr) = bt_rest.split_at_mut(nb);
+                let (bo, bor) = bo_rest.split_at_mut(nb);
+                bt_rest = btr;
+                bo_rest = bor;
+                pieces.push((e, t, o, (bt, bo)));
             }
             let results: Vec<ElementResult> = pieces
                 .into_par_iter()
-                .map(|(e, t, o)| {
+                .map(|(e, t, o, (bt, bo))| {
                     let el = &model.elements[e];
                     let region = &model.regions[el.region];
                     let mat = &model.materials[region.material].law;
@@ -194,13 +291,30 @@ impl<'m> System<'m> {
                     let mut fe = vec![0.0; nd];
                     let mut ke = vec![0.0; nd * nd];
                     let c0 = gp_offset[e] - g0;
+                    // Start from the latched crack states where a crack formed in this
+                    // increment, from the committed states elsewhere.
+                    let base = &committed[c0..c0 + t.len()];
+                    let first = latched.partition_point(|x| x.0 < gp_offset[e]);
+                    let owned: Option<Vec<PointState>> = latched
+                        .get(first)
+                        .filter(|x| x.0 < gp_offset[e + 1])
+                        .map(|_| {
+                            let mut v = base.to_vec();
+                            for (g, st) in latched[first..]
+                                .iter()
+                                .take_while(|x| x.0 < gp_offset[e + 1])
+                            {
+                                v[g - gp_offset[e]] = st.clone();
+                            }
+                            v
+                        });
                     continuum::response(
                         el.kind,
                         el.integration,
                         &coords,
                         region.thickness,
                         mat,
-                        &committed[c0..c0 + t.len()],
+                        owned.as_deref().unwrap_or(base),
                         &ue,
                         &mut fe,
                         &mut ke,
@@ -208,6 +322,39 @@ impl<'m> System<'m> {
                         o,
                     )
                     .map_err(|err| (e, err))?;
+                    // Embedded bars hosted by this element: uniaxial steel at each point,
+                    // ε_b = T(φ) B u_e + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
+                    let bc0 = bar_offset[e] - b0;
+                    for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
+                        .iter()
+                        .zip(bt.iter_mut().zip(bo.iter_mut()))
+                        .enumerate()
+                    {
+                        let bar = &model.bars[b];
+                        let bp = &bar.points[p].point;
+                        let g = bar_strain_vector(el.kind, &coords, bp);
+                        let eps =
+                            g.iter().zip(&ue).map(|(a, b)| a * b).sum::<f64>() + bar.prestrain();
+                        let (s_new, sig, et) =
+                            update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
+                        *st = s_new;
+                        *out = BarOutput {
+                            strain: eps,
+                            stress: sig,
+                            plastic_strain: s_new.plastic_strain,
+                        };
+                        let fs = sig * bar.area * bp.weight_length;
+                        let ks = et * bar.area * bp.weight_length;
+                        for r in 0..nd {
+                            fe[r] += g[r] * fs;
+                            let gr = g[r] * ks;
+                            if gr != 0.0 {
+                                for c in 0..nd {
+                                    ke[r * nd + c] += gr * g[c];
+                                }
+                            }
+                        }
+                    }
                     Ok((fe, ke))
                 })
                 .collect();
@@ -334,6 +481,9 @@ impl<'m> System<'m> {
         std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
         self.iface_committed.clone_from(&self.iface_trial);
         self.tendon_committed.clone_from(&self.tendon_trial);
+        self.bar_committed.clone_from(&self.bar_trial);
+        self.bar_out.clone_from(&self.bar_out_trial);
+        self.latched.clear();
     }
 
     /// Gather the free-equation part of a full dof vector.

@@ -5,13 +5,18 @@ use super::error::{Ctx, InputError};
 use super::gmsh_mesh;
 use super::locate;
 use super::schema::*;
+use crate::elements::bar::{BarEmbedder, BarPath, EmbedOptions, HostElement};
 use crate::elements::continuum::{min_jacobian, Integration};
 use crate::elements::interface::{
     suggest_normal_stiffness, InterfaceElement, InterfaceParams, JointNeighbour,
 };
 use crate::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
+use crate::fem::shape::map_point;
 use crate::fem::shape::QuadKind;
+use crate::materials::concrete::{ConcreteParams, ShearRetention, TensionSoftening};
+use crate::materials::mc90::{self, TensileRef};
 use crate::materials::point::Material;
+use crate::materials::steel::SteelParams;
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
 use crate::model::*;
@@ -110,10 +115,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         file.materials.iter().map(|m| m.name.as_str()),
     )?;
     let mut materials = Vec::new();
+    let mut steels: Vec<(String, SteelParams)> = Vec::new();
     for (i, m) in file.materials.iter().enumerate() {
         let k = |f: &str| format!("materials[{i}].{f}");
         let law = match m.kind.as_str() {
             "elastic" => {
+                check_material_keys(ctx, i, m, &["E", "nu", "density"])?;
                 let e = positive(ctx, &k("E"), m.e.ok_or_else(|| ctx.err(k("E"), "missing"))?)?;
                 let nu = m.nu.ok_or_else(|| ctx.err(k("nu"), "missing"))?;
                 if !(nu > -1.0 && nu < 0.5) {
@@ -145,10 +152,15 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 }
                 Material::Elastic { e, nu, density }
             }
+            "concrete" => concrete_law(ctx, i, m, &mut warnings)?,
+            "rebar" | "prestressing_steel" => {
+                steels.push((m.name.clone(), steel_law(ctx, i, m)?));
+                continue;
+            }
             other => {
                 return Err(ctx.err(
                     k("kind"),
-                    format!("unknown material kind '{other}' (expected elastic)"),
+                    format!("unknown material kind '{other}' (expected elastic, concrete, rebar or prestressing_steel)"),
                 ))
             }
         };
@@ -161,6 +173,15 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     unique_names(ctx, "regions", file.regions.iter().map(|r| r.name.as_str()))?;
     let mut regions = Vec::new();
     for (i, r) in file.regions.iter().enumerate() {
+        if steels.iter().any(|(n, _)| *n == r.material) {
+            return Err(ctx.err(
+                format!("regions[{i}].material"),
+                format!(
+                    "'{}' is a steel material (for [[bars]]); a region needs an elastic or concrete material",
+                    r.material
+                ),
+            ));
+        }
         let material = index_by_name(
             ctx,
             &format!("regions[{i}].material"),
@@ -223,6 +244,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         monitors: Vec::new(),
         steps: Vec::new(),
         controls: SolverControls::default(),
+        bars: Vec::new(),
     };
     if !joints.is_empty() {
         add_joints(ctx, mesh, &mut model, &joints, &joint_materials)?;
@@ -379,6 +401,8 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         }
         model.load_cases.push(case);
     }
+    // Embedded bars (needed by bar monitors).
+    build_bars(ctx, &file.bars, &steels, &mut model)?;
     // Monitors.
     unique_names(
         ctx,
@@ -472,10 +496,13 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     (_, j) => MonitorKind::JointContactDepth { joint: j.expect("checked above") },
                 }
             }
+            "bar_stress" | "max_crack_strain" | "max_plastic_strain" | "crushed_points" => {
+                material_monitor(ctx, &key, m, &model)?
+            }
             o => {
                 return Err(ctx.err(
                     format!("{key}.kind"),
-                    format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip, joint_contact_depth, tendon_stress or tendon_force)"),
+                    format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip, joint_contact_depth, tendon_stress, tendon_force, bar_stress, max_crack_strain, max_plastic_strain or crushed_points)"),
                 ))
             }
         };
@@ -504,13 +531,25 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 StepKind::Linear
             }
             "load" => StepKind::Load,
+            "displacement" => StepKind::Displacement,
+            "arc_length" => StepKind::ArcLength,
             o => {
                 return Err(ctx.err(
                     format!("{key}.kind"),
-                    format!("unknown step kind '{o}' (expected linear or load)"),
+                    format!(
+                    "unknown step kind '{o}' (expected linear, load, displacement or arc_length)"
+                ),
                 ))
             }
         };
+        let path = path_control(ctx, &key, s, kind, &model, &used)?;
+        if kind == StepKind::Displacement && !s.loads.is_empty() {
+            return Err(ctx.err(
+                format!("{key}.loads"),
+                "a displacement step holds the loads of the previous steps; give no loads",
+            ));
+        }
+        let held = factors.clone();
         for (name, f) in &s.loads {
             let c = index_by_name(
                 ctx,
@@ -541,12 +580,33 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 ))
             }
         };
+        let path = match path {
+            Some(PathControl::ArcLength(mut a)) => {
+                // `loads` of an arc-length step is the reference pattern, not a total.
+                a.reference = factors.iter().zip(&held).map(|(f, h)| f - h).collect();
+                for (name, f) in &s.loads {
+                    if let Some(c) = model.load_cases.iter().position(|c| &c.name == name) {
+                        a.reference[c] = *f;
+                    }
+                }
+                factors.clone_from(&held);
+                if a.reference.iter().all(|r| *r == 0.0) {
+                    return Err(ctx.err(
+                        format!("{key}.loads"),
+                        "an arc-length step needs a reference load: give loads = { case = factor }",
+                    ));
+                }
+                Some(PathControl::ArcLength(a))
+            }
+            p => p,
+        };
         model.steps.push(Step {
             name: s.name.clone(),
             kind,
             factors: factors.clone(),
             increments,
             output_every_increment,
+            path,
         });
     }
     for (i, t) in file.tendons.iter().enumerate() {
@@ -1153,6 +1213,66 @@ fn add_joints(
     Ok(())
 }
 
+// ------------------------------------------------------------------------------------------
+// Concrete, steel and embedded bars; path-following steps; material monitors.
+// ------------------------------------------------------------------------------------------
+
+/// Names of the keys set in a material table (schema spelling).
+fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
+    let f = |b: bool, k: &'static str| b.then_some(k);
+    [
+        f(m.e.is_some(), "E"),
+        f(m.nu.is_some(), "nu"),
+        f(m.density.is_some(), "density"),
+        f(m.fcm.is_some(), "fcm"),
+        f(m.ftm.is_some(), "ftm"),
+        f(m.c.is_some(), "C"),
+        f(m.tensile_reference.is_some(), "tensile_reference"),
+        f(m.tension_softening.is_some(), "tension_softening"),
+        f(m.alpha.is_some(), "alpha"),
+        f(m.gf.is_some(), "Gf"),
+        f(m.eps_c1.is_some(), "eps_c1"),
+        f(m.eps_cu.is_some(), "eps_cu"),
+        f(m.initial_yield_ratio.is_some(), "initial_yield_ratio"),
+        f(m.softening_limit.is_some(), "softening_limit"),
+        f(m.crack_ratio.is_some(), "crack_ratio"),
+        f(m.shear_k1.is_some(), "shear_k1"),
+        f(m.shear_eps_ref.is_some(), "shear_eps_ref"),
+        f(m.shear_beta_min.is_some(), "shear_beta_min"),
+        f(m.residual_stiffness.is_some(), "residual_stiffness"),
+        f(m.secant_crack_tangent.is_some(), "secant_crack_tangent"),
+        f(
+            m.normalize_equivalent_stress.is_some(),
+            "normalize_equivalent_stress",
+        ),
+        f(m.fy.is_some(), "fy"),
+        f(m.et.is_some(), "Et"),
+        f(m.ep.is_some(), "Ep"),
+        f(m.fptk.is_some(), "fptk"),
+        f(m.eps_uk.is_some(), "eps_uk"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// A key that does not belong to the material's kind is an error, not silently ignored.
+fn check_material_keys(ctx: &Ctx, i: usize, m: &MaterialIn, allowed: &[&str]) -> R<()> {
+    for k in given_material_keys(m) {
+        if !allowed.contains(&k) {
+            return Err(ctx.err(
+                format!("materials[{i}].{k}"),
+                format!(
+                    "not a key of kind '{}' (its keys: {})",
+                    m.kind,
+                    allowed.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn origin_of(mesh: &MeshIn, ctx: &Ctx) -> R<[f64; 2]> {
     let o = mesh.origin.unwrap_or([0.0, 0.0]);
     if o.iter().any(|v| !v.is_finite()) {
@@ -1318,4 +1438,520 @@ fn build_tendon(
         mode,
         stressed_in_step: 0,
     })
+}
+
+fn fraction(ctx: &Ctx, key: &str, v: f64, lo: f64, hi: f64) -> R<f64> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(ctx.err(key, format!("must lie in [{lo}, {hi}] (got {v})")))
+    }
+}
+
+/// `kind = "concrete"`: MC90 defaults from f_cm, each overridable.
+fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>) -> R<Material> {
+    let k = |f: &str| format!("materials[{i}].{f}");
+    check_material_keys(
+        ctx,
+        i,
+        m,
+        &[
+            "fcm",
+            "E",
+            "nu",
+            "density",
+            "ftm",
+            "C",
+            "tensile_reference",
+            "tension_softening",
+            "alpha",
+            "Gf",
+            "eps_c1",
+            "eps_cu",
+            "initial_yield_ratio",
+            "softening_limit",
+            "crack_ratio",
+            "shear_k1",
+            "shear_eps_ref",
+            "shear_beta_min",
+            "residual_stiffness",
+            "secant_crack_tangent",
+            "normalize_equivalent_stress",
+        ],
+    )?;
+    let fcm = positive(
+        ctx,
+        &k("fcm"),
+        m.fcm
+            .ok_or_else(|| ctx.err(k("fcm"), "missing (mean compressive strength [Pa])"))?,
+    )?;
+    if fcm < 1e6 {
+        warnings.push(format!(
+            "{}: {}: fcm = {fcm} Pa looks like MPa; segfem works in Pa",
+            ctx.file,
+            k("fcm")
+        ));
+    }
+    let nu = fraction(ctx, &k("nu"), m.nu.unwrap_or(0.2), 0.0, 0.499)?;
+    let density = m.density.unwrap_or(0.0);
+    if !(density.is_finite() && density >= 0.0) {
+        return Err(ctx.err(k("density"), "must be zero or positive"));
+    }
+    let tref = match m.tensile_reference.as_deref() {
+        None | Some("fcm") => TensileRef::Fcm,
+        Some("fck") => TensileRef::Fck,
+        Some(o) => {
+            return Err(ctx.err(
+                k("tensile_reference"),
+                format!("unknown value '{o}' (expected fcm or fck)"),
+            ))
+        }
+    };
+    if m.ftm.is_some() && m.c.is_some() {
+        return Err(ctx.err(k("C"), "give ftm or C, not both"));
+    }
+    let c = m.c.unwrap_or(mc90::C_MEAN);
+    if !(c > 0.0 && c < 1.0) {
+        return Err(ctx.err(
+            k("C"),
+            format!("must lie in (0, 1) (MC90: 0.095–0.185; got {c})"),
+        ));
+    }
+    let mut p = ConcreteParams::from_mc90_with(fcm, nu, c, tref);
+    if let Some(ftm) = m.ftm {
+        p.ftm = positive(ctx, &k("ftm"), ftm)?;
+        if ftm >= 0.5 * fcm {
+            return Err(ctx.err(k("ftm"), "must be well below fcm (ftm/fcm < 0.5)"));
+        }
+        p.ottosen = mc90::ottosen_params(p.ftm, fcm);
+    }
+    if let Some(e) = m.e {
+        p.ec = positive(ctx, &k("E"), e)?;
+    }
+    if let Some(v) = m.eps_c1 {
+        p.eps_c1 = positive(ctx, &k("eps_c1"), v)?;
+    }
+    if let Some(v) = m.eps_cu {
+        p.eps_cu = positive(ctx, &k("eps_cu"), v)?;
+    }
+    if let Some(v) = m.initial_yield_ratio {
+        p.initial_yield_ratio = fraction(ctx, &k("initial_yield_ratio"), v, 0.0, 0.9)?;
+    }
+    if let Some(v) = m.softening_limit {
+        p.softening_limit = positive(ctx, &k("softening_limit"), v)?;
+    }
+    if let Some(v) = m.crack_ratio {
+        p.crack_ratio = fraction(ctx, &k("crack_ratio"), v, 0.0, 1.0)?;
+    }
+    if let Some(v) = m.residual_stiffness {
+        p.residual_stiffness = fraction(ctx, &k("residual_stiffness"), v, 1e-12, 0.1)?;
+    }
+    if let Some(v) = m.secant_crack_tangent {
+        p.secant_crack_tangent = v;
+    }
+    if let Some(v) = m.normalize_equivalent_stress {
+        p.normalize_equivalent_stress = v;
+    }
+    let d = ShearRetention::default();
+    p.shear = ShearRetention {
+        k1: positive(ctx, &k("shear_k1"), m.shear_k1.unwrap_or(d.k1))?,
+        eps_ref: positive(
+            ctx,
+            &k("shear_eps_ref"),
+            m.shear_eps_ref.unwrap_or(d.eps_ref),
+        )?,
+        beta_min: fraction(
+            ctx,
+            &k("shear_beta_min"),
+            m.shear_beta_min.unwrap_or(d.beta_min),
+            1e-9,
+            1.0,
+        )?,
+    };
+    p.tension = match m.tension_softening.as_deref() {
+        None | Some("hinton") => {
+            if m.gf.is_some() {
+                return Err(ctx.err(
+                    k("Gf"),
+                    "Gf is used by tension_softening = \"crack_band\" only",
+                ));
+            }
+            let alpha = m.alpha.unwrap_or(5e-4);
+            TensionSoftening::Hinton {
+                alpha: positive(ctx, &k("alpha"), alpha)?,
+            }
+        }
+        Some("crack_band") => {
+            if m.alpha.is_some() {
+                return Err(ctx.err(
+                    k("alpha"),
+                    "alpha is used by tension_softening = \"hinton\" only",
+                ));
+            }
+            let gf = m.gf.unwrap_or(mc90::fracture_energy(fcm, 30.0));
+            TensionSoftening::CrackBand {
+                gf: positive(ctx, &k("Gf"), gf)?,
+            }
+        }
+        Some(o) => {
+            return Err(ctx.err(
+                k("tension_softening"),
+                format!("unknown value '{o}' (expected hinton or crack_band)"),
+            ))
+        }
+    };
+    p.validate()
+        .map_err(|e| ctx.err(format!("materials[{i}]"), e.to_string()))?;
+    Ok(Material::Concrete {
+        params: Box::new(p),
+        density,
+    })
+}
+
+/// `kind = "rebar"` or `"prestressing_steel"`: the uniaxial law of embedded bars.
+fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<SteelParams> {
+    let k = |f: &str| format!("materials[{i}].{f}");
+    let need = |v: Option<f64>, f: &str| -> R<f64> {
+        positive(ctx, &k(f), v.ok_or_else(|| ctx.err(k(f), "missing"))?)
+    };
+    if m.kind == "rebar" {
+        check_material_keys(ctx, i, m, &["E", "fy", "Et"])?;
+        let e = need(m.e, "E")?;
+        let fy = need(m.fy, "fy")?;
+        if fy >= e {
+            return Err(ctx.err(k("fy"), "must be far below E (units are Pa)"));
+        }
+        match m.et {
+            None => Ok(SteelParams::rebar(e, fy)),
+            Some(et) if et.is_finite() && (0.0..e).contains(&et) => {
+                Ok(SteelParams::rebar_hardening(e, fy, et))
+            }
+            Some(et) => Err(ctx.err(k("Et"), format!("must lie in [0, E) (got {et})"))),
+        }
+    } else {
+        check_material_keys(ctx, i, m, &["Ep", "fptk", "eps_uk"])?;
+        let ep = need(m.ep, "Ep")?;
+        let fptk = need(m.fptk, "fptk")?;
+        if fptk >= ep {
+            return Err(ctx.err(k("fptk"), "must be far below Ep (units are Pa)"));
+        }
+        match m.eps_uk {
+            None => Ok(SteelParams::prestressing(ep, fptk)),
+            Some(e) if e.is_finite() && e > 0.9 * fptk / ep => {
+                Ok(SteelParams::prestressing_hardening(ep, fptk, e))
+            }
+            Some(e) => Err(ctx.err(
+                k("eps_uk"),
+                format!(
+                    "must exceed the yield strain 0.9 fptk/Ep = {:.5} (got {e})",
+                    0.9 * fptk / ep
+                ),
+            )),
+        }
+    }
+}
+
+/// Cut the bars through the mesh and store their integration points.
+fn build_bars(
+    ctx: &Ctx,
+    bars: &[BarIn],
+    steels: &[(String, SteelParams)],
+    model: &mut Model,
+) -> R<()> {
+    if bars.is_empty() {
+        return Ok(());
+    }
+    unique_names(ctx, "bars", bars.iter().map(|b| b.name.as_str()))?;
+    let coords: Vec<Vec<[f64; 2]>> = model
+        .elements
+        .iter()
+        .map(|e| model.element_coords(e))
+        .collect();
+    let hosts: Vec<HostElement> = model
+        .elements
+        .iter()
+        .zip(&coords)
+        .map(|(e, c)| HostElement {
+            kind: e.kind,
+            coords: c,
+        })
+        .collect();
+    let embedder = BarEmbedder::new(&hosts).map_err(|e| ctx.err("mesh", e.to_string()))?;
+    let mut out = Vec::new();
+    for (i, b) in bars.iter().enumerate() {
+        let key = format!("bars[{i}]");
+        let named = format!("bar '{}'", b.name);
+        let steel = steels
+            .iter()
+            .find(|(n, _)| *n == b.material)
+            .map(|(_, s)| *s)
+            .ok_or_else(|| {
+                let known: Vec<&str> = steels.iter().map(|(n, _)| n.as_str()).collect();
+                ctx.err(
+                    format!("{key}.material"),
+                    format!(
+                        "{named}: no rebar or prestressing_steel material named '{}' (defined: {})",
+                        b.material,
+                        known.join(", ")
+                    ),
+                )
+            })?;
+        let area = positive(ctx, &format!("{key}.area"), b.area)?;
+        if area > 0.1 {
+            return Err(ctx.err(
+                format!("{key}.area"),
+                format!("{named}: {area} m² is not a bar area (units are m²)"),
+            ));
+        }
+        let initial_stress = b.initial_stress.unwrap_or(0.0);
+        if !initial_stress.is_finite() || initial_stress.abs() >= steel.fy {
+            return Err(ctx.err(
+                format!("{key}.initial_stress"),
+                format!(
+                    "{named}: must be finite and below the yield stress {:.4e} Pa in magnitude",
+                    steel.fy
+                ),
+            ));
+        }
+        let given = b.path.is_some() as u8 + b.parabola.is_some() as u8 + b.arc.is_some() as u8;
+        if given != 1 {
+            return Err(ctx.err(
+                &key,
+                format!("{named}: give exactly one of path, parabola or arc"),
+            ));
+        }
+        let path = if let Some(p) = &b.path {
+            BarPath::Polyline(p.clone())
+        } else if let Some(p) = &b.parabola {
+            BarPath::Parabola {
+                start: p.start,
+                end: p.end,
+                sag: p.sag,
+            }
+        } else {
+            let a = b.arc.as_ref().expect("one path given");
+            BarPath::Arc {
+                center: a.center,
+                radius: a.radius,
+                theta_start: a.theta_start,
+                theta_end: a.theta_end,
+            }
+        };
+        let n_gauss = b.gauss_points.unwrap_or(4);
+        if !(1..=64).contains(&n_gauss) {
+            return Err(ctx.err(
+                format!("{key}.gauss_points"),
+                format!("{named}: must lie in 1..=64"),
+            ));
+        }
+        let pieces = embedder
+            .embed(
+                &path,
+                &EmbedOptions {
+                    n_gauss,
+                    ..Default::default()
+                },
+            )
+            .map_err(|e| ctx.err(format!("{key}.path"), format!("{named}: {e}")))?;
+        let mut points = Vec::new();
+        let mut piece_ends = Vec::new();
+        let mut piece_points = Vec::new();
+        for pc in &pieces {
+            let el = &model.elements[pc.element];
+            let c = &coords[pc.element];
+            let at = |q: [f64; 2]| map_point(&el.kind.eval(q[0], q[1]), c);
+            piece_ends.push([at(pc.nat_nodes[0]), at(pc.nat_nodes[1])]);
+            let p0 = points.len();
+            points.extend(pc.points.iter().map(|p| BarGaussPoint {
+                element: pc.element,
+                point: *p,
+            }));
+            piece_points.push((p0, points.len()));
+        }
+        out.push(Bar {
+            name: b.name.clone(),
+            area,
+            steel,
+            initial_stress,
+            n_pieces: pieces.len(),
+            points,
+            piece_ends,
+            piece_points,
+        });
+    }
+    model.bars = out;
+    Ok(())
+}
+
+/// Optional region by name (None = all regions).
+fn optional_region(ctx: &Ctx, key: &str, model: &Model, name: Option<&str>) -> R<Option<usize>> {
+    name.map(|n| {
+        index_by_name(
+            ctx,
+            key,
+            "region",
+            model.regions.iter().map(|r| r.name.as_str()),
+            n,
+        )
+    })
+    .transpose()
+}
+
+/// Bar-stress and concrete-state monitors.
+fn material_monitor(ctx: &Ctx, key: &str, m: &MonitorIn, model: &Model) -> R<MonitorKind> {
+    if m.kind == "bar_stress" {
+        let name = m
+            .bar
+            .as_deref()
+            .ok_or_else(|| ctx.err(format!("{key}.bar"), "missing"))?;
+        let bar = index_by_name(
+            ctx,
+            &format!("{key}.bar"),
+            "bar",
+            model.bars.iter().map(|b| b.name.as_str()),
+            name,
+        )?;
+        let point = m.point.map(|p| {
+            let pts = &model.bars[bar].points;
+            (0..pts.len())
+                .min_by(|&a, &b| {
+                    let d = |i: usize| {
+                        let x = pts[i].point.x;
+                        (x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2)
+                    };
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap_or(0)
+        });
+        return Ok(MonitorKind::BarStress { bar, point });
+    }
+    if m.point.is_some() || m.node.is_some() {
+        return Err(ctx.err(
+            format!("{key}.point"),
+            format!(
+                "a {} monitor takes an optional region, not a location",
+                m.kind
+            ),
+        ));
+    }
+    let region = optional_region(ctx, &format!("{key}.region"), model, m.region.as_deref())?;
+    Ok(match m.kind.as_str() {
+        "max_crack_strain" => MonitorKind::MaxCrackStrain { region },
+        "max_plastic_strain" => MonitorKind::MaxPlasticStrain { region },
+        _ => MonitorKind::CrushedPoints { region },
+    })
+}
+
+/// A node/point + component + value table → (node, direction, value).
+fn control_dof(
+    ctx: &Ctx,
+    key: &str,
+    c: &ControlIn,
+    model: &Model,
+    used: &[bool],
+) -> R<(Vec<usize>, Dir, f64)> {
+    let nodes = locate_nodes(ctx, key, model, used, c.node, c.point, c.line)?;
+    let d = dir(ctx, &format!("{key}.component"), c.component.as_deref())?;
+    if !c.value.is_finite() {
+        return Err(ctx.err(format!("{key}.value"), "must be a finite number [m]"));
+    }
+    Ok((nodes, d, c.value))
+}
+
+/// Control of displacement and arc-length steps; keys of the wrong step kind are errors.
+fn path_control(
+    ctx: &Ctx,
+    key: &str,
+    s: &StepIn,
+    kind: StepKind,
+    model: &Model,
+    used: &[bool],
+) -> R<Option<PathControl>> {
+    let arc_keys = [
+        (s.initial_increment.is_some(), "initial_increment"),
+        (s.desired_iterations.is_some(), "desired_iterations"),
+        (s.max_growth.is_some(), "max_growth"),
+        (s.target_factor.is_some(), "target_factor"),
+        (s.stop_displacement.is_some(), "stop_displacement"),
+    ];
+    if kind != StepKind::ArcLength {
+        if let Some((_, k)) = arc_keys.iter().find(|(g, _)| *g) {
+            return Err(ctx.err(format!("{key}.{k}"), "only arc_length steps take this key"));
+        }
+    }
+    if kind != StepKind::Displacement && s.control.is_some() {
+        return Err(ctx.err(
+            format!("{key}.control"),
+            "only displacement steps take a control",
+        ));
+    }
+    match kind {
+        StepKind::Displacement => {
+            let c = s.control.as_ref().ok_or_else(|| {
+                ctx.err(
+                    format!("{key}.control"),
+                    "missing: give control = { point = [x, y], component = \"y\", value = -0.01 }",
+                )
+            })?;
+            let (nodes, dir, value) = control_dof(ctx, &format!("{key}.control"), c, model, used)?;
+            for &node in &nodes {
+                let k = 2 * node + dir.index();
+                if model
+                    .supports
+                    .iter()
+                    .any(|sp| sp.dofs.iter().any(|(n, d, _)| 2 * n + d.index() == k))
+                {
+                    return Err(ctx.err(
+                        format!("{key}.control"),
+                        format!(
+                            "node {} ({:?}) is supported in that direction; control a free dof",
+                            node + 1,
+                            model.nodes[node]
+                        ),
+                    ));
+                }
+            }
+            Ok(Some(PathControl::Displacement { nodes, dir, value }))
+        }
+        StepKind::ArcLength => {
+            let initial_increment = s.initial_increment.ok_or_else(|| {
+                ctx.err(
+                    format!("{key}.initial_increment"),
+                    "missing: the load-factor increment of the first increment",
+                )
+            })?;
+            let initial_increment =
+                positive(ctx, &format!("{key}.initial_increment"), initial_increment)?;
+            let target_displacement = s
+                .stop_displacement
+                .as_ref()
+                .map(|c| {
+                    let k = format!("{key}.stop_displacement");
+                    if c.line.is_some() {
+                        return Err(ctx.err(&k, "give a node or point, not a line"));
+                    }
+                    control_dof(ctx, &k, c, model, used).map(|(n, d, v)| (n[0], d, v))
+                })
+                .transpose()?;
+            if let Some(t) = s.target_factor {
+                positive(ctx, &format!("{key}.target_factor"), t)?;
+            }
+            let desired_iterations = s.desired_iterations.unwrap_or(6).max(1);
+            let max_growth = positive(
+                ctx,
+                &format!("{key}.max_growth"),
+                s.max_growth.unwrap_or(10.0),
+            )?;
+            Ok(Some(PathControl::ArcLength(ArcLengthControl {
+                initial_increment,
+                desired_iterations,
+                max_growth,
+                target_factor: s.target_factor,
+                target_displacement,
+                max_increments: s.increments.unwrap_or(100),
+                reference: Vec::new(),
+            })))
+        }
+        _ => Ok(None),
+    }
 }

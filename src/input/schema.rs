@@ -28,6 +28,8 @@ pub struct File {
     #[serde(default)]
     pub steps: Vec<StepIn>,
     pub solver: Option<SolverIn>,
+    #[serde(default)]
+    pub bars: Vec<BarIn>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -39,6 +41,35 @@ pub struct MaterialIn {
     pub e: Option<f64>,
     pub nu: Option<f64>,
     pub density: Option<f64>,
+    // concrete
+    pub fcm: Option<f64>,
+    pub ftm: Option<f64>,
+    #[serde(rename = "C")]
+    pub c: Option<f64>,
+    pub tensile_reference: Option<String>,
+    pub tension_softening: Option<String>,
+    pub alpha: Option<f64>,
+    #[serde(rename = "Gf")]
+    pub gf: Option<f64>,
+    pub eps_c1: Option<f64>,
+    pub eps_cu: Option<f64>,
+    pub initial_yield_ratio: Option<f64>,
+    pub softening_limit: Option<f64>,
+    pub crack_ratio: Option<f64>,
+    pub shear_k1: Option<f64>,
+    pub shear_eps_ref: Option<f64>,
+    pub shear_beta_min: Option<f64>,
+    pub residual_stiffness: Option<f64>,
+    pub secant_crack_tangent: Option<bool>,
+    pub normalize_equivalent_stress: Option<bool>,
+    // steel
+    pub fy: Option<f64>,
+    #[serde(rename = "Et")]
+    pub et: Option<f64>,
+    #[serde(rename = "Ep")]
+    pub ep: Option<f64>,
+    pub fptk: Option<f64>,
+    pub eps_uk: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -188,6 +219,8 @@ pub struct MonitorIn {
     pub case: Option<String>,
     pub joint: Option<String>,
     pub tendon: Option<String>,
+    pub bar: Option<String>,
+    pub region: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -199,6 +232,52 @@ pub struct StepIn {
     pub loads: BTreeMap<String, f64>,
     pub increments: Option<usize>,
     pub output: Option<String>,
+    pub control: Option<ControlIn>,
+    pub initial_increment: Option<f64>,
+    pub desired_iterations: Option<usize>,
+    pub max_growth: Option<f64>,
+    pub target_factor: Option<f64>,
+    pub stop_displacement: Option<ControlIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlIn {
+    pub node: Option<i64>,
+    pub point: Option<[f64; 2]>,
+    pub line: Option<[[f64; 2]; 2]>,
+    pub component: Option<String>,
+    pub value: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BarIn {
+    pub name: String,
+    pub path: Option<Vec<[f64; 2]>>,
+    pub parabola: Option<ParabolaIn>,
+    pub arc: Option<ArcIn>,
+    pub area: f64,
+    pub material: String,
+    pub initial_stress: Option<f64>,
+    pub gauss_points: Option<usize>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParabolaIn {
+    pub start: [f64; 2],
+    pub end: [f64; 2],
+    pub sag: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcIn {
+    pub center: [f64; 2],
+    pub radius: f64,
+    pub theta_start: f64,
+    pub theta_end: f64,
 }
 
 #[derive(Debug, Deserialize)]

@@ -23,6 +23,12 @@ pub struct Row {
     pub factors: Vec<f64>,
     /// Monitor values, in model order.
     pub monitors: Vec<f64>,
+    /// Negative pivots of the last tangent (limit point passed when > 0).
+    pub negative_pivots: usize,
+    /// Arc-length load factor λ (NaN outside arc-length steps).
+    pub arc_length_factor: f64,
+    /// Force of the displacement control [N] (NaN outside displacement steps).
+    pub control_force: f64,
 }
 
 /// Records history and writes outputs into a directory.
@@ -58,11 +64,30 @@ impl<'m> Recorder<'m> {
         for m in &self.model.monitors {
             s.push_str(&format!(",{} [{}]", m.name, m.unit()));
         }
+        let (nonlinear, disp, arc) = path_columns(self.model);
+        if nonlinear {
+            s.push_str(",negative_pivots [-]");
+        }
+        if disp {
+            s.push_str(",control_force [N]");
+        }
+        if arc {
+            s.push_str(",arc_length_factor [-]");
+        }
         s.push('\n');
         for r in &self.rows {
             s.push_str(&format!("{},{},{}", r.step + 1, r.increment, r.iterations));
             for v in r.factors.iter().chain(&r.monitors) {
                 s.push_str(&format!(",{v:e}"));
+            }
+            if nonlinear {
+                s.push_str(&format!(",{}", r.negative_pivots));
+            }
+            if disp {
+                s.push_str(&format!(",{:e}", r.control_force));
+            }
+            if arc {
+                s.push_str(&format!(",{:e}", r.arc_length_factor));
             }
             s.push('\n');
         }
@@ -115,6 +140,16 @@ impl<'m> Recorder<'m> {
                 MonitorKind::JointSlip { joint } => joints_of(*joint)
                     .map(|j| summarise(snap.system, j).max_slip)
                     .fold(0.0, f64::max),
+                MonitorKind::BarStress { bar, point } => bar_stress(snap, *bar, *point),
+                MonitorKind::MaxCrackStrain { region } => {
+                    point_extreme(snap, *region, |p| p.crack_strain())
+                }
+                MonitorKind::MaxPlasticStrain { region } => {
+                    point_extreme(snap, *region, |p| p.equivalent_plastic_strain())
+                }
+                MonitorKind::CrushedPoints { region } => {
+                    point_extreme_sum(snap, *region, |p| p.is_crushed() as u8 as f64)
+                }
             })
             .collect()
     }
@@ -148,6 +183,7 @@ impl<'m> Recorder<'m> {
         let cs = flat(&f.cell_stress);
         let ce = flat(&f.cell_strain);
         let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
+        let st = cell_states(snap);
         let mut reaction = vec![0.0; 3 * model.nodes.len()];
         for s in &model.supports {
             for &(n, d, _) in &s.dofs {
@@ -203,6 +239,29 @@ impl<'m> Recorder<'m> {
                     components: 3,
                     values: &ce,
                 },
+                Array::I32 {
+                    name: "cracks",
+                    values: &st.cracks,
+                },
+                Array::F64 {
+                    name: "crack_angle",
+                    components: 1,
+                    values: &st.angle,
+                },
+                Array::F64 {
+                    name: "crack_strain",
+                    components: 1,
+                    values: &st.crack_strain,
+                },
+                Array::F64 {
+                    name: "plastic_strain",
+                    components: 1,
+                    values: &st.plastic,
+                },
+                Array::I32 {
+                    name: "crushed",
+                    values: &st.crushed,
+                },
             ],
         );
         let name = format!("step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
@@ -217,6 +276,11 @@ impl<'m> Recorder<'m> {
             );
             write_atomic(&self.dir.join(&name), lines.as_bytes())?;
             self.pvd.push((t, 1, name));
+        }
+        if !model.bars.is_empty() {
+            let bname = format!("bars_step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
+            write_atomic(&self.dir.join(&bname), bars_vtu(snap).as_bytes())?;
+            self.pvd.push((t, 2, bname));
         }
         write_atomic(
             &self.dir.join("results.pvd"),
@@ -234,6 +298,9 @@ impl Observer for Recorder<'_> {
             iterations: snap.iterations,
             factors: snap.factors.to_vec(),
             monitors,
+            negative_pivots: snap.negative_pivots,
+            arc_length_factor: snap.arc_length_factor.unwrap_or(f64::NAN),
+            control_force: snap.control_force.unwrap_or(f64::NAN),
         });
         let step = &self.model.steps[snap.step];
         if self.write_fields && (snap.end_of_step || step.output_every_increment) {
@@ -329,4 +396,191 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
             },
         ],
     ))
+}
+
+/// Stress of a bar [Pa] at one of its points, or the value of largest magnitude.
+fn bar_stress(snap: &Snapshot, bar: usize, point: Option<usize>) -> f64 {
+    let sys = snap.system;
+    let mut best: f64 = 0.0;
+    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
+        if b != bar {
+            continue;
+        }
+        let s = sys.bar_out[i].stress;
+        match point {
+            Some(q) if q == p => return s,
+            Some(_) => {}
+            None => {
+                if s.abs() > best.abs() {
+                    best = s;
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Committed point states of the elements of a region (all if None).
+fn region_points<'a>(
+    snap: &'a Snapshot,
+    region: Option<usize>,
+) -> impl Iterator<Item = &'a crate::materials::point::PointState> + 'a {
+    let sys = snap.system;
+    sys.model
+        .elements
+        .iter()
+        .enumerate()
+        .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
+        .flat_map(move |(i, _)| &sys.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]])
+}
+
+fn point_extreme(
+    snap: &Snapshot,
+    region: Option<usize>,
+    f: impl Fn(&crate::materials::point::PointState) -> f64,
+) -> f64 {
+    region_points(snap, region).map(f).fold(0.0, f64::max)
+}
+
+fn point_extreme_sum(
+    snap: &Snapshot,
+    region: Option<usize>,
+    f: impl Fn(&crate::materials::point::PointState) -> f64,
+) -> f64 {
+    region_points(snap, region).map(f).sum()
+}
+
+/// Which extra history columns a model has: negative pivots (nonlinear models), control
+/// force (displacement steps), arc-length factor (arc-length steps).
+fn path_columns(model: &Model) -> (bool, bool, bool) {
+    use crate::model::StepKind;
+    let has = |k: StepKind| model.steps.iter().any(|s| s.kind == k);
+    let nonlinear = !model.materials.iter().all(|m| m.law.is_linear())
+        || !model.bars.is_empty()
+        || has(StepKind::Displacement)
+        || has(StepKind::ArcLength);
+    (
+        nonlinear,
+        has(StepKind::Displacement),
+        has(StepKind::ArcLength),
+    )
+}
+
+/// Cell values of the concrete states (Gauss points of each element).
+struct CellStates {
+    /// Largest number of cracks at a point [-].
+    cracks: Vec<i32>,
+    /// Crack-normal angle from x [deg] at the point with the largest crack strain.
+    angle: Vec<f64>,
+    /// Largest crack-opening strain [-].
+    crack_strain: Vec<f64>,
+    /// Largest equivalent plastic strain [-].
+    plastic: Vec<f64>,
+    /// Number of crushed points [-].
+    crushed: Vec<i32>,
+}
+
+fn cell_states(snap: &Snapshot) -> CellStates {
+    let sys = snap.system;
+    let n = sys.model.elements.len();
+    let mut c = CellStates {
+        cracks: Vec::with_capacity(n),
+        angle: Vec::with_capacity(n),
+        crack_strain: Vec::with_capacity(n),
+        plastic: Vec::with_capacity(n),
+        crushed: Vec::with_capacity(n),
+    };
+    for e in 0..n {
+        let pts = &sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+        c.cracks
+            .push(pts.iter().map(|p| p.n_cracks()).max().unwrap_or(0) as i32);
+        let widest = pts
+            .iter()
+            .filter(|p| p.n_cracks() > 0)
+            .max_by(|a, b| a.crack_strain().total_cmp(&b.crack_strain()));
+        c.angle
+            .push(widest.map_or(0.0, |p| p.crack_angle().to_degrees()));
+        c.crack_strain
+            .push(pts.iter().map(|p| p.crack_strain()).fold(0.0, f64::max));
+        c.plastic.push(
+            pts.iter()
+                .map(|p| p.equivalent_plastic_strain())
+                .fold(0.0, f64::max),
+        );
+        c.crushed
+            .push(pts.iter().filter(|p| p.is_crushed()).count() as i32);
+    }
+    c
+}
+
+/// The bars as a .vtu of poly-lines: one cell per piece (entry, its Gauss points, exit);
+/// point data = stress, strain and plastic strain (the entry/exit points take the values of
+/// the nearest Gauss point); cell data = bar index.
+fn bars_vtu(snap: &Snapshot) -> String {
+    let sys = snap.system;
+    let model = sys.model;
+    // Output values per (bar, point) from the element-sorted arrays.
+    let mut vals: Vec<Vec<crate::analysis::system::BarOutput>> = model
+        .bars
+        .iter()
+        .map(|b| vec![Default::default(); b.points.len()])
+        .collect();
+    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
+        vals[b][p] = sys.bar_out[i];
+    }
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let mut cells: Vec<Vec<usize>> = Vec::new();
+    let mut bar_id: Vec<i32> = Vec::new();
+    let (mut stress, mut strain, mut plastic) = (Vec::new(), Vec::new(), Vec::new());
+    for (b, bar) in model.bars.iter().enumerate() {
+        for (k, &(p0, p1)) in bar.piece_points.iter().enumerate() {
+            if p1 == p0 {
+                continue;
+            }
+            let mut cell = Vec::with_capacity(p1 - p0 + 2);
+            let mut push = |x: [f64; 2], o: &crate::analysis::system::BarOutput| {
+                cell.push(points.len());
+                points.push(x);
+                stress.push(o.stress);
+                strain.push(o.strain);
+                plastic.push(o.plastic_strain);
+            };
+            push(bar.piece_ends[k][0], &vals[b][p0]);
+            for p in p0..p1 {
+                push(bar.points[p].point.x, &vals[b][p]);
+            }
+            push(bar.piece_ends[k][1], &vals[b][p1 - 1]);
+            cells.push(cell);
+            bar_id.push(b as i32);
+        }
+    }
+    let types = vec![4u8; cells.len()]; // VTK_POLY_LINE
+    render(
+        &Grid {
+            points: &points,
+            cells: &cells,
+            types: &types,
+        },
+        &[
+            Array::F64 {
+                name: "bar_stress",
+                components: 1,
+                values: &stress,
+            },
+            Array::F64 {
+                name: "bar_strain",
+                components: 1,
+                values: &strain,
+            },
+            Array::F64 {
+                name: "bar_plastic_strain",
+                components: 1,
+                values: &plastic,
+            },
+        ],
+        &[Array::I32 {
+            name: "bar",
+            values: &bar_id,
+        }],
+    )
 }

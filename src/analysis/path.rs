@@ -1,0 +1,622 @@
+//! Path following: displacement control of one dof and Crisfield's cylindrical arc-length
+//! method. Both go past limit points of the load; arc length also past snap-backs. The
+//! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
+//! reports the number of negative pivots.
+
+use super::solver::SparseCholesky;
+use super::steps::{
+    newton, norm, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot, Timings,
+};
+use super::system::System;
+use crate::fem::dofs::CONSTRAINED;
+use crate::model::{ArcLengthControl, PathControl, Step, StepKind};
+use std::time::Instant;
+
+/// The analysis state a path-following step works on (owned by `steps::run`).
+pub(super) struct PathContext<'a, 's> {
+    /// The system.
+    pub sys: &'a mut System<'s>,
+    /// The linear solver.
+    pub solver: &'a mut SparseCholesky,
+    /// Load vectors of the load cases at factor 1 (all dofs) [N].
+    pub cases: &'a [Vec<f64>],
+    /// Current load-case factors (updated).
+    pub factors: &'a mut Vec<f64>,
+    /// Current displacements (all dofs) [m].
+    pub u: &'a mut Vec<f64>,
+    /// Timings and counters.
+    pub timings: &'a mut Timings,
+    /// Negative pivots at the last converged increment.
+    pub neg_pivots: &'a mut usize,
+}
+
+impl PathContext<'_, '_> {
+    /// Σ_c w_c f_c over all dofs [N].
+    fn combine(&self, weights: &[f64]) -> Vec<f64> {
+        let mut f = vec![0.0; self.sys.model.n_dofs()];
+        for (c, w) in self.cases.iter().zip(weights) {
+            if *w != 0.0 {
+                f.iter_mut().zip(c).for_each(|(a, v)| *a += w * v);
+            }
+        }
+        f
+    }
+
+    /// Assemble at `u` with the tangent, factorise it (LDLᵀ fallback).
+    fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>), NewtonFailure> {
+        let t = Instant::now();
+        let a = self
+            .sys
+            .assemble(u, true)
+            .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+        self.sys.latch_cracks();
+        self.timings.assembly_s += t.elapsed().as_secs_f64();
+        Ok((a.f_int, a.k_values.expect("tangent requested")))
+    }
+
+    /// Add a free-equation correction to the full displacement vector.
+    fn add_free(&self, u: &mut [f64], du: &[f64], scale: f64) {
+        for (d, &q) in self.sys.dofs.eq.iter().enumerate() {
+            if q != CONSTRAINED {
+                u[d] += scale * du[q];
+            }
+        }
+    }
+
+    /// Report a converged increment to the observer.
+    #[allow(clippy::too_many_arguments)]
+    fn report(
+        &mut self,
+        obs: &mut dyn Observer,
+        step: usize,
+        increment: usize,
+        end_of_step: bool,
+        f_int: &[f64],
+        f_ext: &[f64],
+        iterations: usize,
+        arc_length_factor: Option<f64>,
+        control_force: Option<f64>,
+    ) -> Result<(), AnalysisError> {
+        self.timings.increments += 1;
+        self.timings.iterations += iterations;
+        let name = &self.sys.model.steps[step].name;
+        note_limit_point(
+            self.timings,
+            self.neg_pivots,
+            self.solver.negative_pivots,
+            name,
+            increment,
+        );
+        let t = Instant::now();
+        obs.increment(&Snapshot {
+            system: self.sys,
+            step,
+            increment,
+            end_of_step,
+            factors: self.factors,
+            f_int,
+            f_ext,
+            iterations,
+            negative_pivots: self.solver.negative_pivots,
+            arc_length_factor,
+            control_force,
+        })?;
+        self.timings.output_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+}
+
+/// Run one displacement or arc-length step.
+pub(super) fn run_step(
+    ctx: &mut PathContext,
+    si: usize,
+    step: &Step,
+    obs: &mut dyn Observer,
+) -> Result<(), AnalysisError> {
+    match (&step.path, step.kind) {
+        (Some(PathControl::Displacement { nodes, dir, value }), StepKind::Displacement) => {
+            let dofs: Vec<usize> = nodes.iter().map(|n| 2 * n + dir.index()).collect();
+            displacement_step(ctx, si, step, &dofs, *value, obs)
+        }
+        (Some(PathControl::ArcLength(a)), StepKind::ArcLength) => {
+            arc_length_step(ctx, si, step, a, obs)
+        }
+        _ => Err(AnalysisError::Mechanism(format!(
+            "step '{}': path control missing (input error)",
+            step.name
+        ))),
+    }
+}
+
+fn not_converged(
+    ctx: &PathContext,
+    step: &Step,
+    increment: usize,
+    level: f64,
+    cuts: usize,
+    f: &NewtonFailure,
+) -> AnalysisError {
+    AnalysisError::NotConverged {
+        step: step.name.clone(),
+        increment,
+        level,
+        cuts,
+        reason: f.describe(ctx.sys),
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+// Displacement control
+// ------------------------------------------------------------------------------------------
+
+/// Positions in the lower-triangle value array of the off-diagonal entries of row and
+/// column `q`: (other index, position). Found once per step.
+fn row_positions(sys: &System, q: usize) -> Vec<(usize, usize)> {
+    let p = &sys.asm.pattern;
+    let mut v: Vec<(usize, usize)> = (0..q)
+        .filter_map(|j| p.position(q, j).map(|pos| (j, pos)))
+        .collect();
+    v.extend((p.col_ptr[q] + 1..p.col_ptr[q + 1]).map(|pos| (p.row_idx[pos], pos)));
+    v
+}
+
+fn displacement_step(
+    ctx: &mut PathContext,
+    si: usize,
+    step: &Step,
+    dofs: &[usize],
+    value: f64,
+    obs: &mut dyn Observer,
+) -> Result<(), AnalysisError> {
+    let mut ctl = Vec::new();
+    for &c in dofs {
+        let q = ctx.sys.dofs.eq[c];
+        if q == CONSTRAINED {
+            return Err(AnalysisError::Mechanism(format!(
+                "step '{}': the controlled dof is constrained",
+                step.name
+            )));
+        }
+        // All controlled dofs move by the same increment from their own start values.
+        ctl.push(Controlled {
+            c,
+            q,
+            v0: ctx.sys.u[c],
+            row_pos: row_positions(ctx.sys, q),
+        });
+    }
+    let f_ext = ctx.combine(&ctx.factors.clone());
+    // The step drives the first controlled dof to `value`; the others follow with the same
+    // increment (equal to it when they start equal).
+    let v0 = ctl[0].v0;
+    let n_inc = step.increments.max(1);
+    let (mut level, mut d_level) = (0.0, 1.0 / n_inc as f64);
+    let (mut increment, mut cuts) = (0, 0);
+    while level < 1.0 - 1e-12 {
+        let target = (level + d_level).min(1.0);
+        let shift = (value - v0) * target;
+        match newton_controlled(ctx, &f_ext, &ctl, shift) {
+            Ok((f_int, iterations)) => {
+                let u = ctx.u.clone();
+                ctx.sys.commit(&u);
+                level = target;
+                increment += 1;
+                let force: f64 = ctl.iter().map(|k| f_int[k.c] - f_ext[k.c]).sum();
+                ctx.report(
+                    obs,
+                    si,
+                    increment,
+                    level >= 1.0 - 1e-12,
+                    &f_int,
+                    &f_ext,
+                    iterations,
+                    None,
+                    Some(force),
+                )?;
+                // Grow back after cuts (at most to the nominal size).
+                if iterations <= 4 {
+                    d_level = (2.0 * d_level).min(1.0 / n_inc as f64);
+                }
+            }
+            Err(f) => {
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                if cuts >= ctx.sys.model.controls.max_cuts {
+                    return Err(not_converged(ctx, step, increment + 1, target, cuts, &f));
+                }
+                cuts += 1;
+                d_level *= 0.5;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A controlled dof: full index, free equation, value at the start of the step [m], and
+/// the off-diagonal positions of its row/column in the tangent.
+struct Controlled {
+    c: usize,
+    q: usize,
+    v0: f64,
+    row_pos: Vec<(usize, usize)>,
+}
+
+/// Newton with the controlled dofs driven to v0 + `shift`: their equations are removed from
+/// the system (rows and columns zeroed, diagonals kept) and their increments imposed; the
+/// first iteration moves the other dofs by −K_fq Δ (tangent predictor), so the controlled
+/// nodes are not pushed alone. Returns the converged internal forces and the iterations.
+fn newton_controlled(
+    ctx: &mut PathContext,
+    f_ext: &[f64],
+    ctl: &[Controlled],
+    shift: f64,
+) -> Result<(Vec<f64>, usize), NewtonFailure> {
+    let controls = ctx.sys.model.controls.clone();
+    let mut history = Vec::new();
+    let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
+    let mut u = ctx.u.clone();
+    for it in 0..=controls.max_iterations {
+        let (f_int, mut k) = ctx.tangent(&u)?;
+        let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
+        let mut rf = ctx.sys.to_free(&r);
+        for k in ctl {
+            rf[k.q] = 0.0; // the reaction of the control
+        }
+        let rel = norm(&rf) / norm(f_ext).max(norm(&f_int)).max(f64::MIN_POSITIVE);
+        history.push(rel);
+        if !rel.is_finite() {
+            return Err(NewtonFailure::Diverged(history));
+        }
+        if it > 0 {
+            let energy_ok = it > 1
+                && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
+            if rel <= controls.force_tolerance || energy_ok {
+                ctx.u.copy_from_slice(&u);
+                return Ok((f_int, it));
+            }
+        }
+        if it == controls.max_iterations {
+            break;
+        }
+        let p = &ctx.sys.asm.pattern;
+        if it == 0 {
+            // rhs_i = r_i − Σ_q K_iq Δ_q for the free i; rhs_q = K_qq Δ_q.
+            for k_ in ctl {
+                let delta = k_.v0 + shift - ctx.u[k_.c];
+                for &(j, pos) in &k_.row_pos {
+                    rf[j] -= k[pos] * delta;
+                }
+            }
+            for k_ in ctl {
+                let delta = k_.v0 + shift - ctx.u[k_.c];
+                rf[k_.q] = k[p.col_ptr[k_.q]] * delta;
+            }
+        }
+        for k_ in ctl {
+            for &(_, pos) in &k_.row_pos {
+                k[pos] = 0.0;
+            }
+        }
+        ctx.solver
+            .factorize_indefinite(&ctx.sys.asm.pattern, &k)
+            .map_err(NewtonFailure::Singular)?;
+        let mut du = rf.clone();
+        ctx.solver.solve_in_place(&mut du);
+        // Damping when the residual stagnates over two iterations: Newton cycles between
+        // two sides of a kink of the material response (a crack closing/reopening, a point
+        // switching between elastic and plastic); a shorter step lands between them.
+        let damp = damping(&history);
+        if damp < 1.0 {
+            du.iter_mut().for_each(|v| *v *= damp);
+        }
+        if it > 0 {
+            let energy = du.iter().zip(&rf).map(|(a, b)| a * b).sum::<f64>().abs();
+            first_energy.get_or_insert(energy);
+            last_energy = Some(energy);
+        }
+        ctx.add_free(&mut u, &du, 1.0);
+    }
+    Err(NewtonFailure::Diverged(history))
+}
+
+// ------------------------------------------------------------------------------------------
+// Arc length
+// ------------------------------------------------------------------------------------------
+
+/// A converged arc-length increment.
+struct ArcIncrement {
+    f_int: Vec<f64>,
+    d_lambda: f64,
+    du: Vec<f64>,
+    iterations: usize,
+}
+
+fn arc_length_step(
+    ctx: &mut PathContext,
+    si: usize,
+    step: &Step,
+    a: &ArcLengthControl,
+    obs: &mut dyn Observer,
+) -> Result<(), AnalysisError> {
+    let held = ctx.factors.clone();
+    let f_base = ctx.combine(&held);
+    let q_full = ctx.combine(&a.reference);
+    let q_free = ctx.sys.to_free(&q_full);
+    let max_cuts = ctx.sys.model.controls.max_cuts;
+    let mut lambda = 0.0;
+    let mut dl: Option<f64> = None;
+    let mut dl0 = 0.0;
+    let mut du_prev: Option<Vec<f64>> = None;
+    let (mut increment, mut cuts) = (0, 0);
+    let start_disp = a
+        .target_displacement
+        .map(|(n, d, _)| ctx.sys.u[2 * n + d.index()]);
+    let factors_at = |lam: f64| -> Vec<f64> {
+        held.iter()
+            .zip(&a.reference)
+            .map(|(h, r)| h + lam * r)
+            .collect()
+    };
+    let mut failed_dl: Option<f64> = None;
+    while increment < a.max_increments {
+        match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
+            Ok(inc) => {
+                if dl0 == 0.0 {
+                    dl0 = dl.expect("set by the first increment");
+                }
+                cuts = 0;
+                let mut lam_new = lambda + inc.d_lambda;
+                let mut f_int = inc.f_int;
+                let mut iterations = inc.iterations;
+                // Land on the target factor by a load-controlled correction if this increment
+                // crossed it on the way up (the arc-length point is kept if that fails).
+                let mut reached = false;
+                if let Some(t) = a.target_factor {
+                    if lambda < t && lam_new >= t {
+                        reached = true;
+                        let mut u_try = ctx.sys.u.clone();
+                        let f_t: Vec<f64> =
+                            f_base.iter().zip(&q_full).map(|(b, q)| b + t * q).collect();
+                        let mut factored = false;
+                        if let Ok((fi, it)) = newton(
+                            ctx.sys,
+                            ctx.solver,
+                            &mut u_try,
+                            &f_t,
+                            ctx.timings,
+                            &mut factored,
+                            StepKind::Load,
+                        ) {
+                            ctx.u.copy_from_slice(&u_try);
+                            f_int = fi;
+                            iterations += it;
+                            lam_new = t;
+                        } else {
+                            // Restore the trial states of the arc-length point.
+                            let u = ctx.u.clone();
+                            ctx.sys.assemble(&u, false).map_err(|(e, err)| {
+                                AnalysisError::Mechanism(format!("element {}: {err}", e + 1))
+                            })?;
+                        }
+                    }
+                }
+                let u = ctx.u.clone();
+                ctx.sys.commit(&u);
+                lambda = lam_new;
+                increment += 1;
+                *ctx.factors = factors_at(lambda);
+                if let (Some((n, d, v)), Some(u0)) = (a.target_displacement, start_disp) {
+                    let x = ctx.sys.u[2 * n + d.index()];
+                    if (x - v) * (v - u0).signum() >= 0.0 {
+                        reached = true;
+                    }
+                }
+                let end = reached || increment >= a.max_increments;
+                let f_ext: Vec<f64> = f_base
+                    .iter()
+                    .zip(&q_full)
+                    .map(|(b, q)| b + lambda * q)
+                    .collect();
+                ctx.report(
+                    obs,
+                    si,
+                    increment,
+                    end,
+                    &f_int,
+                    &f_ext,
+                    iterations,
+                    Some(lambda),
+                    None,
+                )?;
+                // Step-size adaptation: Δl ← Δl √(N_desired/N), bounded to [½, 2] per
+                // increment and to max_growth × the first arc length.
+                let ratio = (a.desired_iterations as f64 / inc.iterations.max(1) as f64)
+                    .sqrt()
+                    .clamp(0.5, 2.0);
+                dl = dl.map(|l| (l * ratio).min(a.max_growth * dl0));
+                du_prev = Some(inc.du);
+                if end {
+                    break;
+                }
+            }
+            Err(f) => {
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                if cuts >= max_cuts || dl.is_none() {
+                    return Err(not_converged(ctx, step, increment + 1, lambda, cuts, &f));
+                }
+                if cuts == 0 {
+                    failed_dl = dl;
+                }
+                // Retry with Δl × ½, 2, ¼, 4, … of the failed length: a material jump (a crack
+                // forming, the stress dropping at fixed strain) leaves a gap in the path that
+                // a shorter arc cannot cross when the last point sits just before it; a
+                // longer one steps over it.
+                cuts += 1;
+                let k = cuts.div_ceil(2) as i32;
+                let factor = if cuts % 2 == 1 {
+                    0.5_f64.powi(k)
+                } else {
+                    2.0_f64.powi(k)
+                };
+                dl = failed_dl.map(|l| factor * l);
+            }
+        }
+    }
+    Ok(())
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// One arc-length increment from the committed state at load factor `lambda_n`, with
+/// arc length `dl` (set from the initial load-factor increment if None): cylindrical
+/// constraint ‖Δu‖ = Δl over the free equations (Crisfield 1981).
+#[allow(clippy::too_many_arguments)]
+fn arc_increment(
+    ctx: &mut PathContext,
+    f_base: &[f64],
+    q_full: &[f64],
+    q_free: &[f64],
+    lambda_n: f64,
+    dl: &mut Option<f64>,
+    a: &ArcLengthControl,
+    du_prev: &Option<Vec<f64>>,
+) -> Result<ArcIncrement, NewtonFailure> {
+    let controls = ctx.sys.model.controls.clone();
+    let u_n = ctx.sys.u.clone();
+    // Predictor: tangent at the committed state.
+    let (_, k) = ctx.tangent(&u_n)?;
+    ctx.solver
+        .factorize_indefinite(&ctx.sys.asm.pattern, &k)
+        .map_err(NewtonFailure::Singular)?;
+    let mut dut = q_free.to_vec();
+    ctx.solver.solve_in_place(&mut dut);
+    let nt = norm(&dut);
+    if !(nt.is_finite() && nt > 0.0) {
+        return Err(NewtonFailure::Diverged(vec![nt]));
+    }
+    let l = *dl.get_or_insert(a.initial_increment * nt);
+    // Direction: keep going the way the previous increment went (Feng's criterion
+    // Δu_prev · δu_t > 0), which follows snap-backs where the load must decrease.
+    // With a positive-definite tangent the load must grow (sign of det K); past a limit
+    // point (negative pivots) the previous direction decides.
+    let sign = match du_prev {
+        Some(p) if ctx.solver.negative_pivots > 0 && dot(p, &dut) < 0.0 => -1.0,
+        _ => 1.0,
+    };
+    let mut d_lambda = sign * l / nt;
+    let mut du: Vec<f64> = dut.iter().map(|v| v * d_lambda).collect();
+    let mut u = u_n.clone();
+    ctx.add_free(&mut u, &du, 1.0);
+    let mut history = Vec::new();
+    let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
+    for it in 1..=controls.max_iterations + 1 {
+        let (f_int, k) = ctx.tangent(&u)?;
+        let lam = lambda_n + d_lambda;
+        let r: Vec<f64> = f_base
+            .iter()
+            .zip(q_full)
+            .zip(&f_int)
+            .map(|((b, q), i)| b + lam * q - i)
+            .collect();
+        let rf = ctx.sys.to_free(&r);
+        let f_ext_norm = norm(
+            &f_base
+                .iter()
+                .zip(q_full)
+                .map(|(b, q)| b + lam * q)
+                .collect::<Vec<_>>(),
+        );
+        let rel = norm(&rf) / f_ext_norm.max(norm(&f_int)).max(f64::MIN_POSITIVE);
+        history.push(rel);
+        if !rel.is_finite() {
+            return Err(NewtonFailure::Diverged(history));
+        }
+        let energy_ok = it > 2
+            && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
+        if rel <= controls.force_tolerance || energy_ok {
+            ctx.u.copy_from_slice(&u);
+            return Ok(ArcIncrement {
+                f_int,
+                d_lambda,
+                du,
+                iterations: it,
+            });
+        }
+        if it > controls.max_iterations {
+            break;
+        }
+        ctx.solver
+            .factorize_indefinite(&ctx.sys.asm.pattern, &k)
+            .map_err(NewtonFailure::Singular)?;
+        let mut dur = rf.clone();
+        ctx.solver.solve_in_place(&mut dur);
+        let mut dut = q_free.to_vec();
+        ctx.solver.solve_in_place(&mut dut);
+        // ‖Δu + δu_r + δλ δu_t‖² = Δl²  →  a1 δλ² + a2 δλ + a3 = 0.
+        let w: Vec<f64> = du.iter().zip(&dur).map(|(a, b)| a + b).collect();
+        let a1 = dot(&dut, &dut);
+        let a2 = 2.0 * dot(&dut, &w);
+        let a3 = dot(&w, &w) - l * l;
+        let disc = a2 * a2 - 4.0 * a1 * a3;
+        let dlam = if disc < 0.0 {
+            // No intersection with the cylinder: take the closest point (the minimum of the
+            // quadratic); the next iterations pull back onto the constraint.
+            -a2 / (2.0 * a1)
+        } else {
+            // Of the two roots take the one whose new Δu makes the smaller angle with the
+            // current one (no backtracking along the path).
+            let sq = disc.sqrt();
+            let r1 = (-a2 + sq) / (2.0 * a1);
+            let r2 = (-a2 - sq) / (2.0 * a1);
+            let cosang = |r: f64| {
+                w.iter()
+                    .zip(&dut)
+                    .zip(&du)
+                    .map(|((wi, ti), di)| (wi + r * ti) * di)
+                    .sum::<f64>()
+            };
+            let (near, far) = if cosang(r1) >= cosang(r2) {
+                (r1, r2)
+            } else {
+                (r2, r1)
+            };
+            // Stagnation (the residual not falling over two iterations) means Newton cycles
+            // across a kink of the response — typically at a crack that snaps back, where the
+            // root nearest the predictor lies on the wrong side of the peak: take the other
+            // root then.
+            let n = history.len();
+            let stagnating = n >= 3 && history[n - 1] >= 0.9 * history[n - 3];
+            if stagnating {
+                far
+            } else {
+                near
+            }
+        };
+        let corr: Vec<f64> = dur.iter().zip(&dut).map(|(r, t)| r + dlam * t).collect();
+        let energy = dot(&corr, &rf).abs();
+        first_energy.get_or_insert(energy);
+        last_energy = Some(energy);
+        for (d, c) in du.iter_mut().zip(&corr) {
+            *d += c;
+        }
+        d_lambda += dlam;
+        ctx.add_free(&mut u, &corr, 1.0);
+    }
+    Err(NewtonFailure::Diverged(history))
+}
+
+/// Correction scale from the residual history: 1, or ½, ¼, … (at least 1/16) while the
+/// relative residual has not fallen by 10 % over the last two iterations.
+pub(super) fn damping(history: &[f64]) -> f64 {
+    let n = history.len();
+    let mut k = 0;
+    let mut i = n;
+    while i >= 3 && history[i - 1] >= 0.9 * history[i - 3] && k < 4 {
+        k += 1;
+        i -= 1;
+    }
+    0.5_f64.powi(k)
+}

@@ -1,0 +1,476 @@
+//! Concrete and embedded bars through the FE engine: input → system → path following.
+//! Release-mode friendly (each case well under a second).
+
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::materials::concrete::ConcreteParams;
+use segfem::model::Model;
+
+/// What the tests read from each converged increment.
+#[derive(Default)]
+struct Trace {
+    /// (step, control force [N], watched displacement [m], negative pivots, arc λ).
+    rows: Vec<(usize, f64, f64, usize, f64)>,
+    /// Watched dof (2·node + component).
+    dof: usize,
+    /// Bar stresses [Pa] of the last increment.
+    bar_stress: Vec<f64>,
+    /// Largest crack strain and crushed count at the last increment.
+    last_states: (f64, usize),
+}
+
+impl Observer for Trace {
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let sys = snap.system;
+        self.rows.push((
+            snap.step,
+            snap.control_force.unwrap_or(f64::NAN),
+            sys.u[self.dof],
+            snap.negative_pivots,
+            snap.arc_length_factor.unwrap_or(f64::NAN),
+        ));
+        self.bar_stress = sys.bar_out.iter().map(|o| o.stress).collect();
+        self.last_states = (
+            sys.committed
+                .iter()
+                .map(|p| p.crack_strain())
+                .fold(0.0, f64::max),
+            sys.committed.iter().filter(|p| p.is_crushed()).count(),
+        );
+        Ok(())
+    }
+}
+
+fn model(text: &str) -> Model {
+    match segfem::input::parse(text, "test.toml") {
+        Ok(b) => b.model,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+fn run(m: &Model, dof: usize) -> Trace {
+    let mut t = Trace {
+        dof,
+        ..Default::default()
+    };
+    steps::run(m, &mut t).unwrap_or_else(|e| panic!("{e}"));
+    t
+}
+
+/// One 0.1 m Q4 (thickness 0.1 m) of C30 concrete, held at x = 0 (and at the origin in y),
+/// its right edge driven in x to each `value` in turn in `n` increments.
+fn block(stages: &[(f64, usize)], extra: &str) -> String {
+    let mut steps = String::new();
+    for (i, (value, n)) in stages.iter().enumerate() {
+        steps.push_str(&format!(
+            r#"
+[[steps]]
+name = "s{i}"
+kind = "displacement"
+control = {{ line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = {value} }}
+increments = {n}
+"#
+        ));
+    }
+    format!(
+        r#"
+[[materials]]
+name = "c30"
+kind = "concrete"
+fcm = 38e6
+nu = 0.2
+{extra}
+
+[[regions]]
+name = "r"
+material = "c30"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]
+blocks = [{{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }}]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+{steps}"#
+    )
+}
+
+/// Uniaxial compression to the peak under displacement control follows the MC90 curve:
+/// σ(ε) from the control force / area against `CompressionCurve::stress`. Required 1 %;
+/// the material point alone reproduces it to 1e-6, so a failure here is an engine error
+/// (load path, control, assembly). The peak must be reached (last point at ε_c1).
+#[test]
+fn uniaxial_compression_follows_mc90_curve_to_peak() {
+    let p = ConcreteParams::from_mc90(38e6, 0.2);
+    let eps_end = p.eps_c1;
+    let m = model(&block(&[(-eps_end * 0.1, 44)], ""));
+    let t = run(&m, 2);
+    let curve = p.curve();
+    assert_eq!(t.rows.len(), 44);
+    for &(_, f, u, _, _) in &t.rows {
+        let eps = -u / 0.1;
+        let sigma = -f / 0.01; // area 0.1 × 0.1 m²
+        let expect = curve.stress(eps);
+        assert!(
+            (sigma - expect).abs() <= 0.01 * expect,
+            "ε = {eps:.3e}: σ = {sigma:.4e}, MC90 {expect:.4e}"
+        );
+    }
+    let (_, f, u, _, _) = *t.rows.last().unwrap();
+    assert!((-u / 0.1 - eps_end).abs() < 1e-12);
+    assert!((-f / 0.01 - p.fcm).abs() < 0.01 * p.fcm);
+}
+
+/// Uniaxial tension: linear to f_tm (Ottosen uniaxial tensile strength = f_tm within
+/// 0.2 %, so 1 % on the peak), then the Hinton exponential softening
+/// σ = f_tm exp(−(ε − ε0)/α) (1 % of f_tm: the crack forms inside an increment, so the
+/// first cracked point may sit on the jump from the elastic line to the curve).
+#[test]
+fn uniaxial_tension_cracks_at_ftm_and_softens() {
+    let p = ConcreteParams::from_mc90(38e6, 0.2);
+    let alpha = 2e-4;
+    let eps0 = p.ftm / p.ec;
+    let eps_end = eps0 + 4.0 * alpha;
+    // Fine increments (Δε = ε0/1000, i.e. 0.1 % of f_tm per increment) around cracking.
+    let m = model(&block(
+        &[
+            (0.98 * eps0 * 0.1, 5),
+            (1.02 * eps0 * 0.1, 40),
+            (eps_end * 0.1, 80),
+        ],
+        &format!("alpha = {alpha}"),
+    ));
+    let t = run(&m, 2);
+    let peak = t.rows.iter().map(|r| r.1 / 0.01).fold(0.0, f64::max);
+    assert!(
+        (peak - p.ftm).abs() < 0.01 * p.ftm,
+        "peak {peak:.4e} vs f_tm {:.4e}",
+        p.ftm
+    );
+    for &(_, f, u, _, _) in &t.rows {
+        let eps = u / 0.1;
+        let sigma = f / 0.01;
+        let expect = if eps <= eps0 * 0.998 {
+            p.ec * eps
+        } else if eps >= eps0 * 1.05 {
+            p.ftm * (-(eps - eps0) / alpha).exp()
+        } else {
+            continue; // the increment in which the crack forms
+        };
+        assert!(
+            (sigma - expect).abs() < 0.01 * p.ftm,
+            "ε = {eps:.3e}: σ = {sigma:.4e}, expected {expect:.4e}"
+        );
+    }
+    let last = t.rows.last().unwrap().1 / 0.01;
+    assert!(last < 0.05 * p.ftm, "softened to {last:.3e}");
+    // Crack strain recorded in the states: ε − σ/E on the crack axis ≈ total strain.
+    assert!(t.last_states.0 > 0.9 * eps_end);
+}
+
+/// Elastic 1.2 × 0.9 m block, 4 × 3 Q4 elements, every boundary node driven along the
+/// uniform strain field (εx, εy, γxy) = (1e-3, −4e-4, 6e-4); one straight bar from boundary
+/// to boundary through the centre at angle φ. The bar's nodal forces telescope to zero at
+/// interior nodes (exact integration in affine hosts), so the interior nodes stay on the
+/// linear field and the bar stress is E_s tᵀεt at every point: checked to 1e-9 (round-off)
+/// for several orientations, crossing 3–6 elements.
+#[test]
+fn bar_in_uniform_strain_carries_es_as_eps_in_any_orientation() {
+    let (ex, ey, g) = (1e-3, -4e-4, 6e-4);
+    let disp = |x: f64, y: f64| [ex * x + 0.5 * g * y, 0.5 * g * x + ey * y];
+    let (lx, ly) = (1.2, 0.9);
+    let mut supports = String::new();
+    let mut k = 0;
+    for i in 0..=4 {
+        for j in 0..=3 {
+            if i != 0 && i != 4 && j != 0 && j != 3 {
+                continue;
+            }
+            let (x, y) = (lx * i as f64 / 4.0, ly * j as f64 / 3.0);
+            let [u, v] = disp(x, y);
+            supports.push_str(&format!(
+                "[[supports]]\nname = \"b{k}\"\npoint = [{x}, {y}]\nux = {u:e}\nuy = {v:e}\n"
+            ));
+            k += 1;
+        }
+    }
+    for phi_deg in [0.0_f64, 30.0, 63.0, 90.0, 120.0] {
+        let phi = phi_deg.to_radians();
+        let (c, s) = (phi.cos(), phi.sin());
+        // Intersections of the line through the centre with the rectangle.
+        let (cx, cy) = (0.5 * lx, 0.5 * ly);
+        let tx = if c.abs() > 1e-12 {
+            cx / c.abs()
+        } else {
+            f64::INFINITY
+        };
+        let ty = if s.abs() > 1e-12 {
+            cy / s.abs()
+        } else {
+            f64::INFINITY
+        };
+        let t = tx.min(ty);
+        let (a, b) = ([cx - t * c, cy - t * s], [cx + t * c, cy + t * s]);
+        let text = format!(
+            r#"
+[[materials]]
+name = "host"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+
+[[materials]]
+name = "b500"
+kind = "rebar"
+E = 200e9
+fy = 500e6
+
+[[regions]]
+name = "r"
+material = "host"
+thickness = 0.2
+
+[mesh]
+type = "banded"
+length = {lx}
+nx = 4
+bands = [{{ region = "r", depth = {ly}, rows = 3 }}]
+
+{supports}
+
+[[bars]]
+name = "bar"
+path = [[{}, {}], [{}, {}]]
+area = 2e-4
+material = "b500"
+
+[[steps]]
+name = "stretch"
+kind = "load"
+"#,
+            a[0], a[1], b[0], b[1]
+        );
+        let m = model(&text);
+        assert!(m.bars[0].n_pieces >= 3, "crosses several elements");
+        let t = run(&m, 0);
+        let eb = c * c * ex + s * s * ey + c * s * g;
+        let sig = 200e9 * eb;
+        assert_eq!(t.bar_stress.len(), m.bars[0].points.len());
+        for s_b in &t.bar_stress {
+            assert!(
+                (s_b - sig).abs() <= 1e-9 * sig.abs(),
+                "φ = {phi_deg}°: σ_b = {s_b:e}, E ε_b = {sig:e}"
+            );
+        }
+        // Bar force E_s A_s ε_b [N].
+        let n_b = t.bar_stress[0] * m.bars[0].area;
+        assert!((n_b - 200e9 * 2e-4 * eb).abs() <= 1e-9 * n_b.abs());
+    }
+}
+
+/// Pre-tensioned bars in an elastic prism (1.0 × 0.2 m, thickness 0.2 m, one row of Q4)
+/// free to shorten; two bars of A_s/2 along the top and bottom edges, so that their end
+/// forces are the consistent forces of a uniform stress and the field is exactly uniform:
+/// equilibrium N_s + σ_c A_c = 0 and compatibility give the elastic shortening
+/// ε = −σ0 A_s/(E_c A_c + E_s A_s) and σ_s = σ0 + E_s ε (uniaxial: σy = 0 everywhere, so ν
+/// plays no part). Checked to 1e-9 relative (linear problem, one Newton correction).
+#[test]
+fn initial_stress_gives_elastic_shortening() {
+    let text = r#"
+[[materials]]
+name = "host"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+
+[[materials]]
+name = "strand"
+kind = "prestressing_steel"
+Ep = 195e9
+fptk = 1860e6
+
+[[regions]]
+name = "r"
+material = "host"
+thickness = 0.2
+
+[mesh]
+type = "banded"
+length = 1.0
+nx = 5
+bands = [{ region = "r", depth = 0.2, rows = 1 }]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.2]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+point = [0.0, 0.0]
+uy = 0.0
+
+[[bars]]
+name = "bottom"
+path = [[0.0, 0.0], [1.0, 0.0]]
+area = 0.5e-3
+material = "strand"
+initial_stress = 1000e6
+
+[[bars]]
+name = "top"
+path = [[0.0, 0.2], [1.0, 0.2]]
+area = 0.5e-3
+material = "strand"
+initial_stress = 1000e6
+
+[[steps]]
+name = "release"
+kind = "load"
+"#;
+    let m = model(text);
+    // Watch ux at the right end.
+    let right = m
+        .nodes
+        .iter()
+        .position(|p| (p[0] - 1.0).abs() < 1e-12 && p[1].abs() < 1e-12)
+        .unwrap();
+    let t = run(&m, 2 * right);
+    let eps = -1000e6 * 1e-3 / (30e9 * 0.04 + 195e9 * 1e-3);
+    let u = t.rows.last().unwrap().2;
+    assert!(
+        (u - eps).abs() <= 1e-9 * eps.abs(),
+        "u = {u:e}, expected {eps:e}"
+    );
+    for s in &t.bar_stress {
+        let expect = 1000e6 + 195e9 * eps;
+        assert!(
+            (s - expect).abs() <= 1e-9 * expect,
+            "σ_s = {s:e}, expected {expect:e}"
+        );
+    }
+}
+
+/// Snap-back: a concrete element (0.1 m long, Hinton softening α = 1e-4, ν = 0) in series
+/// with an elastic bar (1 m, E2 = 30 GPa), pulled by a line load λ·(1 MPa × 0.01 m²) at the
+/// free end. Known path (uniform uniaxial stress σ = λ MPa):
+/// before cracking δ = 0.1 σ/E_c + σ/E2; after, ε_c = ε0 + α ln(f_tm/σ) and
+/// δ = 0.1 ε_c + σ/E2 — δ decreases from the peak until σ* = h α E2/L (snap-back) and
+/// grows again below it. Load control and displacement control cannot pass this; arc
+/// length must, with negative pivots reported in softening. Tolerance 1e-3 of the peak
+/// displacement (the Newton tolerance 1e-6 on forces; the crack forms at the Ottosen
+/// strength = f_tm within 0.2 %).
+#[test]
+fn arc_length_passes_snap_back_on_known_path() {
+    let p = ConcreteParams::from_mc90(38e6, 0.0);
+    let (alpha, e2, h, l) = (3e-4, 30e9, 0.1, 1.0);
+    let text = format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 38e6
+nu = 0.0
+alpha = {alpha}
+
+[[materials]]
+name = "e"
+kind = "elastic"
+E = {e2}
+nu = 0.0
+
+[[regions]]
+name = "concrete"
+material = "c"
+thickness = 0.1
+
+[[regions]]
+name = "spring"
+material = "e"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [0.1, 0.0], [1.1, 0.0], [1.1, 0.1], [0.1, 0.1], [0.0, 0.1]]
+blocks = [
+  {{ region = "concrete", element = "Q4", elements = [[1, 2, 5, 6]] }},
+  {{ region = "spring", element = "Q4", elements = [[2, 3, 4, 5]] }},
+]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+
+[[load_cases]]
+name = "pull"
+line_loads = [{{ line = [[1.1, 0.0], [1.1, 0.1]], q = [1e5, 0.0] }}]
+
+[[steps]]
+name = "arc"
+kind = "arc_length"
+loads = {{ pull = 1.0 }}
+initial_increment = 0.2
+desired_iterations = 5
+max_growth = 1.0
+increments = 400
+stop_displacement = {{ node = 3, component = "x", value = 1.4e-4 }}
+"#
+    );
+    let m = model(&text);
+    let t = run(&m, 2 * 2); // node 3 (index 2), x
+    let (ft, ec, eps0) = (p.ftm, p.ec, p.ftm / p.ec);
+    let sigma_star = h * alpha * e2 / l;
+    let delta_peak = h * eps0 + ft / e2;
+    let mut cracked = false;
+    let mut went_back = false;
+    let (mut prev_d, mut prev_lam) = (0.0, 0.0);
+    let mut min_d = f64::INFINITY;
+    let mut saw_negative_pivots = false;
+    for &(_, _, d, neg, lam) in &t.rows {
+        let sigma = lam * 1e6;
+        // Before the peak λ only grows; once it falls the point is on the softening branch.
+        cracked |= lam < prev_lam;
+        if d < prev_d {
+            went_back = true;
+        }
+        let expect = if !cracked && sigma <= ft {
+            h * sigma / ec + sigma * l / e2
+        } else {
+            h * (eps0 + alpha * (ft / sigma).ln()) + sigma * l / e2
+        };
+        assert!(
+            (d - expect).abs() < 1e-3 * delta_peak,
+            "λ = {lam:.4}: δ = {d:.6e}, known path {expect:.6e}"
+        );
+        saw_negative_pivots |= neg > 0;
+        if lam * 1e6 > 0.5 * sigma_star {
+            min_d = min_d.min(d);
+        }
+        prev_d = d;
+        prev_lam = lam;
+    }
+    assert!(went_back, "the path must snap back (δ decreasing)");
+    assert!(saw_negative_pivots, "softening must show a negative pivot");
+    // The snap-back minimum was passed: the path came below δ(σ*) + 5 % and ended (stop
+    // displacement 1.4e-4 m, beyond the peak, on the rising branch after the minimum) with
+    // σ < σ*.
+    let d_star = h * (eps0 + alpha * (ft / sigma_star).ln()) + sigma_star * l / e2;
+    assert!(d_star < 0.8 * delta_peak, "the test problem must snap back");
+    assert!(min_d < d_star * 1.05, "min δ {min_d:e} vs δ* {d_star:e}");
+    let (_, _, d_end, _, lam_end) = *t.rows.last().unwrap();
+    assert!(d_end >= 1.4e-4 && lam_end * 1e6 < sigma_star);
+}
