@@ -91,6 +91,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
             factors: vec![1.0],
             increments: 1,
             output_every_increment: false,
+            time: None,
         }],
         controls: SolverControls::default(),
     };

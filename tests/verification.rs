@@ -79,6 +79,7 @@ fn model_from_mesh(
             factors: vec![1.0],
             increments: 1,
             output_every_increment: false,
+            time: None,
         }],
         controls: SolverControls::default(),
     }

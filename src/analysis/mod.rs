@@ -4,3 +4,4 @@ pub mod loads;
 pub mod solver;
 pub mod steps;
 pub mod system;
+pub mod time;

@@ -5,7 +5,8 @@ use super::loads::load_vector;
 use super::solver::{SolverError, SolverStats, SparseCholesky};
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
-use crate::model::{Model, StepKind};
+use crate::materials::point::TimeContext;
+use crate::model::{Model, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
 
 /// A converged increment, as observers see it.
@@ -97,6 +98,12 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
         u[d] = v;
     }
     let mut factored_linear = false;
+    // Analysis clock [d]: steps before the first time step act at its start.
+    let mut clock = model
+        .steps
+        .iter()
+        .find_map(|s| s.time.map(|t| t.from))
+        .unwrap_or(DEFAULT_START_DAY);
     for (si, step) in model.steps.iter().enumerate() {
         sys.stress_tendons(si);
         let start = factors.clone();
@@ -118,6 +125,13 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
                 }
             }
+            sys.begin_time_increment(match &step.time {
+                Some(span) => TimeContext {
+                    t_from: span.time_at(level),
+                    t_to: span.time_at(target),
+                },
+                None => TimeContext::at(clock),
+            });
             match newton(
                 &mut sys,
                 &mut solver,
@@ -169,6 +183,9 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     d_level *= 0.5;
                 }
             }
+        }
+        if let Some(span) = &step.time {
+            clock = span.to;
         }
     }
     timings.solver = solver.stats.clone();

@@ -6,7 +6,7 @@ use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{PointState, UpdateError};
+use crate::materials::point::{PointState, TimeContext, UpdateError};
 use crate::model::Model;
 use rayon::prelude::*;
 
@@ -52,6 +52,10 @@ pub struct System<'m> {
     pub tendon_committed: Vec<Option<TendonState>>,
     /// Trial tendon states.
     pub tendon_trial: Vec<Option<TendonState>>,
+    /// Time interval of the current increment on the analysis clock [d].
+    pub time: TimeContext,
+    /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
+    pub tendon_time: Vec<Option<super::time::TendonTime>>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -140,6 +144,8 @@ impl<'m> System<'m> {
             tendon_u0: vec![Vec::new(); model.tendons.len()],
             tendon_committed: vec![None; model.tendons.len()],
             tendon_trial: vec![None; model.tendons.len()],
+            time: TimeContext::default(),
+            tendon_time: vec![None; model.tendons.len()],
         }
     }
 
@@ -156,6 +162,7 @@ impl<'m> System<'m> {
         let mut f_int = vec![0.0; u.len()];
         let mut k_values = tangent.then(|| vec![0.0; self.asm.pattern.nnz()]);
         let n_el = model.elements.len();
+        let time = self.time;
         let mut start = 0;
         // Split the state arrays per element once per chunk so that chunks can be filled in
         // parallel without aliasing.
@@ -194,7 +201,7 @@ impl<'m> System<'m> {
                     let mut fe = vec![0.0; nd];
                     let mut ke = vec![0.0; nd * nd];
                     let c0 = gp_offset[e] - g0;
-                    continuum::response(
+                    continuum::response_with_time(
                         el.kind,
                         el.integration,
                         &coords,
@@ -206,6 +213,7 @@ impl<'m> System<'m> {
                         &mut ke,
                         t,
                         o,
+                        &time,
                     )
                     .map_err(|err| (e, err))?;
                     Ok((fe, ke))
@@ -328,6 +336,7 @@ impl<'m> System<'m> {
 
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
+        self.commit_time_dependent();
         self.u.copy_from_slice(u);
         std::mem::swap(&mut self.committed, &mut self.trial);
         self.trial.clone_from(&self.committed);

@@ -39,6 +39,14 @@ pub struct MaterialIn {
     pub e: Option<f64>,
     pub nu: Option<f64>,
     pub density: Option<f64>,
+    // elastic_creep (MC90 creep and shrinkage)
+    pub fcm: Option<f64>,
+    pub rh: Option<f64>,
+    pub h0: Option<f64>,
+    pub cement: Option<String>,
+    pub n_units: Option<usize>,
+    pub shrinkage: Option<bool>,
+    pub drying_start: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -47,6 +55,7 @@ pub struct RegionIn {
     pub name: String,
     pub material: String,
     pub thickness: f64,
+    pub cast_day: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -107,6 +116,7 @@ pub struct TendonIn {
     pub deviators: Option<String>,
     pub deviator_friction: Option<f64>,
     pub stressed_in_step: Option<String>,
+    pub relaxation_class: Option<i64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -186,6 +196,12 @@ pub struct StepIn {
     pub loads: BTreeMap<String, f64>,
     pub increments: Option<usize>,
     pub output: Option<String>,
+    // time steps
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+    pub duration: Option<f64>,
+    pub substeps: Option<usize>,
+    pub first_substep: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
