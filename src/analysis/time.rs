@@ -126,9 +126,10 @@ impl System<'_> {
                     lengths: el.reference_lengths().to_vec(),
                 });
             }
-            let (Some(tt), Some(committed)) =
-                (self.tendon_time[t].as_mut(), self.tendon_committed[t].as_ref())
-            else {
+            let (Some(tt), Some(committed)) = (
+                self.tendon_time[t].as_mut(),
+                self.tendon_committed[t].as_ref(),
+            ) else {
                 continue;
             };
             if tt.chains.iter().all(Option::is_none) {

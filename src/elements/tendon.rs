@@ -381,7 +381,11 @@ impl ExternalTendon {
     /// first is used). Used by time-dependent analyses to impose the steel relaxation as a
     /// stress-free strain; stresses follow at the next response. Panics on a length mismatch.
     pub fn set_initial_strains(&mut self, e: &[f64]) {
-        assert_eq!(e.len(), self.n_spans(), "tendon: one initial strain per span");
+        assert_eq!(
+            e.len(),
+            self.n_spans(),
+            "tendon: one initial strain per span"
+        );
         self.initial_strain.copy_from_slice(e);
     }
     /// Steel modulus E_p \[Pa\].

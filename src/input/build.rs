@@ -199,7 +199,6 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             thickness,
         });
     }
-    assign_cast_days(ctx, &file.regions, &mut regions, &mut materials, &mut warnings)?;
     let region_names = || regions.iter().map(|r| r.name.as_str());
     // Joint materials.
     unique_names(
@@ -216,12 +215,26 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .mesh
         .as_ref()
         .ok_or_else(|| ctx.err("mesh", "missing: give a [mesh] table"))?;
-    let (nodes, elements, joints) = if mesh.kind == "segmental" {
+    let (nodes, mut elements, joints) = if mesh.kind == "segmental" {
         build_segmental(mesh, ctx, &region_names)?
     } else {
         let (n, e) = build_mesh(mesh, ctx, &region_names)?;
         (n, e, Vec::new())
     };
+    let mut cast_days: Vec<Option<f64>> = file.regions.iter().map(|r| r.cast_day).collect();
+    if let Some(days) = &mesh.segment_cast_days {
+        segment_regions(
+            ctx,
+            mesh,
+            days,
+            &joints,
+            &nodes,
+            &mut elements,
+            &mut regions,
+            &mut cast_days,
+        )?;
+    }
+    assign_cast_days(ctx, &cast_days, &mut regions, &mut materials, &mut warnings)?;
     let mut model = Model {
         title: file.title.clone().unwrap_or_default(),
         nodes,
@@ -1397,14 +1410,23 @@ fn creep_material(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String
             "an elastic_creep material takes its modulus from fcm (MC90 E_ci); remove E",
         ));
     }
-    let fcm = positive(ctx, &k("fcm"), m.fcm.ok_or_else(|| ctx.err(k("fcm"), "missing [Pa]"))?)?;
+    let fcm = positive(
+        ctx,
+        &k("fcm"),
+        m.fcm.ok_or_else(|| ctx.err(k("fcm"), "missing [Pa]"))?,
+    )?;
     if !(5e6..=200e6).contains(&fcm) {
         return Err(ctx.err(
             k("fcm"),
             format!("{fcm} Pa is outside 5–200 MPa; segfem works in Pa (45 MPa = 45e6)"),
         ));
     }
-    let rh = m.rh.ok_or_else(|| ctx.err(k("rh"), "missing (relative humidity as a fraction, 0.7 = 70 %)"))?;
+    let rh = m.rh.ok_or_else(|| {
+        ctx.err(
+            k("rh"),
+            "missing (relative humidity as a fraction, 0.7 = 70 %)",
+        )
+    })?;
     if !(rh.is_finite() && rh > 0.0 && rh <= 1.0) {
         return Err(ctx.err(
             k("rh"),
@@ -1418,9 +1440,16 @@ fn creep_material(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String
             k("rh")
         ));
     }
-    let h0 = positive(ctx, &k("h0"), m.h0.ok_or_else(|| ctx.err(k("h0"), "missing (notional size 2 Ac/u [m])"))?)?;
+    let h0 = positive(
+        ctx,
+        &k("h0"),
+        m.h0.ok_or_else(|| ctx.err(k("h0"), "missing (notional size 2 Ac/u [m])"))?,
+    )?;
     if h0 > 5.0 {
-        return Err(ctx.err(k("h0"), format!("{h0} m is not a notional size 2 Ac/u in metres")));
+        return Err(ctx.err(
+            k("h0"),
+            format!("{h0} m is not a notional size 2 Ac/u in metres"),
+        ));
     }
     let cement = match m.cement.as_deref() {
         None | Some("N") => CementClass::N,
@@ -1463,8 +1492,12 @@ fn creep_material(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String
         ));
     }
     let p = CreepShrinkageParams::new(fcm, rh, h0, cement, drying_start);
-    let chain = MaxwellChain::fit(&p, n_units)
-        .map_err(|e| ctx.err(k("n_units"), format!("creep chain identification failed: {e}")))?;
+    let chain = MaxwellChain::fit(&p, n_units).map_err(|e| {
+        ctx.err(
+            k("n_units"),
+            format!("creep chain identification failed: {e}"),
+        )
+    })?;
     Ok(Material::AgeingViscoelastic {
         chain: std::sync::Arc::new(chain),
         nu,
@@ -1479,7 +1512,7 @@ fn creep_material(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String
 /// differ only in `cast_day`.
 fn assign_cast_days(
     ctx: &Ctx,
-    input: &[RegionIn],
+    input: &[Option<f64>],
     regions: &mut [Region],
     materials: &mut Vec<NamedMaterial>,
     warnings: &mut Vec<String>,
@@ -1489,12 +1522,15 @@ fn assign_cast_days(
     for (i, (r, region)) in input.iter().zip(regions.iter_mut()).enumerate() {
         let m = region.material;
         let creep = matches!(materials[m].law, Material::AgeingViscoelastic { .. });
-        let day = r.cast_day.unwrap_or(0.0);
+        let day = r.unwrap_or(0.0);
         if !day.is_finite() {
-            return Err(ctx.err(format!("regions[{i}].cast_day"), "must be a finite number of days"));
+            return Err(ctx.err(
+                format!("regions[{i}].cast_day"),
+                "must be a finite number of days",
+            ));
         }
         if !creep {
-            if r.cast_day.is_some() {
+            if r.is_some() {
                 warnings.push(format!(
                     "{}: regions[{i}].cast_day: ignored, material '{}' is not time dependent",
                     ctx.file, materials[m].name
@@ -1526,7 +1562,12 @@ fn assign_cast_days(
 
 /// Check that every creep region exists (is cast) when the analysis starts at `start` [d].
 fn check_ages(ctx: &Ctx, model: &Model, start: f64, warnings: &mut Vec<String>) -> R<()> {
+    let mut used = vec![false; model.regions.len()];
+    model.elements.iter().for_each(|e| used[e.region] = true);
     for (i, r) in model.regions.iter().enumerate() {
+        if !used[i] {
+            continue;
+        }
         if let Material::AgeingViscoelastic { cast_day, .. } = &model.materials[r.material].law {
             let age = start - cast_day;
             if age < 0.0 {
@@ -1631,4 +1672,65 @@ fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) -> R<TimeSpan
         first,
         substeps,
     })
+}
+
+/// `mesh.segment_cast_days`: one casting day per segment of a segmental mesh. Each band
+/// region is split into one region per segment ("webs@S2"), carrying that segment's day.
+#[allow(clippy::too_many_arguments)]
+fn segment_regions(
+    ctx: &Ctx,
+    mesh: &MeshIn,
+    days: &[f64],
+    joints: &[segmental::Joint],
+    nodes: &[[f64; 2]],
+    elements: &mut [Element],
+    regions: &mut Vec<Region>,
+    cast_days: &mut Vec<Option<f64>>,
+) -> R<()> {
+    if mesh.kind != "segmental" {
+        return Err(ctx.err(
+            "mesh.segment_cast_days",
+            "only for type = \"segmental\" (give cast_day per region otherwise)",
+        ));
+    }
+    let n_seg = joints.len() + 1;
+    if days.len() != n_seg {
+        return Err(ctx.err(
+            "mesh.segment_cast_days",
+            format!(
+                "give one day per segment: {} for {n_seg} segments",
+                days.len()
+            ),
+        ));
+    }
+    if let Some(i) = days.iter().position(|d| !d.is_finite()) {
+        return Err(ctx.err(
+            format!("mesh.segment_cast_days[{i}]"),
+            "must be a finite number of days",
+        ));
+    }
+    let n_base = regions.len();
+    let mut map: HashMap<(usize, usize), usize> = HashMap::new();
+    for el in elements.iter_mut() {
+        let xc = el.nodes.iter().map(|&n| nodes[n][0]).sum::<f64>() / el.nodes.len() as f64;
+        let seg = joints.iter().filter(|j| j.x < xc).count();
+        let key = (el.region, seg);
+        let idx = *map.entry(key).or_insert_with(|| {
+            let base = &regions[el.region];
+            regions.push(Region {
+                name: format!("{}@S{}", base.name, seg + 1),
+                material: base.material,
+                thickness: base.thickness,
+            });
+            cast_days.push(Some(days[seg]));
+            regions.len() - 1
+        });
+        el.region = idx;
+    }
+    // The band regions keep their names for monitors and output but no longer own elements;
+    // their own cast_day (if any) is superseded.
+    for d in cast_days.iter_mut().take(n_base) {
+        *d = None;
+    }
+    Ok(())
 }

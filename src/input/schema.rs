@@ -76,6 +76,7 @@ pub struct MeshIn {
     pub n_segments: Option<usize>,
     pub nx_per_segment: Option<usize>,
     pub joint_material: Option<String>,
+    pub segment_cast_days: Option<Vec<f64>>,
     // explicit
     #[serde(default)]
     pub nodes: Vec<[f64; 2]>,
