@@ -425,3 +425,117 @@ fn tendon_relaxation_at_constant_strain_follows_mc90() {
     let last = s0 - rec.last().unwrap().forces[0] / 1e-3;
     assert!(last > 0.05 * s0 && last < 0.09 * s0, "{last}");
 }
+
+/// The seed beam (examples/seed-beam.toml) with its elastic concrete replaced by the MC90
+/// creep material (fcm 45 MPa as the seed's E = 35.5 GPa implies, RH 70 %, h0 0.2 m),
+/// prestressed with self weight on day 28 and held for 1e4 days.
+fn seed_beam_creep(substeps: &str) -> String {
+    let seed = include_str!("../examples/seed-beam.toml");
+    let head = &seed[..seed.find("[[steps]]").unwrap()];
+    let text = head
+        .replace(
+            "kind = \"elastic\"\nE = 35.5e9          # MC90 Eci for fcm = 45 MPa",
+            "kind = \"elastic_creep\"\nfcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"",
+        )
+        .replace(
+            "deviators = \"held\"",
+            "deviators = \"held\"\nrelaxation_class = 2",
+        );
+    assert!(text.contains("elastic_creep") && text.contains("relaxation_class"));
+    format!(
+        r#"{text}
+[[steps]]
+name = "prestress"
+kind = "load"
+loads = {{ self_weight = 1.0 }}
+[[steps]]
+name = "long_term"
+kind = "time"
+from = 28.0
+duration = 1e4
+{substeps}
+"#
+    )
+}
+
+#[test]
+fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
+    use segfem::materials::mc90_time::creep_coefficient;
+    let text = seed_beam_creep("");
+    let rec = run(&text);
+    let p0 = rec[0].forces[0]; // after the instantaneous step [N]
+    let l = rec.last().unwrap().losses[0];
+    let fe_loss = l[2] + l[3]; // creep + shrinkage + relaxation [Pa]
+                               // Hand estimate, EC2 5.10.6 (2) (MC90 functions), with the stress and eccentricity
+                               // averaged along the unbonded tendon (EC2: mean strains along an unbonded tendon):
+                               // Δσ = [ε_cs E_p + 0.8 Δσ_pr + α φ σ_c] / [1 + α A_p/A_c (1 + A_c z²/I)(1 + 0.8 φ)].
+    let p = params(7.0);
+    let (t0, t) = (28.0, 28.0 + 1e4);
+    let phi = creep_coefficient(&p, t, t0);
+    let eps_cs = -(shrinkage_strain(&p, t) - shrinkage_strain(&p, t0));
+    let (ep, ap) = (195e9, 560e-6);
+    let alpha = ep / p.eci();
+    // Box section of the seed beam: bands (width, depth) bottom to top.
+    let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
+    let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for (b, h) in bands {
+        ac += b * h;
+        sy += b * h * (y0 + h / 2.0);
+        y0 += h;
+    }
+    let yc = sy / ac;
+    let mut ic = 0.0;
+    y0 = 0.0;
+    for (b, h) in bands {
+        ic += b * h * h * h / 12.0 + b * h * (y0 + h / 2.0 - yc).powi(2);
+        y0 += h;
+    }
+    let q = ac * 2548.4 * 9.81; // self weight [N/m]
+    let yp = |x: f64| {
+        if x < 2.4 {
+            0.30 - 0.2 * x / 2.4
+        } else if x > 4.8 {
+            0.10 + 0.2 * (x - 4.8) / 2.4
+        } else {
+            0.10
+        }
+    };
+    let n = 7200;
+    let (mut sc, mut z2) = (0.0, 0.0);
+    for i in 0..=n {
+        let x = 7.2 * i as f64 / n as f64;
+        let w = if i == 0 || i == n { 0.5 } else { 1.0 } / n as f64;
+        let z = yc - yp(x);
+        let m = q * x * (7.2 - x) / 2.0;
+        sc += w * (p0 / ac + p0 * z * z / ic - m * z / ic); // compression positive
+        z2 += w * z * z;
+    }
+    let rho = segfem::materials::mc90_time::relaxation_loss(
+        segfem::materials::mc90_time::RelaxationClass::Class2,
+        p0 / ap / 1900e6,
+        t - t0,
+    ) * p0
+        / ap;
+    let hand = (eps_cs * ep + 0.8 * rho + alpha * phi * sc)
+        / (1.0 + alpha * ap / ac * (1.0 + ac * z2 / ic) * (1.0 + 0.8 * phi));
+    eprintln!(
+        "seed beam: P0 = {p0:.0} N, σc = {sc:.3e} Pa, φ = {phi:.3}, ε_cs = {eps_cs:.3e}, ρ = {rho:.3e}; loss FE {fe_loss:.4e} Pa (creep+shrinkage {:.4e}, relaxation {:.4e}) vs EC2 {hand:.4e} Pa",
+        l[2], l[3]
+    );
+    // 15 %: the EC2 formula is a sectional age-adjusted-modulus estimate with a fixed ageing
+    // coefficient 0.8 (the chain's effective value depends on t0 and duration, 0.6–0.9), it
+    // smears the varying eccentricity into mean values and ignores the box's shear lag and
+    // the joints; a missing shrinkage (≈ 40 % of the loss here) or creep term fails it.
+    assert!(
+        (fe_loss / hand - 1.0).abs() < 0.15,
+        "FE {fe_loss} vs EC2 {hand}"
+    );
+    // At 0.46 f_ptk the MC90 relaxation is zero.
+    assert!(rho == 0.0 && l[3] == 0.0);
+    // The prestress loss over 1e4 days is a few percent to ~15 % of σp0: a sanity bound.
+    let s0 = p0 / ap;
+    assert!(
+        fe_loss > 0.03 * s0 && fe_loss < 0.2 * s0,
+        "{fe_loss} of {s0}"
+    );
+}
