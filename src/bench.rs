@@ -92,6 +92,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
             increments: 1,
             output_every_increment: false,
             path: None,
+            time: None,
         }],
         controls: SolverControls::default(),
         bars: Vec::new(),

@@ -20,6 +20,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/seed-beam.toml"),
     ),
     (
+        "creep-beam",
+        "the seed beam with MC90 creep, shrinkage and relaxation over 10 000 days",
+        include_str!("../examples/creep-beam.toml"),
+    ),
+    (
         "segmental-decompression",
         "three dry-jointed segments, eccentric axial force, bent until the joints open",
         include_str!("../examples/segmental-decompression.toml"),

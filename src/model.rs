@@ -5,6 +5,7 @@ use crate::elements::continuum::Integration;
 use crate::elements::interface::InterfaceParams;
 use crate::elements::tendon::DeviatorMode;
 use crate::fem::shape::QuadKind;
+use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 use serde::Serialize;
 
@@ -163,6 +164,27 @@ pub enum MonitorKind {
         /// Region index.
         region: Option<usize>,
     },
+    /// Prestress loss of a tendon since stressing, length-weighted mean over its spans
+    /// [Pa] (positive = loss), total or one part of the split (docs/theory-time.md).
+    TendonLoss {
+        /// Tendon index.
+        tendon: usize,
+        /// Which part.
+        part: LossPart,
+    },
+}
+
+/// Part of a tendon's prestress loss (the parts add up to the total).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum LossPart {
+    /// Everything since stressing.
+    Total,
+    /// Instantaneous (load-step) changes: elastic shortening by later tendons, loads.
+    Elastic,
+    /// Changes during time steps from the concrete deformation (creep and shrinkage).
+    CreepShrinkage,
+    /// Relaxation of the steel (stress drop of the chain at the current strain).
+    Relaxation,
 }
 
 /// A named monitor: one column of `history.csv`.
@@ -190,6 +212,7 @@ impl Monitor {
             MonitorKind::MaxCrackStrain { .. }
             | MonitorKind::MaxPlasticStrain { .. }
             | MonitorKind::CrushedPoints { .. } => "-",
+            MonitorKind::TendonLoss { .. } => "Pa",
         }
     }
 }
@@ -205,6 +228,49 @@ pub enum StepKind {
     Displacement,
     /// Arc-length path following (see [`ArcLengthControl`]).
     ArcLength,
+    /// Time step: loads held, the analysis clock advanced in log-spaced substeps (creep,
+    /// shrinkage, relaxation); Newton–Raphson per substep. Times in [`Step::time`].
+    Time,
+}
+
+/// Analysis time [d] at which the analysis starts when no time step says otherwise (the
+/// `from` of the first time step overrides it): loading at 28 days on the analysis clock.
+pub const DEFAULT_START_DAY: f64 = 28.0;
+
+/// The time interval of a time step on the analysis clock [days], split into `substeps`
+/// substeps whose durations since `from` grow geometrically from `first` to `to − from`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TimeSpan {
+    /// Start [d].
+    pub from: f64,
+    /// End [d] (> `from`).
+    pub to: f64,
+    /// Duration of the first substep [d] (0 < first ≤ to − from).
+    pub first: f64,
+    /// Number of substeps (≥ 1).
+    pub substeps: usize,
+}
+
+impl TimeSpan {
+    /// Analysis time [d] at the fraction `level` ∈ [0, 1] of the step: substep k ends at
+    /// level k/n; within the first substep time is linear in level, later substeps are
+    /// geometric (log-spaced durations since `from`). Continuous and increasing, so halving
+    /// a level interval (a cut) halves it in log time.
+    pub fn time_at(&self, level: f64) -> f64 {
+        if level >= 1.0 {
+            return self.to;
+        }
+        let n = self.substeps.max(1);
+        let d = self.to - self.from;
+        let x = level.max(0.0) * n as f64;
+        if n == 1 {
+            return self.from + d * level.max(0.0);
+        }
+        if x <= 1.0 {
+            return self.from + self.first * x;
+        }
+        self.from + self.first * (d / self.first).powf((x - 1.0) / (n as f64 - 1.0))
+    }
 }
 
 /// An analysis step: load factors are the totals reached at the end of the step, reached
@@ -223,6 +289,9 @@ pub struct Step {
     pub output_every_increment: bool,
     /// Path-following control (displacement and arc-length steps).
     pub path: Option<PathControl>,
+    /// Time interval of a [`StepKind::Time`] step (None for load steps, which act
+    /// instantaneously at the current time).
+    pub time: Option<TimeSpan>,
 }
 
 /// Newton and step-cutting controls.
@@ -307,6 +376,8 @@ pub struct TendonEl {
     pub mode: DeviatorMode,
     /// Index of the step at whose start the tendon is stressed.
     pub stressed_in_step: usize,
+    /// Relaxation class of the steel (None = no relaxation).
+    pub relaxation: Option<RelaxationClass>,
 }
 
 /// The complete validated model.

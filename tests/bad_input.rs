@@ -504,6 +504,32 @@ fn unknown_step_kind() {
 }
 
 #[test]
+fn time_step_with_loads() {
+    let model = edit(EXPLICIT, "kind = \"linear\"", "kind = \"time\"\nto = 100.0");
+    rejects(
+        &model,
+        "steps[0].loads",
+        &["holds the loads at their previous factors"],
+    );
+}
+
+#[test]
+fn time_step_ending_before_it_starts() {
+    let model = edit(
+        EXPLICIT,
+        "kind = \"linear\"\nloads = { P = 1.0 }",
+        "kind = \"time\"\nfrom = 28.0\nto = 20.0",
+    );
+    rejects(&model, "steps[0].to", &["must be later than from = 28 d"]);
+}
+
+#[test]
+fn creep_key_on_elastic_material() {
+    let model = edit(EXPLICIT, "nu = 0.2", "nu = 0.2\nfcm = 45e6");
+    rejects(&model, "materials[0].fcm", &["not a key of kind 'elastic'"]);
+}
+
+#[test]
 fn monitor_naming_unknown_support() {
     let model = edit(EXPLICIT, "support = \"left\"", "support = \"middle\"");
     rejects(

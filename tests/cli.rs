@@ -654,8 +654,9 @@ fn box_beam_vtu_files_are_complete() {
                 _ => {}
             }
         }
-        // Points, 3 cell arrays, 5 point arrays, 3 cell-data arrays.
-        assert_eq!(n_arrays, 12, "{f}");
+        // Points, 3 cell arrays, 5 point arrays, and at least the 3 continuum cell-data
+        // arrays (region, stress, strain; concrete state arrays may follow).
+        assert!(n_arrays >= 12, "{f}: {n_arrays} arrays");
         let f64s = |key: &str| -> Vec<f64> {
             arrays[key]
                 .chunks(8)

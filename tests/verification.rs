@@ -80,6 +80,7 @@ fn model_from_mesh(
             increments: 1,
             output_every_increment: false,
             path: None,
+            time: None,
         }],
         controls: SolverControls::default(),
         bars: Vec::new(),

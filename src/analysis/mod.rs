@@ -5,3 +5,4 @@ pub mod path;
 pub mod solver;
 pub mod steps;
 pub mod system;
+pub mod time;

@@ -5,7 +5,8 @@ use super::loads::load_vector;
 use super::solver::{SolverError, SolverStats, SparseCholesky};
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
-use crate::model::{Model, StepKind};
+use crate::materials::point::TimeContext;
+use crate::model::{Model, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
 
 /// A converged increment, as observers see it.
@@ -108,6 +109,12 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
     }
     let mut factored_linear = false;
     let mut neg_pivots = 0;
+    // Analysis clock [d]: steps before the first time step act at its start.
+    let mut clock = model
+        .steps
+        .iter()
+        .find_map(|s| s.time.map(|t| t.from))
+        .unwrap_or(DEFAULT_START_DAY);
     for (si, step) in model.steps.iter().enumerate() {
         sys.stress_tendons(si);
         if matches!(step.kind, StepKind::Displacement | StepKind::ArcLength) {
@@ -142,6 +149,13 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
                 }
             }
+            sys.begin_time_increment(match &step.time {
+                Some(span) => TimeContext {
+                    t_from: span.time_at(level),
+                    t_to: span.time_at(target),
+                },
+                None => TimeContext::at(clock),
+            });
             match newton(
                 &mut sys,
                 &mut solver,
@@ -204,6 +218,9 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
                     d_level *= 0.5;
                 }
             }
+        }
+        if let Some(span) = &step.time {
+            clock = span.to;
         }
     }
     timings.solver = solver.stats.clone();
@@ -283,8 +300,9 @@ pub(super) fn newton(
         let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
         let rf = sys.to_free(&r);
         let rnorm = norm(&rf);
-        // Reference: the larger of the external and internal force norms (reactions count).
-        let reference = norm(f_ext).max(norm(&a.f_int)).max(f64::MIN_POSITIVE);
+        // Reference: the larger of the external force norm and the scale of the element
+        // forces (which stays finite under self-equilibrated prestress).
+        let reference = norm(f_ext).max(a.force_scale).max(f64::MIN_POSITIVE);
         let rel = rnorm / reference;
         if !rel.is_finite() {
             history.push(rel);

@@ -7,7 +7,7 @@ use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{crack_base, PointState, UpdateError};
+use crate::materials::point::{crack_base, PointState, TimeContext, UpdateError};
 use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::Model;
 use rayon::prelude::*;
@@ -71,6 +71,10 @@ pub struct System<'m> {
     /// updates start from until the increment ends (sorted by point index; see
     /// [`crate::materials::point::crack_base`]).
     pub latched: Vec<(usize, PointState)>,
+    /// Time interval of the current increment on the analysis clock [d].
+    pub time: TimeContext,
+    /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
+    pub tendon_time: Vec<Option<super::time::TendonTime>>,
 }
 
 /// Values at one bar integration point for output.
@@ -104,6 +108,10 @@ pub struct Assembled {
     pub f_int: Vec<f64>,
     /// Lower-triangle tangent values over free equations, if requested.
     pub k_values: Option<Vec<f64>>,
+    /// Euclidean norm of the per-dof sums of the absolute element contributions [N]: the
+    /// force scale for convergence checks, also when the loading is self-equilibrated
+    /// (prestress alone), where f_int itself tends to zero.
+    pub force_scale: f64,
 }
 
 impl<'m> System<'m> {
@@ -194,6 +202,8 @@ impl<'m> System<'m> {
             bar_out: vec![BarOutput::default(); n_bp],
             bar_out_trial: vec![BarOutput::default(); n_bp],
             latched: Vec::new(),
+            time: TimeContext::default(),
+            tendon_time: vec![None; model.tendons.len()],
         }
     }
 
@@ -239,8 +249,10 @@ impl<'m> System<'m> {
     ) -> Result<Assembled, (usize, UpdateError)> {
         let model = self.model;
         let mut f_int = vec![0.0; u.len()];
+        let mut f_abs = vec![0.0; u.len()];
         let mut k_values = tangent.then(|| vec![0.0; self.asm.pattern.nnz()]);
         let n_el = model.elements.len();
+        let time = self.time;
         let mut start = 0;
         // Split the state arrays per element once per chunk so that chunks can be filled in
         // parallel without aliasing.
@@ -308,7 +320,7 @@ impl<'m> System<'m> {
                             }
                             v
                         });
-                    continuum::response(
+                    continuum::response_with_time(
                         el.kind,
                         el.integration,
                         &coords,
@@ -320,6 +332,7 @@ impl<'m> System<'m> {
                         &mut ke,
                         t,
                         o,
+                        &time,
                     )
                     .map_err(|err| (e, err))?;
                     // Embedded bars hosted by this element: uniaxial steel at each point,
@@ -364,6 +377,8 @@ impl<'m> System<'m> {
                 for (a, &n) in model.elements[e].nodes.iter().enumerate() {
                     f_int[2 * n] += fe[2 * a];
                     f_int[2 * n + 1] += fe[2 * a + 1];
+                    f_abs[2 * n] += fe[2 * a].abs();
+                    f_abs[2 * n + 1] += fe[2 * a + 1].abs();
                 }
                 if let Some(k) = k_values.as_mut() {
                     self.asm.add_matrix(e, &ke, k);
@@ -393,6 +408,8 @@ impl<'m> System<'m> {
             for (a, &n) in nodes.iter().enumerate() {
                 f_int[2 * n] += r.f_int[2 * a];
                 f_int[2 * n + 1] += r.f_int[2 * a + 1];
+                f_abs[2 * n] += r.f_int[2 * a].abs();
+                f_abs[2 * n + 1] += r.f_int[2 * a + 1].abs();
             }
             if let Some(k) = k_values.as_mut() {
                 let mut ke = r.k;
@@ -422,6 +439,8 @@ impl<'m> System<'m> {
             for (a, &n) in nodes.iter().enumerate() {
                 f_int[2 * n] += r.f_int[2 * a];
                 f_int[2 * n + 1] += r.f_int[2 * a + 1];
+                f_abs[2 * n] += r.f_int[2 * a].abs();
+                f_abs[2 * n + 1] += r.f_int[2 * a + 1].abs();
             }
             if let Some(k) = k_values.as_mut() {
                 let mut ke = r.k;
@@ -434,7 +453,12 @@ impl<'m> System<'m> {
             self.tendon_trial[t] = Some(r.state);
         }
         self.symmetrised = symmetrised;
-        Ok(Assembled { f_int, k_values })
+        let force_scale = f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        Ok(Assembled {
+            f_int,
+            k_values,
+            force_scale,
+        })
     }
 
     /// Stress the tendons assigned to step `step`: each is built on the current deformed
@@ -475,6 +499,7 @@ impl<'m> System<'m> {
 
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
+        self.commit_time_dependent();
         self.u.copy_from_slice(u);
         std::mem::swap(&mut self.committed, &mut self.trial);
         self.trial.clone_from(&self.committed);

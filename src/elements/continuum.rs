@@ -3,7 +3,7 @@
 
 use crate::fem::quadrature::{gauss, gauss_square, Point2};
 use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, QuadKind, MAX_NODES};
-use crate::materials::point::{update, Material, PointState, UpdateError};
+use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
 use serde::{Deserialize, Serialize};
 
 /// Integration rule of a continuum element.
@@ -89,6 +89,39 @@ pub fn response(
     trial: &mut [PointState],
     out: &mut [GaussOutput],
 ) -> Result<(), UpdateError> {
+    response_with_time(
+        kind,
+        integration,
+        coords,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        &TimeContext::default(),
+    )
+}
+
+/// As [`response`] for the time increment `time` (analysis clock, days), which the
+/// material points of time-dependent materials need (creep, shrinkage).
+#[allow(clippy::too_many_arguments)]
+pub fn response_with_time(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
+    k: &mut [f64],
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);
@@ -112,7 +145,7 @@ pub fn response(
             eps[1] += dn[a][1] * uy;
             eps[2] += dn[a][1] * ux + dn[a][0] * uy;
         }
-        let (st, sig, d) = update(mat, &committed[g], &eps, h)?;
+        let (st, sig, d) = update_with_time(mat, &committed[g], &eps, h, time)?;
         trial[g] = st;
         out[g] = GaussOutput {
             strain: eps,

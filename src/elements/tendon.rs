@@ -373,6 +373,25 @@ impl ExternalTendon {
     pub fn initial_stresses(&self) -> &[f64] {
         &self.initial_stress
     }
+    /// Initial (prestress) span strains ε0_i \[-\].
+    pub fn initial_strains(&self) -> &[f64] {
+        &self.initial_strain
+    }
+    /// Replace the initial span strains ε0_i \[-\] (one per span; for `Frictionless` only the
+    /// first is used). Used by time-dependent analyses to impose the steel relaxation as a
+    /// stress-free strain; stresses follow at the next response. Panics on a length mismatch.
+    pub fn set_initial_strains(&mut self, e: &[f64]) {
+        assert_eq!(
+            e.len(),
+            self.n_spans(),
+            "tendon: one initial strain per span"
+        );
+        self.initial_strain.copy_from_slice(e);
+    }
+    /// Steel modulus E_p \[Pa\].
+    pub fn modulus(&self) -> f64 {
+        self.modulus
+    }
     /// Tendon area A_p \[m²\].
     pub fn area(&self) -> f64 {
         self.area

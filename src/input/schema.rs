@@ -70,6 +70,13 @@ pub struct MaterialIn {
     pub ep: Option<f64>,
     pub fptk: Option<f64>,
     pub eps_uk: Option<f64>,
+    // elastic_creep (MC90 creep and shrinkage)
+    pub rh: Option<f64>,
+    pub h0: Option<f64>,
+    pub cement: Option<String>,
+    pub n_units: Option<usize>,
+    pub shrinkage: Option<bool>,
+    pub drying_start: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -78,6 +85,7 @@ pub struct RegionIn {
     pub name: String,
     pub material: String,
     pub thickness: f64,
+    pub cast_day: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -102,6 +110,7 @@ pub struct MeshIn {
     pub file: Option<String>,
     #[serde(default)]
     pub joints: Vec<GmshJointIn>,
+    pub segment_cast_days: Option<Vec<f64>>,
     // explicit
     #[serde(default)]
     pub nodes: Vec<[f64; 2]>,
@@ -149,6 +158,7 @@ pub struct TendonIn {
     pub deviators: Option<String>,
     pub deviator_friction: Option<f64>,
     pub stressed_in_step: Option<String>,
+    pub relaxation_class: Option<i64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -238,6 +248,12 @@ pub struct StepIn {
     pub max_growth: Option<f64>,
     pub target_factor: Option<f64>,
     pub stop_displacement: Option<ControlIn>,
+    // time steps
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+    pub duration: Option<f64>,
+    pub substeps: Option<usize>,
+    pub first_substep: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

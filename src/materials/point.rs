@@ -1,9 +1,12 @@
 //! The material-point dispatcher: the closed set of continuum material kinds, their state,
 //! and one update function used by every continuum element.
 
+use super::chain::{chain_step, plane_stress_d1, ChainState, MaxwellChain};
 use super::concrete::{self, ConcreteParams, ConcreteState};
 use super::elastic::{mul3, plane_stress_d};
+use super::mc90_time::shrinkage_strain;
 use serde::Serialize;
+use std::sync::Arc;
 
 /// A continuum (plane-stress) material.
 #[derive(Debug, Clone, Serialize)]
@@ -25,6 +28,21 @@ pub enum Material {
         /// Density [kg/m³].
         density: f64,
     },
+    /// Ageing linear viscoelastic concrete: MC90 creep through an ageing Maxwell chain and,
+    /// optionally, MC90 shrinkage as an imposed strain (docs/theory-time.md, "In the engine").
+    AgeingViscoelastic {
+        /// The chain identified from the MC90 compliance (shared; unit moduli cached per age).
+        #[serde(skip)]
+        chain: Arc<MaxwellChain>,
+        /// Poisson ratio [-] (constant, isotropic creep).
+        nu: f64,
+        /// Density [kg/m³].
+        density: f64,
+        /// Day of casting on the analysis clock [d]; concrete age = analysis time − cast_day.
+        cast_day: f64,
+        /// Include MC90 shrinkage (from the drying start age of the chain's parameters).
+        shrinkage: bool,
+    },
 }
 
 impl Material {
@@ -33,6 +51,7 @@ impl Material {
         match self {
             Material::Elastic { density, .. } => *density,
             Material::Concrete { density, .. } => *density,
+            Material::AgeingViscoelastic { density, .. } => *density,
         }
     }
 
@@ -41,6 +60,8 @@ impl Material {
         match self {
             Material::Elastic { e, .. } => *e,
             Material::Concrete { params, .. } => params.ec,
+            // The 28-day tangent modulus E_ci of MC90.
+            Material::AgeingViscoelastic { chain, .. } => chain.params().eci(),
         }
     }
 
@@ -49,6 +70,10 @@ impl Material {
         match self {
             Material::Elastic { .. } => PointState::Elastic,
             Material::Concrete { .. } => PointState::Concrete(Box::default()),
+            Material::AgeingViscoelastic { chain, .. } => PointState::Ageing {
+                chain: ChainState::new(chain.n_units()),
+                strain: [0.0; 3],
+            },
         }
     }
 
@@ -66,6 +91,13 @@ pub enum PointState {
     Elastic,
     /// Concrete point (boxed: keeps the enum small for elastic models).
     Concrete(Box<ConcreteState>),
+    /// Ageing viscoelastic concrete: the chain's unit stresses and the committed total strain.
+    Ageing {
+        /// Hidden unit stresses σ_μ [Pa]; the point's stress is their sum.
+        chain: ChainState,
+        /// Total strain (εx, εy, γxy) at the end of the step that produced this state [-].
+        strain: [f64; 3],
+    },
 }
 
 impl PointState {
@@ -73,7 +105,7 @@ impl PointState {
     pub fn concrete(&self) -> Option<&ConcreteState> {
         match self {
             PointState::Concrete(c) => Some(c),
-            PointState::Elastic => None,
+            _ => None,
         }
     }
 
@@ -114,6 +146,29 @@ impl PointState {
     }
 }
 
+/// The time interval of the current increment on the analysis clock [days]. A load step is
+/// an instantaneous increment (`t_from == t_to`) at the current time; a time step advances
+/// the clock. Concrete ages follow as time − cast_day of the material.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct TimeContext {
+    /// Analysis time at the start of the increment [d].
+    pub t_from: f64,
+    /// Analysis time at the end of the increment [d] (≥ `t_from`).
+    pub t_to: f64,
+}
+
+impl TimeContext {
+    /// An instantaneous increment at time `t` [d].
+    pub fn at(t: f64) -> Self {
+        Self { t_from: t, t_to: t }
+    }
+
+    /// Length of the increment Δt [d].
+    pub fn dt(&self) -> f64 {
+        self.t_to - self.t_from
+    }
+}
+
 /// Why a material update failed (the increment is then cut).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UpdateError {
@@ -127,11 +182,29 @@ pub type Update = (PointState, [f64; 3], [[f64; 3]; 3]);
 
 /// Stress update from the committed state and the total strain (εx, εy, γxy).
 /// `char_length` [m] is the element's characteristic length (crack band).
+///
+/// Time-dependent materials see an instantaneous increment at time 0 (see
+/// [`update_with_time`]).
 pub fn update(
     mat: &Material,
     committed: &PointState,
     strain: &[f64; 3],
     char_length: f64,
+) -> Result<Update, UpdateError> {
+    update_with_time(mat, committed, strain, char_length, &TimeContext::default())
+}
+
+/// As [`update`] for the increment `time` (analysis clock in days). Time-independent
+/// materials ignore `time`; the ageing viscoelastic point takes one exponential-algorithm
+/// step of its Maxwell chain from age `time.t_from − cast_day` to `time.t_to − cast_day`,
+/// with the shrinkage increment of that interval as an imposed strain. Its tangent is the
+/// incremental modulus E'' D1(ν), constant within the increment.
+pub fn update_with_time(
+    mat: &Material,
+    committed: &PointState,
+    strain: &[f64; 3],
+    char_length: f64,
+    time: &TimeContext,
 ) -> Result<Update, UpdateError> {
     match (mat, committed) {
         (Material::Elastic { e, nu, .. }, PointState::Elastic) => {
@@ -152,6 +225,50 @@ pub fn update(
                 }
             }
             Ok((PointState::Concrete(Box::new(st)), sig, d))
+        }
+        (
+            Material::AgeingViscoelastic {
+                chain,
+                nu,
+                cast_day,
+                shrinkage,
+                ..
+            },
+            PointState::Ageing {
+                chain: state,
+                strain: eps0,
+            },
+        ) => {
+            let (a0, a1) = (time.t_from - cast_day, time.t_to - cast_day);
+            if !(a1 >= a0 && a0.is_finite() && a1.is_finite()) {
+                return Err(UpdateError::NotConverged(format!(
+                    "ageing concrete: bad time interval {} → {} d",
+                    time.t_from, time.t_to
+                )));
+            }
+            let d_eps = [
+                strain[0] - eps0[0],
+                strain[1] - eps0[1],
+                strain[2] - eps0[2],
+            ];
+            let d_sh = if *shrinkage && a1 > a0 {
+                let p = chain.params();
+                shrinkage_strain(p, a1) - shrinkage_strain(p, a0)
+            } else {
+                0.0
+            };
+            let st = chain_step(chain, *nu, state, a0, a1, &d_eps, d_sh);
+            let d1 = plane_stress_d1(*nu);
+            let d = d1.map(|r| r.map(|v| v * st.e_incr));
+            let sigma = st.new_state.stress();
+            Ok((
+                PointState::Ageing {
+                    chain: st.new_state,
+                    strain: *strain,
+                },
+                sigma,
+                d,
+            ))
         }
         // States are created by `Material::initial_state`, so a mismatch is a programming
         // error; report it as a failed update rather than panicking.

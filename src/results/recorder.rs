@@ -19,6 +19,8 @@ pub struct Row {
     pub increment: usize,
     /// Newton iterations.
     pub iterations: usize,
+    /// Analysis time at the end of the increment [d].
+    pub time: f64,
     /// Load-case factors.
     pub factors: Vec<f64>,
     /// Monitor values, in model order.
@@ -57,7 +59,7 @@ impl<'m> Recorder<'m> {
 
     /// The CSV text of the history (header with units).
     pub fn history_csv(&self) -> String {
-        let mut s = String::from("step,increment,iterations");
+        let mut s = String::from("step,increment,iterations,time [d]");
         for c in &self.model.load_cases {
             s.push_str(&format!(",factor:{} [-]", c.name));
         }
@@ -76,7 +78,13 @@ impl<'m> Recorder<'m> {
         }
         s.push('\n');
         for r in &self.rows {
-            s.push_str(&format!("{},{},{}", r.step + 1, r.increment, r.iterations));
+            s.push_str(&format!(
+                "{},{},{},{:e}",
+                r.step + 1,
+                r.increment,
+                r.iterations,
+                r.time
+            ));
             for v in r.factors.iter().chain(&r.monitors) {
                 s.push_str(&format!(",{v:e}"));
             }
@@ -130,6 +138,10 @@ impl<'m> Recorder<'m> {
                 MonitorKind::TendonForce { tendon } => snap.system.tendon_committed[*tendon]
                     .as_ref()
                     .map(|st| st.forces().into_iter().fold(0.0, f64::max))
+                    .unwrap_or(0.0),
+                MonitorKind::TendonLoss { tendon, part } => snap.system.tendon_time[*tendon]
+                    .as_ref()
+                    .map(|tt| tt.loss(*part))
                     .unwrap_or(0.0),
                 MonitorKind::JointOpening { joint } => joints_of(*joint)
                     .map(|j| summarise(snap.system, j).max_opening)
@@ -296,6 +308,7 @@ impl Observer for Recorder<'_> {
             step: snap.step,
             increment: snap.increment,
             iterations: snap.iterations,
+            time: snap.system.time.t_to,
             factors: snap.factors.to_vec(),
             monitors,
             negative_pivots: snap.negative_pivots,

@@ -1,0 +1,193 @@
+//! Time-dependent analysis in the engine: the analysis clock of the increments, the
+//! relaxation of the external tendons' steel, and the split of the prestress losses
+//! (docs/theory-time.md, "In the engine").
+//!
+//! Relaxation is imposed on the tendon as a stress-free strain R_i per span: at the start of
+//! each increment of length Δt the non-ageing steel chain of the span
+//! ([`SteelRelaxationChain`], fitted to the MC90 loss at the span's initial stress ratio)
+//! gives the stress drop at constant strain, Σ_μ (1 − e^{−Δt/τ_μ}) σ_μ; R grows by that drop
+//! over E_p (plus the small difference between the tendon's elastic stress and the chain
+//! stress, so the two never drift apart). After convergence the chain is advanced with the
+//! span's actual total steel strain increment (exponential algorithm), i.e. relaxation
+//! follows the varying strain the tendon sees as concrete creeps and shrinks.
+//!
+//! Units: days, Pa, strains dimensionless.
+
+use super::system::System;
+use crate::materials::chain::SteelRelaxationChain;
+use crate::materials::point::TimeContext;
+use crate::model::LossPart;
+
+/// Time-dependent record of one tendon span.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpanTime {
+    /// Span stress just after stressing [Pa].
+    pub sigma_initial: f64,
+    /// Initial (prestress) strain at stressing, before relaxation [-].
+    pub eps0: f64,
+    /// Committed accumulated relaxation strain R [-].
+    pub relax_strain: f64,
+    /// R of the current (trial) increment [-].
+    pub relax_strain_trial: f64,
+    /// Committed total steel strain the chain has seen [-].
+    pub steel_strain: f64,
+    /// Chain unit stresses [Pa] (empty without relaxation).
+    pub hidden: Vec<f64>,
+    /// Stress drop at constant strain of the current increment [Pa].
+    pub relax_drop: f64,
+    /// Loss from instantaneous increments (load steps) [Pa].
+    pub loss_elastic: f64,
+    /// Loss during time steps not due to relaxation (concrete creep and shrinkage) [Pa].
+    pub loss_creep: f64,
+    /// Loss by relaxation of the steel [Pa].
+    pub loss_relax: f64,
+}
+
+/// Time-dependent record of one external tendon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TendonTime {
+    /// One entry per span.
+    pub spans: Vec<SpanTime>,
+    /// Relaxation chain per span (None: relaxation off or stress ≤ 0.5 f_ptk).
+    pub chains: Vec<Option<SteelRelaxationChain>>,
+    /// Reference span lengths [m] (weights of the mean loss).
+    pub lengths: Vec<f64>,
+}
+
+impl TendonTime {
+    /// Length-weighted mean over the spans of a loss part [Pa].
+    pub fn loss(&self, part: LossPart) -> f64 {
+        let lt: f64 = self.lengths.iter().sum();
+        self.spans
+            .iter()
+            .zip(&self.lengths)
+            .map(|(s, l)| {
+                l * match part {
+                    LossPart::Total => s.loss_elastic + s.loss_creep + s.loss_relax,
+                    LossPart::Elastic => s.loss_elastic,
+                    LossPart::CreepShrinkage => s.loss_creep,
+                    LossPart::Relaxation => s.loss_relax,
+                }
+            })
+            .sum::<f64>()
+            / lt
+    }
+}
+
+impl System<'_> {
+    /// Start an increment over `time`: set the clock of the material points and impose the
+    /// trial relaxation strains of the tendons (from the committed chain states, so a cut
+    /// increment simply calls this again with a shorter interval).
+    pub fn begin_time_increment(&mut self, time: TimeContext) {
+        self.time = time;
+        let dt = time.dt();
+        for t in 0..self.tendons.len() {
+            let Some(el) = self.tendons[t].as_ref() else {
+                continue;
+            };
+            if self.tendon_time[t].is_none() {
+                let data = &self.model.tendons[t];
+                let ep = el.modulus();
+                let chains: Vec<Option<SteelRelaxationChain>> = el
+                    .initial_stresses()
+                    .iter()
+                    .map(|&s| {
+                        data.relaxation.and_then(|class| {
+                            SteelRelaxationChain::fit(class, s / data.fptk, ep)
+                                .ok()
+                                .filter(|c| c.n_units() > 1)
+                        })
+                    })
+                    .collect();
+                let spans = el
+                    .initial_stresses()
+                    .iter()
+                    .zip(el.initial_strains())
+                    .zip(&chains)
+                    .map(|((&s, &e0), c)| SpanTime {
+                        sigma_initial: s,
+                        eps0: e0,
+                        relax_strain: 0.0,
+                        relax_strain_trial: 0.0,
+                        steel_strain: e0,
+                        hidden: c
+                            .as_ref()
+                            .map(|c| c.fractions.iter().map(|a| a * ep * e0).collect())
+                            .unwrap_or_default(),
+                        relax_drop: 0.0,
+                        loss_elastic: 0.0,
+                        loss_creep: 0.0,
+                        loss_relax: 0.0,
+                    })
+                    .collect();
+                self.tendon_time[t] = Some(TendonTime {
+                    spans,
+                    chains,
+                    lengths: el.reference_lengths().to_vec(),
+                });
+            }
+            let (Some(tt), Some(committed)) = (
+                self.tendon_time[t].as_mut(),
+                self.tendon_committed[t].as_ref(),
+            ) else {
+                continue;
+            };
+            if tt.chains.iter().all(Option::is_none) {
+                continue;
+            }
+            let ep = el.modulus();
+            let mut eps0 = Vec::with_capacity(tt.spans.len());
+            for (i, (sp, chain)) in tt.spans.iter_mut().zip(&tt.chains).enumerate() {
+                sp.relax_drop = 0.0;
+                sp.relax_strain_trial = sp.relax_strain;
+                if let (Some(c), true) = (chain, dt > 0.0) {
+                    let drop: f64 = c
+                        .taus
+                        .iter()
+                        .zip(&sp.hidden)
+                        .map(|(&tau, &h)| -(-dt / tau).exp_m1() * h)
+                        .sum();
+                    let chain_stress: f64 = sp.hidden.iter().sum();
+                    let mismatch = committed.spans[i].stress - chain_stress;
+                    sp.relax_drop = drop;
+                    sp.relax_strain_trial = sp.relax_strain + (drop + mismatch) / ep;
+                }
+                eps0.push(sp.eps0 - sp.relax_strain_trial);
+            }
+            if let Some(el) = self.tendons[t].as_mut() {
+                el.set_initial_strains(&eps0);
+            }
+        }
+    }
+
+    /// Book-keeping of a converged increment, called by [`System::commit`] before the trial
+    /// tendon states replace the committed ones: the loss split and the relaxation chains.
+    pub(crate) fn commit_time_dependent(&mut self) {
+        let dt = self.time.dt();
+        for t in 0..self.tendon_time.len() {
+            let (Some(tt), Some(old), Some(new)) = (
+                self.tendon_time[t].as_mut(),
+                self.tendon_committed[t].as_ref(),
+                self.tendon_trial[t].as_ref(),
+            ) else {
+                continue;
+            };
+            for (i, (sp, chain)) in tt.spans.iter_mut().zip(&tt.chains).enumerate() {
+                let d_sigma = new.spans[i].stress - old.spans[i].stress;
+                if dt > 0.0 {
+                    sp.loss_relax += sp.relax_drop;
+                    sp.loss_creep += -d_sigma - sp.relax_drop;
+                } else {
+                    sp.loss_elastic += -d_sigma;
+                }
+                let steel = new.spans[i].strain + sp.relax_strain_trial;
+                if let Some(c) = chain {
+                    sp.hidden = c.step(&sp.hidden, dt, steel - sp.steel_strain).new_hidden;
+                }
+                sp.steel_strain = steel;
+                sp.relax_strain = sp.relax_strain_trial;
+                sp.relax_drop = 0.0;
+            }
+        }
+    }
+}

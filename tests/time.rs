@@ -1,0 +1,541 @@
+//! Time-dependent analysis through the engine: MC90 creep and shrinkage of concrete by the
+//! ageing Maxwell chain, relaxation of external tendons, prestress losses over time.
+//! Run with `cargo test --release --test time` (the beam tests take a few seconds).
+
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::materials::mc90_time::{
+    compliance, shrinkage_strain, CementClass, CreepShrinkageParams,
+};
+use segfem::model::LossPart;
+
+/// One record per converged increment.
+#[derive(Debug, Clone, Default)]
+struct Rec {
+    time: f64,
+    strain: [f64; 3],
+    stress: [f64; 3],
+    u: Vec<f64>,
+    forces: Vec<f64>,
+    losses: Vec<[f64; 4]>,
+}
+
+#[derive(Default)]
+struct Keep(Vec<Rec>);
+
+impl Observer for Keep {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let sys = s.system;
+        let parts = [
+            LossPart::Total,
+            LossPart::Elastic,
+            LossPart::CreepShrinkage,
+            LossPart::Relaxation,
+        ];
+        self.0.push(Rec {
+            time: sys.time.t_to,
+            strain: sys.gauss[0].strain,
+            stress: sys.gauss[0].stress,
+            u: sys.u.clone(),
+            forces: sys
+                .tendon_committed
+                .iter()
+                .map(|t| t.as_ref().map(|t| t.forces()[0]).unwrap_or(0.0))
+                .collect(),
+            losses: sys
+                .tendon_time
+                .iter()
+                .map(|t| {
+                    t.as_ref()
+                        .map(|t| parts.map(|p| t.loss(p)))
+                        .unwrap_or_default()
+                })
+                .collect(),
+        });
+        Ok(())
+    }
+}
+
+fn run(text: &str) -> Vec<Rec> {
+    let model = segfem::input::parse(text, "time.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let mut k = Keep::default();
+    steps::run(&model, &mut k).unwrap();
+    k.0
+}
+
+/// The MC90 data of MODEL.md's checks: fcm 45 MPa, RH 70 %, h = 200 mm, cement N.
+fn params(drying_start: f64) -> CreepShrinkageParams {
+    CreepShrinkageParams::new(45e6, 0.70, 0.200, CementClass::N, drying_start)
+}
+
+const CONCRETE: &str = r#"
+[[materials]]
+name = "c"
+kind = "elastic_creep"
+fcm = 45e6
+rh = 0.70
+h0 = 0.200
+cement = "N"
+nu = 0.2
+"#;
+
+/// A 0.1 m square Q4 specimen, 0.1 m thick, held on its left edge (ux) and at its
+/// bottom-left corner (uy): free to contract laterally, so the stress is uniaxial.
+fn specimen(shrinkage: bool, stress: f64, t0: f64, steps: &str) -> String {
+    format!(
+        r#"{CONCRETE}shrinkage = {shrinkage}
+drying_start = 7.0
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+cast_day = 0.0
+[mesh]
+type = "banded"
+length = 0.1
+nx = 1
+element = "Q4"
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "P"
+line_loads = [{{ line = [[0.1, 0.0], [0.1, 0.1]], q = [{q}, 0.0] }}]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ P = 1.0 }}
+[[steps]]
+name = "creep"
+kind = "time"
+from = {t0}
+{steps}
+"#,
+        q = stress * 0.1
+    )
+}
+
+#[test]
+fn creep_under_constant_stress_follows_mc90() {
+    // σ = −4 MPa < 0.4 fcm (linear creep). ε(t)/(σ J(t, t0)) within 2 % from 1 to 1e4 days
+    // after loading for t0 = 7, 28, 365 d: the chain itself reproduces J within 0.6 % at
+    // 10 steps/decade (docs/theory-time.md §2); the default 5 substeps/decade adds < 0.7 %
+    // at 1e4 d; 2 % leaves room for both but fails for a missing creep term (φ ≈ 1.5–2.8)
+    // or a wrong loading age (J(1e4, 7) vs J(1e4, 28) differ by 20 %).
+    let sigma = -4e6;
+    let p = params(7.0);
+    for t0 in [7.0, 28.0, 365.0] {
+        let rec = run(&specimen(false, sigma, t0, "duration = 1e4"));
+        let load = &rec[0];
+        assert_eq!(load.time, t0);
+        assert!(
+            (load.stress[0] / sigma - 1.0).abs() < 1e-9,
+            "{:?}",
+            load.stress
+        );
+        let mut checked = 0;
+        let mut worst: f64 = 0.0;
+        for r in &rec[1..] {
+            let d = r.time - t0;
+            assert!(
+                (r.stress[0] / sigma - 1.0).abs() < 1e-8,
+                "stress held constant"
+            );
+            if d < 0.999 {
+                continue;
+            }
+            let want = sigma * compliance(&p, r.time, t0);
+            let ratio = r.strain[0] / want;
+            assert!(
+                (ratio - 1.0).abs() < 0.02,
+                "t0 = {t0} d, t − t0 = {d} d: ε/(σJ) = {ratio}"
+            );
+            worst = worst.max((ratio - 1.0).abs());
+            checked += 1;
+        }
+        eprintln!("t0 = {t0} d: worst |ε/(σJ) − 1| = {worst:.4} over {checked} substeps");
+        assert!(checked >= 20, "checked {checked} substeps");
+        // Creep really happened: ε(1e4 d) ≥ 2 × the elastic strain.
+        assert!(rec.last().unwrap().strain[0] / load.strain[0] > 2.0);
+    }
+}
+
+#[test]
+fn free_shrinkage_follows_mc90() {
+    // No load: the specimen shrinks freely, stress-free, by ε_cs(t) − ε_cs(t_start) in both
+    // directions. The imposed strain enters exactly, so the tolerance is round-off (1e-9
+    // relative), and the stress must stay ≈ 0 (1 Pa).
+    let p = params(7.0);
+    let rec = run(&specimen(true, 0.0, 7.0, "to = 10007.0"));
+    let mut n = 0;
+    for r in &rec[1..] {
+        let want = shrinkage_strain(&p, r.time) - shrinkage_strain(&p, 7.0);
+        assert!(want < 0.0);
+        for c in 0..2 {
+            assert!(
+                (r.strain[c] / want - 1.0).abs() < 1e-9,
+                "t = {}: ε = {:?}, ε_cs = {want}",
+                r.time,
+                r.strain
+            );
+        }
+        assert!(r.stress.iter().all(|s| s.abs() < 1.0), "{:?}", r.stress);
+        n += 1;
+    }
+    assert!(n > 20);
+    // 1e4 days of drying at RH 70 %: ε_cs ≈ −0.3 ‰ (MC90 ε_cso = −3.9e-4 × β_s ≈ 0.8).
+    let last = rec.last().unwrap().strain[0];
+    assert!(last < -2.5e-4 && last > -4e-4, "{last}");
+}
+
+/// A straight member of two precast segments (2 × 1 m, 0.2 m deep, dry joint) cast on
+/// days −300 and 0, under a constant axial compression applied on day 28.
+fn two_segments() -> String {
+    format!(
+        r#"{CONCRETE}shrinkage = false
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.2
+[[joint_materials]]
+name = "dry"
+kind = "dry"
+friction = 0.7
+[mesh]
+type = "segmental"
+segments = [1.0, 1.0]
+nx_per_segment = 4
+element = "Q4"
+joint_material = "dry"
+segment_cast_days = [-300.0, 0.0]
+bands = [{{ region = "r", depth = 0.2, rows = 2 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.2]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "P"
+line_loads = [{{ line = [[2.0, 0.0], [2.0, 0.2]], q = [-1e6, 0.0] }}]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ P = 1.0 }}
+[[steps]]
+name = "creep"
+kind = "time"
+from = 28.0
+to = 10028.0
+"#
+    )
+}
+
+#[test]
+fn younger_segment_creeps_more() {
+    // Constant stress −5 MPa in both segments. Each segment's strain must follow J(t, t0) of
+    // its own loading age (328 d and 28 d): the chain is identified per age. 2 % as in the
+    // specimen test; the joint (penalty contact) adds nothing to the segment strains. A
+    // program using one age for all segments fails: J(1e4 + 28, 28)/J(1e4 + 328, 328) = 1.38.
+    let text = two_segments();
+    let model = segfem::input::parse(&text, "two.toml").unwrap().model;
+    let gp = |x: f64| {
+        let e = model
+            .elements
+            .iter()
+            .position(|el| {
+                let xs: Vec<f64> = el.nodes.iter().map(|&n| model.nodes[n][0]).collect();
+                xs.iter().cloned().fold(f64::INFINITY, f64::min) < x
+                    && xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max) > x
+            })
+            .unwrap();
+        4 * e
+    };
+    let (g_old, g_young) = (gp(0.4), gp(1.6));
+    struct Strains(Vec<(f64, f64, f64)>, usize, usize);
+    impl Observer for Strains {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            let g = &s.system.gauss;
+            self.0
+                .push((s.system.time.t_to, g[self.1].strain[0], g[self.2].strain[0]));
+            Ok(())
+        }
+    }
+    let mut obs = Strains(Vec::new(), g_old, g_young);
+    steps::run(&model, &mut obs).unwrap();
+    let p = params(7.0);
+    let sigma = -5e6;
+    let (t_end, e_old, e_young) = *obs.0.last().unwrap();
+    let j_old = compliance(&p, t_end + 300.0, 328.0);
+    let j_young = compliance(&p, t_end, 28.0);
+    assert!(
+        (e_old / (sigma * j_old) - 1.0).abs() < 0.02,
+        "old: {e_old} vs {}",
+        sigma * j_old
+    );
+    assert!(
+        (e_young / (sigma * j_young) - 1.0).abs() < 0.02,
+        "young: {e_young} vs {}",
+        sigma * j_young
+    );
+    assert!(
+        e_young < 1.2 * e_old,
+        "younger segment creeps more: {e_young} vs {e_old}"
+    );
+}
+
+/// A 6 m simply supported beam, 0.3 × 0.6 m, creeping concrete, one straight external
+/// tendon 0.2 m below the centroid, self weight, prestress on day 28, then 1e4 days.
+fn prestressed_beam(relaxation: &str, substeps: &str) -> String {
+    format!(
+        r#"{CONCRETE}density = 2500.0
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.3
+[mesh]
+type = "banded"
+length = 6.0
+nx = 24
+element = "Q8"
+bands = [{{ region = "r", depth = 0.6, rows = 4 }}]
+[[tendons]]
+name = "T"
+kind = "external"
+points = [[0.0, 0.1], [6.0, 0.1]]
+area = 1e-3
+Ep = 195e9
+fptk = 1860e6
+initial_stress = 1300e6
+{relaxation}
+[[supports]]
+name = "left"
+point = [0.0, 0.0]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "right"
+point = [6.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "g"
+gravity = [0.0, -9.81]
+[[steps]]
+name = "prestress"
+kind = "load"
+loads = {{ g = 1.0 }}
+[[steps]]
+name = "creep"
+kind = "time"
+from = 28.0
+duration = 1e4
+{substeps}
+"#
+    )
+}
+
+fn midspan_uy(text: &str, rec: &Rec) -> f64 {
+    let model = segfem::input::parse(text, "b.toml").unwrap().model;
+    let mid = model
+        .nodes
+        .iter()
+        .position(|p| (p[0] - 3.0).abs() < 1e-9 && p[1].abs() < 1e-9)
+        .unwrap();
+    rec.u[2 * mid + 1]
+}
+
+#[test]
+fn results_do_not_depend_on_the_substeps() {
+    // Camber (upward, prestress > self weight) grows by creep; halving every substep must
+    // change the 1e4-day deflection and tendon force by < 1 % (the chain algorithm at the
+    // default 5 substeps/decade is within 0.1 % of converged, docs/theory-time.md §2).
+    let a = prestressed_beam("relaxation_class = 2", "");
+    let b = prestressed_beam("relaxation_class = 2", "substeps = 52");
+    let (ra, rb) = (run(&a), run(&b));
+    assert_eq!(
+        ra.len(),
+        1 + 26,
+        "default: 5 substeps per decade over 0.1 … 1e4 d, + 1"
+    );
+    let (ua, ub) = (
+        midspan_uy(&a, ra.last().unwrap()),
+        midspan_uy(&b, rb.last().unwrap()),
+    );
+    let u0 = midspan_uy(&a, &ra[0]);
+    eprintln!("midspan uy: instantaneous {u0:e}, 1e4 d {ua:e} (26 substeps) {ub:e} (52)");
+    assert!(
+        ua > 0.0 && ua > 1.5 * u0,
+        "camber grows by creep: {u0} → {ua}"
+    );
+    assert!((ua / ub - 1.0).abs() < 0.01, "{ua} vs {ub}");
+    let (fa, fb) = (ra.last().unwrap().forces[0], rb.last().unwrap().forces[0]);
+    assert!((fa / fb - 1.0).abs() < 0.001, "{fa} vs {fb}");
+    // The loss parts add up to the total and the tendon force agrees with the total loss.
+    let l = ra.last().unwrap().losses[0];
+    assert!((l[1] + l[2] + l[3] - l[0]).abs() < 1e-6 * l[0]);
+    assert!(
+        (1300e6 - l[0] - fa / 1e-3).abs() < 1e-6 * 1300e6,
+        "{l:?} {fa}"
+    );
+    assert!(
+        l[2] > 0.0 && l[3] > 0.0,
+        "creep+shrinkage and relaxation losses: {l:?}"
+    );
+}
+
+/// The same tendon stressed against a practically rigid elastic block: the strain is
+/// (nearly) constant, so the stress must follow the MC90 relaxation ρ(t).
+#[test]
+fn tendon_relaxation_at_constant_strain_follows_mc90() {
+    use segfem::materials::mc90_time::{relaxation_loss, RelaxationClass};
+    // Rigid block: E = 1e16 Pa makes the concrete shortening under 1.3 MN ~1e-8 of the
+    // tendon strain, so the strain is constant to that order.
+    let text = prestressed_beam("relaxation_class = 2", "")
+        .replace("kind = \"elastic_creep\"", "kind = \"elastic\"\nE = 1e16")
+        .replace("fcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"\n", "");
+    let rec = run(&text);
+    let s0 = 1300e6;
+    let mut worst: f64 = 0.0;
+    for r in &rec[1..] {
+        let d = r.time - 28.0;
+        let want = relaxation_loss(RelaxationClass::Class2, s0 / 1860e6, d) * s0;
+        let got = s0 - r.forces[0] / 1e-3;
+        // 0.1 % of σ everywhere, 3 % of the loss from 1 d on (the chain's fit of the MC90
+        // power law: 1.6 % worst for class 2 at 0.7, docs/theory-time.md §3).
+        assert!((got - want).abs() < 1e-3 * s0, "t = {d}: {got} vs {want}");
+        if d >= 1.0 {
+            worst = worst.max((got / want - 1.0).abs());
+        }
+        // The whole loss is booked as relaxation.
+        let l = r.losses[0];
+        assert!((l[3] - got).abs() < 1e-3 * got.max(1e3), "{l:?} vs {got}");
+    }
+    eprintln!("relaxation: worst relative error from 1 d: {worst:.4}");
+    assert!(worst < 0.03);
+    // 1e4 days, class 2 at 0.7 f_ptk: ρ = 2.5 % × (240000 h/1000 h)^0.19 ≈ 7 %.
+    let last = s0 - rec.last().unwrap().forces[0] / 1e-3;
+    assert!(last > 0.05 * s0 && last < 0.09 * s0, "{last}");
+}
+
+/// The seed beam (examples/seed-beam.toml) with its elastic concrete replaced by the MC90
+/// creep material (fcm 45 MPa as the seed's E = 35.5 GPa implies, RH 70 %, h0 0.2 m),
+/// prestressed with self weight on day 28 and held for 1e4 days.
+fn seed_beam_creep(substeps: &str) -> String {
+    let seed = include_str!("../examples/seed-beam.toml");
+    let head = &seed[..seed.find("[[steps]]").unwrap()];
+    let text = head
+        .replace(
+            "kind = \"elastic\"\nE = 35.5e9          # MC90 Eci for fcm = 45 MPa",
+            "kind = \"elastic_creep\"\nfcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"",
+        )
+        .replace(
+            "deviators = \"held\"",
+            "deviators = \"held\"\nrelaxation_class = 2",
+        );
+    assert!(text.contains("elastic_creep") && text.contains("relaxation_class"));
+    format!(
+        r#"{text}
+[[steps]]
+name = "prestress"
+kind = "load"
+loads = {{ self_weight = 1.0 }}
+[[steps]]
+name = "long_term"
+kind = "time"
+from = 28.0
+duration = 1e4
+{substeps}
+"#
+    )
+}
+
+#[test]
+fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
+    use segfem::materials::mc90_time::creep_coefficient;
+    let text = seed_beam_creep("");
+    let rec = run(&text);
+    let p0 = rec[0].forces[0]; // after the instantaneous step [N]
+    let l = rec.last().unwrap().losses[0];
+    let fe_loss = l[2] + l[3]; // creep + shrinkage + relaxation [Pa]
+                               // Hand estimate, EC2 5.10.6 (2) (MC90 functions), with the stress and eccentricity
+                               // averaged along the unbonded tendon (EC2: mean strains along an unbonded tendon):
+                               // Δσ = [ε_cs E_p + 0.8 Δσ_pr + α φ σ_c] / [1 + α A_p/A_c (1 + A_c z²/I)(1 + 0.8 φ)].
+    let p = params(7.0);
+    let (t0, t) = (28.0, 28.0 + 1e4);
+    let phi = creep_coefficient(&p, t, t0);
+    let eps_cs = -(shrinkage_strain(&p, t) - shrinkage_strain(&p, t0));
+    let (ep, ap) = (195e9, 560e-6);
+    let alpha = ep / p.eci();
+    // Box section of the seed beam: bands (width, depth) bottom to top.
+    let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
+    let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for (b, h) in bands {
+        ac += b * h;
+        sy += b * h * (y0 + h / 2.0);
+        y0 += h;
+    }
+    let yc = sy / ac;
+    let mut ic = 0.0;
+    y0 = 0.0;
+    for (b, h) in bands {
+        ic += b * h * h * h / 12.0 + b * h * (y0 + h / 2.0 - yc).powi(2);
+        y0 += h;
+    }
+    let q = ac * 2548.4 * 9.81; // self weight [N/m]
+    let yp = |x: f64| {
+        if x < 2.4 {
+            0.30 - 0.2 * x / 2.4
+        } else if x > 4.8 {
+            0.10 + 0.2 * (x - 4.8) / 2.4
+        } else {
+            0.10
+        }
+    };
+    let n = 7200;
+    let (mut sc, mut z2) = (0.0, 0.0);
+    for i in 0..=n {
+        let x = 7.2 * i as f64 / n as f64;
+        let w = if i == 0 || i == n { 0.5 } else { 1.0 } / n as f64;
+        let z = yc - yp(x);
+        let m = q * x * (7.2 - x) / 2.0;
+        sc += w * (p0 / ac + p0 * z * z / ic - m * z / ic); // compression positive
+        z2 += w * z * z;
+    }
+    let rho = segfem::materials::mc90_time::relaxation_loss(
+        segfem::materials::mc90_time::RelaxationClass::Class2,
+        p0 / ap / 1900e6,
+        t - t0,
+    ) * p0
+        / ap;
+    let hand = (eps_cs * ep + 0.8 * rho + alpha * phi * sc)
+        / (1.0 + alpha * ap / ac * (1.0 + ac * z2 / ic) * (1.0 + 0.8 * phi));
+    eprintln!(
+        "seed beam: P0 = {p0:.0} N, σc = {sc:.3e} Pa, φ = {phi:.3}, ε_cs = {eps_cs:.3e}, ρ = {rho:.3e}; loss FE {fe_loss:.4e} Pa (creep+shrinkage {:.4e}, relaxation {:.4e}) vs EC2 {hand:.4e} Pa",
+        l[2], l[3]
+    );
+    // 15 %: the EC2 formula is a sectional age-adjusted-modulus estimate with a fixed ageing
+    // coefficient 0.8 (the chain's effective value depends on t0 and duration, 0.6–0.9), it
+    // smears the varying eccentricity into mean values and ignores the box's shear lag and
+    // the joints; a missing shrinkage (≈ 40 % of the loss here) or creep term fails it.
+    assert!(
+        (fe_loss / hand - 1.0).abs() < 0.15,
+        "FE {fe_loss} vs EC2 {hand}"
+    );
+    // At 0.46 f_ptk the MC90 relaxation is zero.
+    assert!(rho == 0.0 && l[3] == 0.0);
+    // The prestress loss over 1e4 days is a few percent to ~15 % of σp0: a sanity bound.
+    let s0 = p0 / ap;
+    assert!(
+        fe_loss > 0.03 * s0 && fe_loss < 0.2 * s0,
+        "{fe_loss} of {s0}"
+    );
+}
