@@ -117,7 +117,7 @@ figcaption{font-size:14px;color:#555}.note{color:#8a5a00;font-size:14px}.bad{col
 /// Key numbers of a history: one table row per factor and monitor column.
 fn key_numbers(h: &Table) -> String {
     let mut s = String::from(
-        "<table><tr><th>quantity</th><th>unit</th><th>final</th><th>min</th><th>max</th><th>largest |value|</th><th>at step.increment</th></tr>\n",
+        "<table><tr><th>quantity</th><th>unit</th><th>final</th><th>min</th><th>max</th><th>largest |value|</th><th>at step / increment</th></tr>\n",
     );
     let step = h.column("step").ok();
     let inc = h.column("increment").ok();
@@ -135,7 +135,7 @@ fn key_numbers(h: &Table) -> String {
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
             .expect("not empty");
         let at = match (step, inc) {
-            (Some(s), Some(i)) => format!("{}.{}", s.values[k], i.values[k]),
+            (Some(s), Some(i)) => format!("{} / {}", s.values[k], i.values[k]),
             _ => format!("row {}", k + 1),
         };
         let _ = writeln!(
