@@ -17,3 +17,4 @@ pub mod model;
 pub mod prestress;
 pub mod results;
 pub mod run;
+pub mod view;

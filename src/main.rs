@@ -94,6 +94,64 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 4])]
         refine: Vec<usize>,
     },
+    /// Draw figures (PNG and SVG) of a finished run: curves, mesh, deformed shape, fields.
+    Plot(PlotArgs),
+    /// Write a self-contained HTML report of a finished run.
+    Report(ReportArgs),
+}
+
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// Run output directory (with history.csv, results.pvd).
+    dir: PathBuf,
+    /// x column of the history curve (monitor name).
+    #[arg(long)]
+    x: Option<String>,
+    /// y columns of the history curve, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    y: Vec<String>,
+    /// Reference points: CSV with a header and two columns (x, y).
+    #[arg(long = "ref")]
+    reference: Option<PathBuf>,
+    /// Further run directories drawn on the same chart, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    runs: Vec<PathBuf>,
+    /// Output number (1-based, as listed in results.pvd; default: the last).
+    #[arg(long)]
+    step: Option<usize>,
+    /// Field of the colour map: sx, sy, txy, s1, s2.
+    #[arg(long)]
+    field: Option<String>,
+    /// Colour map of element averages instead of smoothed nodal values.
+    #[arg(long)]
+    cells: bool,
+    /// Magnification of the deformed shape (default: largest displacement = 5 % of model size).
+    #[arg(long)]
+    scale: Option<f64>,
+    /// Output directory (default: DIR/figures).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// Run output directory.
+    dir: PathBuf,
+    /// HTML file to write (default: DIR/report.html).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Reference points (CSV, two columns x, y) for a comparison table.
+    #[arg(long = "ref")]
+    reference: Option<PathBuf>,
+    /// x column of the history curve.
+    #[arg(long)]
+    x: Option<String>,
+    /// y column of the history curve.
+    #[arg(long)]
+    y: Option<String>,
+    /// Output number for the drawings (1-based; default: the last).
+    #[arg(long)]
+    step: Option<usize>,
 }
 
 fn main() -> ExitCode {
@@ -119,7 +177,67 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Command::Plot(a) => view_plot(a),
+        Command::Report(a) => view_report(a),
     }
+}
+
+fn view_plot(a: PlotArgs) -> ExitCode {
+    use segfem::view;
+    let field = match a
+        .field
+        .as_deref()
+        .map(str::parse::<view::Field>)
+        .transpose()
+    {
+        Ok(f) => f,
+        Err(e) => return view_error(e),
+    };
+    let opts = view::PlotOptions {
+        dir: a.dir,
+        x: a.x,
+        y: a.y,
+        reference: a.reference,
+        runs: a.runs,
+        step: a.step,
+        field,
+        cells: a.cells,
+        scale: a.scale,
+        out: a.output,
+    };
+    match view::plot(&opts) {
+        Ok(o) => {
+            o.notes.iter().for_each(|n| eprintln!("note: {n}"));
+            o.files.iter().for_each(|f| println!("{}", f.display()));
+            ExitCode::SUCCESS
+        }
+        Err(e) => view_error(e),
+    }
+}
+
+fn view_report(a: ReportArgs) -> ExitCode {
+    use segfem::view::report;
+    let opts = report::ReportOptions {
+        dir: a.dir,
+        out: a.output,
+        reference: a.reference,
+        x: a.x,
+        y: a.y,
+        step: a.step,
+    };
+    match report::report(&opts) {
+        Ok((path, notes)) => {
+            notes.iter().for_each(|n| eprintln!("note: {n}"));
+            println!("{}", path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => view_error(e),
+    }
+}
+
+fn view_error(e: segfem::view::ViewError) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::from(e.exit_code())
 }
 
 fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool) -> ExitCode {

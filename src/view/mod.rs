@@ -1,0 +1,574 @@
+//! An engineer's view of a finished run: figures (`segfem plot`) and a self-contained HTML
+//! report (`segfem report`) read back from the files a run writes (`history.csv`,
+//! `summary.json`, `results.pvd` and its `.vtu` files).
+//!
+//! Figures whose data a run does not write (crack patterns, joint diagrams) are skipped
+//! with a one-line note; they are drawn as soon as the `.vtu` files carry the cell arrays
+//! `crack_angle` [rad] and `n_cracks` [-], or line cells with an `opening` [m] array (and
+//! optionally `normal_stress` [Pa] and `joint` [-]).
+
+pub mod data;
+pub mod figures;
+pub mod report;
+
+use data::{Grid, Output, Table};
+use figures::{
+    auto_scale, save, ContourFigure, CrackFigure, CurveFigure, DeformedFigure, FieldValues,
+    JointFigure, JointProfile, MeshFigure, Series,
+};
+use std::path::{Path, PathBuf};
+
+/// Why a view command failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewError {
+    /// Bad arguments or unreadable/missing input files (exit status 2).
+    #[error("{0}")]
+    Usage(String),
+    /// Figures or the report could not be written (exit status 1).
+    #[error("{0}")]
+    Io(String),
+}
+
+impl ViewError {
+    /// Process exit status.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            ViewError::Usage(_) => 2,
+            ViewError::Io(_) => 1,
+        }
+    }
+}
+
+/// A scalar stress field for colour maps. Stresses are shown in MPa.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Field {
+    /// σx [MPa].
+    Sx,
+    /// σy [MPa].
+    Sy,
+    /// τxy [MPa].
+    Txy,
+    /// Major principal stress σ1 [MPa].
+    S1,
+    /// Minor principal stress σ2 [MPa].
+    S2,
+}
+
+impl std::str::FromStr for Field {
+    type Err = ViewError;
+    fn from_str(s: &str) -> Result<Self, ViewError> {
+        Ok(match s.trim().to_ascii_lowercase().as_str() {
+            "sx" => Field::Sx,
+            "sy" => Field::Sy,
+            "txy" => Field::Txy,
+            "s1" => Field::S1,
+            "s2" => Field::S2,
+            o => {
+                return Err(ViewError::Usage(format!(
+                    "--field: unknown field '{o}' (sx, sy, txy, s1, s2)"
+                )))
+            }
+        })
+    }
+}
+
+impl Field {
+    /// Short name (file names).
+    pub fn name(self) -> &'static str {
+        match self {
+            Field::Sx => "sx",
+            Field::Sy => "sy",
+            Field::Txy => "txy",
+            Field::S1 => "s1",
+            Field::S2 => "s2",
+        }
+    }
+
+    /// Label with unit.
+    pub fn label(self) -> &'static str {
+        match self {
+            Field::Sx => "σx [MPa]",
+            Field::Sy => "σy [MPa]",
+            Field::Txy => "τxy [MPa]",
+            Field::S1 => "σ1 [MPa]",
+            Field::S2 => "σ2 [MPa]",
+        }
+    }
+
+    fn of(self, s: [f64; 3]) -> f64 {
+        let c = 0.5 * (s[0] + s[1]);
+        let r = (0.5 * (s[0] - s[1])).hypot(s[2]);
+        match self {
+            Field::Sx => s[0],
+            Field::Sy => s[1],
+            Field::Txy => s[2],
+            Field::S1 => c + r,
+            Field::S2 => c - r,
+        }
+    }
+}
+
+/// Options of `segfem plot`.
+#[derive(Debug, Clone, Default)]
+pub struct PlotOptions {
+    /// Run directory.
+    pub dir: PathBuf,
+    /// x column of the history curve (monitor name); default: the first monitor in m.
+    pub x: Option<String>,
+    /// y columns; default: the first load-factor monitor (or the last `factor:` column).
+    pub y: Vec<String>,
+    /// Reference CSV (first two columns: x, y) drawn as markers.
+    pub reference: Option<PathBuf>,
+    /// Further run directories drawn on the same chart.
+    pub runs: Vec<PathBuf>,
+    /// Output number (1-based, order of `results.pvd`); default: the last.
+    pub step: Option<usize>,
+    /// Field for the colour map; default σx.
+    pub field: Option<Field>,
+    /// Colour map from cell (element-average) values instead of smoothed nodal values.
+    pub cells: bool,
+    /// Magnification of the deformed shape; default: the largest displacement drawn as
+    /// 5 % of the model size.
+    pub scale: Option<f64>,
+    /// Output directory; default `<dir>/figures`.
+    pub out: Option<PathBuf>,
+}
+
+/// What `segfem plot` produced.
+#[derive(Debug, Clone, Default)]
+pub struct PlotOutcome {
+    /// Files written (PNG and SVG of each figure).
+    pub files: Vec<PathBuf>,
+    /// One-line notes on skipped figures.
+    pub notes: Vec<String>,
+    /// The history curves drawn (values as read from the CSV files).
+    pub curves: Option<CurveFigure>,
+    /// Magnification used for the deformed shape.
+    pub scale: Option<f64>,
+    /// The `.vtu` file the field figures were drawn from.
+    pub vtu: Option<PathBuf>,
+}
+
+fn run_name(dir: &Path) -> String {
+    dir.file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| dir.display().to_string())
+}
+
+/// Read `<dir>/history.csv`.
+pub fn read_history(dir: &Path) -> Result<Table, ViewError> {
+    if !dir.is_dir() {
+        return Err(ViewError::Usage(format!(
+            "{}: not a directory (give the output directory of `segfem run`)",
+            dir.display()
+        )));
+    }
+    Table::read(&dir.join("history.csv"))
+}
+
+/// Default (x, y) columns of the load–displacement curve of a history.
+pub fn default_columns(h: &Table) -> Result<(String, Vec<String>), ViewError> {
+    let x = h
+        .monitors()
+        .find(|c| c.unit == "m")
+        .or_else(|| h.monitors().next())
+        .map(|c| c.name.clone())
+        .unwrap_or_else(|| "increment".into());
+    let y = h
+        .monitors()
+        .find(|c| c.unit == "-")
+        .or_else(|| h.factors().last())
+        .or_else(|| h.monitors().find(|c| c.name != x))
+        .map(|c| c.name.clone())
+        .ok_or_else(|| ViewError::Usage(format!("{}: no columns to plot", h.path.display())))?;
+    Ok((x, vec![y]))
+}
+
+/// The history curve figure: `y` columns against `x` for the run `dir` and the `runs`,
+/// with reference markers.
+pub fn curve_figure(
+    dir: &Path,
+    x: Option<&str>,
+    y: &[String],
+    runs: &[PathBuf],
+    reference: Option<&Path>,
+) -> Result<CurveFigure, ViewError> {
+    let h = read_history(dir)?;
+    let (dx, dy) = default_columns(&h)?;
+    let x = x.map(str::to_string).unwrap_or(dx);
+    let y: Vec<String> = if y.is_empty() { dy } else { y.to_vec() };
+    let xc = h.column(&x)?;
+    let ycols = y
+        .iter()
+        .map(|k| h.column(k))
+        .collect::<Result<Vec<_>, _>>()?;
+    let several_runs = !runs.is_empty();
+    let mut series = Vec::new();
+    let mut tables = vec![(dir.to_path_buf(), h.clone())];
+    for r in runs {
+        tables.push((r.clone(), read_history(r)?));
+    }
+    for (d, t) in &tables {
+        let xs = t.column(&x)?;
+        for yc in &ycols {
+            let ys = t.column(&yc.name)?;
+            let label = match (several_runs, ycols.len() > 1) {
+                (true, true) => format!("{}: {}", run_name(d), yc.name),
+                (true, false) => run_name(d),
+                _ => yc.name.clone(),
+            };
+            series.push(Series {
+                label,
+                points: xs
+                    .values
+                    .iter()
+                    .copied()
+                    .zip(ys.values.iter().copied())
+                    .collect(),
+            });
+        }
+    }
+    let units: Vec<&str> = ycols.iter().map(|c| c.unit.as_str()).collect();
+    let y_label = if ycols.len() == 1 {
+        ycols[0].label()
+    } else if units.iter().all(|u| *u == units[0]) && !units[0].is_empty() {
+        format!(
+            "{} [{}]",
+            ycols
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            units[0]
+        )
+    } else {
+        ycols
+            .iter()
+            .map(|c| c.label())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let reference = match reference {
+        Some(p) => {
+            let t = Table::read(p)?;
+            if t.columns.len() < 2 {
+                return Err(ViewError::Usage(format!(
+                    "{}: a reference file needs two columns (x, y)",
+                    p.display()
+                )));
+            }
+            let (a, b) = (&t.columns[0], &t.columns[1]);
+            Some(Series {
+                label: format!("reference: {}", run_name(p)),
+                points: a
+                    .values
+                    .iter()
+                    .copied()
+                    .zip(b.values.iter().copied())
+                    .collect(),
+            })
+        }
+        None => None,
+    };
+    Ok(CurveFigure {
+        title: format!(
+            "{} against {}",
+            ycols
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            xc.name
+        ),
+        x_label: xc.label(),
+        y_label,
+        series,
+        reference,
+    })
+}
+
+/// The output chosen by `step` (1-based; default the last) from `results.pvd`.
+pub fn pick_output(dir: &Path, step: Option<usize>) -> Result<(usize, Output), ViewError> {
+    let outs = data::read_pvd(dir)?;
+    if outs.is_empty() {
+        return Err(ViewError::Usage(format!(
+            "{}: results.pvd lists no outputs",
+            dir.display()
+        )));
+    }
+    let n = step.unwrap_or(outs.len());
+    if n == 0 || n > outs.len() {
+        return Err(ViewError::Usage(format!(
+            "--step: {n} is out of range (this run has outputs 1 to {})",
+            outs.len()
+        )));
+    }
+    Ok((n, outs[n - 1].clone()))
+}
+
+/// Nodal displacements (ux, uy) [m] of a grid (zero when absent).
+pub fn displacements(g: &Grid) -> Vec<[f64; 2]> {
+    match g.point_array("displacement").filter(|a| a.components >= 2) {
+        Some(a) => (0..g.points.len())
+            .map(|i| [a.get(i, 0), a.get(i, 1)])
+            .collect(),
+        None => vec![[0.0; 2]; g.points.len()],
+    }
+}
+
+/// Values of `field` in MPa, nodal (`principal_stress` for σ1/σ2 when present, else from
+/// `stress`) or per cell (from the cell `stress`).
+pub fn field_values(g: &Grid, field: Field, cells: bool) -> Result<FieldValues, ViewError> {
+    let missing = |what: &str| {
+        ViewError::Usage(format!(
+            "{}: no {what} 'stress' array for the colour map",
+            g.path.display()
+        ))
+    };
+    let from = |a: &data::Array, n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| field.of([a.get(i, 0), a.get(i, 1), a.get(i, 2)]) / 1e6)
+            .collect()
+    };
+    if cells {
+        let a = g
+            .cell_array("stress")
+            .filter(|a| a.components >= 3)
+            .ok_or_else(|| missing("cell"))?;
+        return Ok(FieldValues::Cell(from(a, g.cells.len())));
+    }
+    if let (Some(p), Field::S1 | Field::S2) = (
+        g.point_array("principal_stress")
+            .filter(|a| a.components >= 2),
+        field,
+    ) {
+        let c = if field == Field::S1 { 0 } else { 1 };
+        return Ok(FieldValues::Nodal(
+            (0..g.points.len()).map(|i| p.get(i, c) / 1e6).collect(),
+        ));
+    }
+    let a = g
+        .point_array("stress")
+        .filter(|a| a.components >= 3)
+        .ok_or_else(|| missing("point"))?;
+    Ok(FieldValues::Nodal(from(a, g.points.len())))
+}
+
+/// Crack data per cell (angle [rad], count), when the grid has `crack_angle` and
+/// `n_cracks` cell arrays. Angles larger than 2π in magnitude are taken as degrees.
+pub fn cracks(g: &Grid) -> Option<Vec<(f64, usize)>> {
+    let a = g.cell_array("crack_angle")?;
+    let n = g.cell_array("n_cracks")?;
+    let degrees = a
+        .values
+        .iter()
+        .any(|v| v.abs() > std::f64::consts::TAU + 1e-9);
+    Some(
+        (0..g.cells.len())
+            .map(|i| {
+                let t = a.get(i, 0);
+                (
+                    if degrees { t.to_radians() } else { t },
+                    n.get(i, 0).max(0.0) as usize,
+                )
+            })
+            .collect(),
+    )
+}
+
+/// Joint profiles from line cells carrying `opening` [m] (cell or point data), with
+/// `normal_stress` [Pa] where present. Joints are told apart by a `joint` cell array, or
+/// else by the x of the cell's mid-point.
+pub fn joint_profiles(g: &Grid) -> Vec<JointProfile> {
+    let lines: Vec<usize> = (0..g.cells.len()).filter(|&i| g.is_line(i)).collect();
+    let cell_open = g.cell_array("opening");
+    let point_open = g.point_array("opening");
+    if lines.is_empty() || (cell_open.is_none() && point_open.is_none()) {
+        return Vec::new();
+    }
+    let cell_sn = g.cell_array("normal_stress");
+    let point_sn = g.point_array("normal_stress");
+    let id = g.cell_array("joint");
+    let (lo, hi) = g.bounds();
+    let tol = 1e-6 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1e-12);
+    // (key, name, points (y, opening, normal stress))
+    type Group = (f64, String, Vec<(f64, f64, f64)>);
+    let mut groups: Vec<Group> = Vec::new();
+    for &i in &lines {
+        let c = &g.cells[i];
+        let mid = |k: usize| c.iter().map(|&n| g.points[n][k]).sum::<f64>() / c.len() as f64;
+        let (xm, ym) = (mid(0), mid(1));
+        let mut samples: Vec<(f64, f64, f64)> = Vec::new();
+        if let Some(o) = cell_open {
+            let sn = cell_sn.map_or(f64::NAN, |s| s.get(i, 0) / 1e6);
+            samples.push((ym, o.get(i, 0) * 1e3, sn));
+        } else if let Some(o) = point_open {
+            for &n in c {
+                let sn = point_sn.map_or(f64::NAN, |s| s.get(n, 0) / 1e6);
+                samples.push((g.points[n][1], o.get(n, 0) * 1e3, sn));
+            }
+        }
+        let (key, name) = match id {
+            Some(a) => {
+                let k = a.get(i, 0);
+                (k, format!("joint {}", k as i64))
+            }
+            None => (xm, format!("joint at x = {xm:.3} m")),
+        };
+        match groups.iter_mut().find(|gr| (gr.0 - key).abs() <= tol) {
+            Some(gr) => gr.2.extend(samples),
+            None => groups.push((key, name, samples)),
+        }
+    }
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+    groups
+        .into_iter()
+        .map(|(_, name, mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            points.dedup_by(|a, b| (a.0 - b.0).abs() <= tol && a.1 == b.1);
+            JointProfile { name, points }
+        })
+        .collect()
+}
+
+/// Most joints drawn in one joint figure.
+pub const MAX_JOINTS: usize = 8;
+
+/// `segfem plot`: write the figures of a run into the output directory.
+pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
+    if let Some(s) = opts.scale {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(ViewError::Usage(format!(
+                "--scale: {s} is not a positive number"
+            )));
+        }
+    }
+    let curves = curve_figure(
+        &opts.dir,
+        opts.x.as_deref(),
+        &opts.y,
+        &opts.runs,
+        opts.reference.as_deref(),
+    )?;
+    let out_dir = opts.out.clone().unwrap_or_else(|| opts.dir.join("figures"));
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| ViewError::Io(format!("{}: {e}", out_dir.display())))?;
+    let mut outcome = PlotOutcome::default();
+    outcome.files.extend(save(&curves, &out_dir, "curves")?);
+    outcome.curves = Some(curves);
+    let (n, output) = match pick_output(&opts.dir, opts.step) {
+        Ok(o) => o,
+        Err(e) if opts.step.is_none() => {
+            outcome
+                .notes
+                .push(format!("mesh and field figures: skipped ({e})"));
+            return Ok(outcome);
+        }
+        Err(e) => return Err(e),
+    };
+    let g = Grid::read(&output.file)?;
+    let file = run_name(&output.file);
+    let tag = format!("output {n}, {file}");
+    outcome.vtu = Some(output.file.clone());
+    outcome.files.extend(save(
+        &MeshFigure {
+            grid: &g,
+            title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
+        },
+        &out_dir,
+        "mesh",
+    )?);
+    let disp = displacements(&g);
+    let scale = opts.scale.unwrap_or_else(|| auto_scale(&g, &disp));
+    outcome.scale = Some(scale);
+    outcome.files.extend(save(
+        &DeformedFigure {
+            grid: &g,
+            disp,
+            scale,
+            title: format!("Deformed shape ×{} ({tag})", fmt_scale(scale)),
+        },
+        &out_dir,
+        "deformed",
+    )?);
+    let field = opts.field.unwrap_or(Field::Sx);
+    let values = field_values(&g, field, opts.cells)?;
+    let kind = if opts.cells { "cell averages" } else { "nodal" };
+    outcome.files.extend(save(
+        &ContourFigure {
+            grid: &g,
+            values,
+            label: field.label().into(),
+            title: format!("{} ({kind}, {tag})", field.label()),
+        },
+        &out_dir,
+        &format!("field_{}", field.name()),
+    )?);
+    extra_figures(&g, &tag, &out_dir, &mut outcome)?;
+    Ok(outcome)
+}
+
+/// Crack pattern and joint diagrams, or notes when their data is absent.
+fn extra_figures(
+    g: &Grid,
+    tag: &str,
+    out_dir: &Path,
+    outcome: &mut PlotOutcome,
+) -> Result<(), ViewError> {
+    match crack_figure(g, tag) {
+        Some(f) => outcome.files.extend(save(&f, out_dir, "cracks")?),
+        None => outcome.notes.push(CRACK_NOTE.into()),
+    }
+    match joint_figure(g, tag, &mut outcome.notes) {
+        Some(f) => outcome.files.extend(save(&f, out_dir, "joints")?),
+        None => outcome.notes.push(JOINT_NOTE.into()),
+    }
+    Ok(())
+}
+
+/// Note for a skipped crack pattern.
+pub const CRACK_NOTE: &str =
+    "crack pattern: skipped (the results carry no crack_angle/n_cracks cell arrays)";
+/// Note for skipped joint diagrams.
+pub const JOINT_NOTE: &str =
+    "joint diagrams: skipped (the results carry no joint line cells with an opening array)";
+
+/// The crack pattern figure, when the grid has crack data.
+pub fn crack_figure<'g>(g: &'g Grid, tag: &str) -> Option<CrackFigure<'g>> {
+    let cracks = cracks(g)?;
+    let n = cracks.iter().filter(|c| c.1 > 0).count();
+    Some(CrackFigure {
+        grid: g,
+        cracks,
+        title: format!("Crack pattern: {n} cracked cells ({tag})"),
+    })
+}
+
+/// The joint figure, when the grid has joint data (at most [`MAX_JOINTS`], noted).
+pub fn joint_figure(g: &Grid, tag: &str, notes: &mut Vec<String>) -> Option<JointFigure> {
+    let mut joints = joint_profiles(g);
+    if joints.is_empty() {
+        return None;
+    }
+    if joints.len() > MAX_JOINTS {
+        notes.push(format!(
+            "joint diagrams: the first {MAX_JOINTS} of {} joints drawn",
+            joints.len()
+        ));
+        joints.truncate(MAX_JOINTS);
+    }
+    Some(JointFigure {
+        joints,
+        title: format!("Joints: opening and normal stress over the height ({tag})"),
+    })
+}
+
+/// A magnification written with 3 significant digits.
+pub fn fmt_scale(s: f64) -> String {
+    if s >= 100.0 {
+        format!("{s:.0}")
+    } else {
+        let d = (2 - s.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{s:.d$}")
+    }
+}

@@ -1,0 +1,409 @@
+//! `segfem report`: one self-contained HTML page (no network, no external files) with the
+//! model summary, key numbers of the history, the figures (curves as inline SVG, the
+//! model drawings as base64 PNG) and, given a reference CSV, a comparison table.
+
+use super::data::{Grid, Table};
+use super::figures::{png_bytes, svg_string, CurveFigure, DeformedFigure, MeshFigure};
+use super::{
+    auto_scale, crack_figure, curve_figure, displacements, field_values, fmt_scale, joint_figure,
+    pick_output, read_history, run_name, Field, ViewError, CRACK_NOTE, JOINT_NOTE,
+};
+use base64::Engine;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Options of `segfem report`.
+#[derive(Debug, Clone, Default)]
+pub struct ReportOptions {
+    /// Run directory.
+    pub dir: PathBuf,
+    /// HTML file to write; default `<dir>/report.html`.
+    pub out: Option<PathBuf>,
+    /// Reference CSV (x, y) compared with the computed curve.
+    pub reference: Option<PathBuf>,
+    /// x column of the curve (default as in `plot`).
+    pub x: Option<String>,
+    /// y column of the curve (default as in `plot`).
+    pub y: Option<String>,
+    /// Output number for the field figures (1-based; default the last).
+    pub step: Option<usize>,
+}
+
+/// A row of the comparison table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// Reference x.
+    pub x: f64,
+    /// Reference y.
+    pub y_ref: f64,
+    /// Computed y at x (linear interpolation along the history), if x is within the curve.
+    pub y_calc: Option<f64>,
+}
+
+/// Computed y at `x` on a polyline: the first segment that brackets `x`.
+pub fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
+    for w in points.windows(2) {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        if (x0 <= x && x <= x1) || (x1 <= x && x <= x0) {
+            if x1 == x0 {
+                return Some(y0);
+            }
+            return Some(y0 + (y1 - y0) * (x - x0) / (x1 - x0));
+        }
+    }
+    if points.len() == 1 && points[0].0 == x {
+        return Some(points[0].1);
+    }
+    None
+}
+
+/// Compare the reference points of a curve figure with its first computed series.
+pub fn compare(fig: &CurveFigure) -> Vec<Comparison> {
+    let Some(r) = &fig.reference else {
+        return Vec::new();
+    };
+    let calc = fig
+        .series
+        .first()
+        .map(|s| s.points.as_slice())
+        .unwrap_or(&[]);
+    r.points
+        .iter()
+        .map(|&(x, y)| Comparison {
+            x,
+            y_ref: y,
+            y_calc: interpolate(calc, x),
+        })
+        .collect()
+}
+
+/// HTML-escape text.
+pub fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A number for tables: 4 significant digits.
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if !v.is_finite() {
+        "—".into()
+    } else if (1e-3..1e5).contains(&v.abs()) {
+        let d = (3 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{v:.d$}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+fn png_img(bytes: &[u8], alt: &str) -> String {
+    format!(
+        r#"<img alt="{}" src="data:image/png;base64,{}">"#,
+        esc(alt),
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    )
+}
+
+const STYLE: &str = "body{font-family:'DejaVu Sans',Arial,sans-serif;margin:24px auto;max-width:1400px;color:#222;padding:0 16px}
+h1{font-size:24px;border-bottom:2px solid #1f5aa6;padding-bottom:6px}h2{font-size:19px;margin-top:28px;color:#1f5aa6}
+table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:4px 10px;text-align:right}
+th{background:#eef2f8}td:first-child,th:first-child{text-align:left}
+figure{margin:12px 0}figure img,figure svg{max-width:100%;height:auto;border:1px solid #ddd}
+figcaption{font-size:14px;color:#555}.note{color:#8a5a00;font-size:14px}.bad{color:#b00}";
+
+/// Key numbers of a history: one table row per factor and monitor column.
+fn key_numbers(h: &Table) -> String {
+    let mut s = String::from(
+        "<table><tr><th>quantity</th><th>unit</th><th>final</th><th>min</th><th>max</th><th>largest |value|</th><th>at step / increment</th></tr>\n",
+    );
+    let step = h.column("step").ok();
+    let inc = h.column("increment").ok();
+    for c in h.factors().chain(h.monitors()) {
+        if c.values.is_empty() {
+            continue;
+        }
+        let min = c.values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = c.values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (k, big) = c
+            .values
+            .iter()
+            .copied()
+            .enumerate()
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .expect("not empty");
+        let at = match (step, inc) {
+            (Some(s), Some(i)) => format!("{} / {}", s.values[k], i.values[k]),
+            _ => format!("row {}", k + 1),
+        };
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            esc(&c.name),
+            esc(&c.unit),
+            num(*c.values.last().expect("not empty")),
+            num(min),
+            num(max),
+            num(big),
+            at
+        );
+    }
+    s.push_str("</table>\n");
+    s
+}
+
+fn summary_section(dir: &Path) -> (String, String) {
+    let path = dir.join("summary.json");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return (
+            run_name(dir),
+            format!(
+                "<p class=\"note\">{}: not found; no model summary.</p>\n",
+                esc(&path.display().to_string())
+            ),
+        );
+    };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return (
+            run_name(dir),
+            format!(
+                "<p class=\"note\">{}: not valid JSON.</p>\n",
+                esc(&path.display().to_string())
+            ),
+        );
+    };
+    let title = v["title"].as_str().unwrap_or("segfem run").to_string();
+    let mut s = String::from("<table>\n");
+    let mut row = |k: &str, val: String| {
+        let _ = writeln!(s, "<tr><th>{k}</th><td>{}</td></tr>", esc(&val));
+    };
+    let status = v["status"].as_str().unwrap_or("?").to_string();
+    row("status", status);
+    if let Some(e) = v["error"].as_str() {
+        row("error", e.to_string());
+    }
+    let size = &v["size"];
+    for k in ["nodes", "elements", "dofs", "equations"] {
+        if let Some(n) = size[k].as_u64() {
+            row(k, n.to_string());
+        }
+    }
+    let t = &v["timings"];
+    if let Some(n) = t["increments"].as_u64() {
+        row("converged increments", n.to_string());
+    }
+    if let Some(n) = t["iterations"].as_u64() {
+        row("iterations", n.to_string());
+    }
+    if let Some(w) = v["wall_s"].as_f64() {
+        row("wall time [s]", format!("{w:.3}"));
+    }
+    if let Some(m) = v["peak_memory_bytes"].as_f64() {
+        row("peak memory [MiB]", format!("{:.1}", m / 1048576.0));
+    }
+    if let Some(ws) = v["warnings"].as_array() {
+        for w in ws {
+            row("warning", w.as_str().unwrap_or("").to_string());
+        }
+    }
+    s.push_str("</table>\n");
+    (title, s)
+}
+
+/// `segfem report`: write the HTML page; returns its path and the notes on skipped parts.
+pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError> {
+    let h = read_history(&opts.dir)?;
+    let y: Vec<String> = opts.y.iter().cloned().collect();
+    let curves = curve_figure(
+        &opts.dir,
+        opts.x.as_deref(),
+        &y,
+        &[],
+        opts.reference.as_deref(),
+    )?;
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| opts.dir.join("report.html"));
+    let mut notes = Vec::new();
+    let (title, summary) = summary_section(&opts.dir);
+    let mut html = String::new();
+    let _ = write!(
+        html,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title><style>{STYLE}</style></head><body>\n<h1>{t}</h1>\n<p>Run directory: <code>{d}</code></p>\n<h2>Model and run</h2>\n{summary}",
+        t = esc(&title),
+        d = esc(&opts.dir.display().to_string())
+    );
+    let _ = write!(
+        html,
+        "<h2>Key numbers of the history ({} converged increments)</h2>\n{}",
+        h.rows(),
+        key_numbers(&h)
+    );
+    let peak = h
+        .factors()
+        .chain(h.monitors().filter(|c| c.unit == "-"))
+        .flat_map(|c| c.values.iter().map(move |v| (c.name.as_str(), *v)))
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((name, v)) = peak {
+        let _ = writeln!(
+            html,
+            "<p><b>Peak load factor:</b> {} = {}</p>",
+            esc(name),
+            num(v)
+        );
+    }
+    html.push_str("<h2>History</h2>\n<figure>");
+    html.push_str(&svg_string(&curves)?);
+    let _ = writeln!(
+        html,
+        "<figcaption>{}; a dot per converged increment.</figcaption></figure>",
+        esc(&curves.title)
+    );
+    let cmp = compare(&curves);
+    if let Some(r) = &curves.reference {
+        let _ = writeln!(
+            html,
+            "<h2>Comparison with the reference</h2>\n<p>{} against {}: the computed value is interpolated linearly along the history at each reference x.</p>\n<table><tr><th>{}</th><th>reference {}</th><th>computed</th><th>computed − reference</th><th>computed / reference</th></tr>",
+            esc(&r.label),
+            esc(&curves.series.first().map(|s| s.label.clone()).unwrap_or_default()),
+            esc(&curves.x_label),
+            esc(&curves.y_label)
+        );
+        for c in &cmp {
+            let (calc, diff, ratio) = match c.y_calc {
+                Some(v) => (
+                    num(v),
+                    num(v - c.y_ref),
+                    if c.y_ref != 0.0 {
+                        format!("{:.3}", v / c.y_ref)
+                    } else {
+                        "—".into()
+                    },
+                ),
+                None => ("outside the run".into(), "—".into(), "—".into()),
+            };
+            let _ = writeln!(
+                html,
+                "<tr><td>{}</td><td>{}</td><td>{calc}</td><td>{diff}</td><td>{ratio}</td></tr>",
+                num(c.x),
+                num(c.y_ref)
+            );
+        }
+        html.push_str("</table>\n");
+    }
+    html.push_str("<h2>Model drawings</h2>\n");
+    match pick_output(&opts.dir, opts.step) {
+        Ok((n, output)) => {
+            let g = Grid::read(&output.file)?;
+            let tag = format!("output {n}, {}", run_name(&output.file));
+            fields_section(&mut html, &g, &tag, &mut notes)?;
+        }
+        Err(e) if opts.step.is_none() => notes.push(format!("model drawings: skipped ({e})")),
+        Err(e) => return Err(e),
+    }
+    for n in &notes {
+        let _ = writeln!(html, "<p class=\"note\">{}</p>", esc(n));
+    }
+    html.push_str(
+        "<p style=\"font-size:12px;color:#888\">Written by segfem report.</p>\n</body></html>\n",
+    );
+    std::fs::write(&out, html).map_err(|e| ViewError::Io(format!("{}: {e}", out.display())))?;
+    Ok((out, notes))
+}
+
+fn figure(html: &mut String, png: &[u8], caption: &str) {
+    let _ = writeln!(
+        html,
+        "<figure>{}<figcaption>{}</figcaption></figure>",
+        png_img(png, caption),
+        esc(caption)
+    );
+}
+
+fn fields_section(
+    html: &mut String,
+    g: &Grid,
+    tag: &str,
+    notes: &mut Vec<String>,
+) -> Result<(), ViewError> {
+    let mesh = MeshFigure {
+        grid: g,
+        title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
+    };
+    figure(html, &png_bytes(&mesh)?, "Mesh, cells coloured by region");
+    let disp = displacements(g);
+    let scale = auto_scale(g, &disp);
+    let def = DeformedFigure {
+        grid: g,
+        disp,
+        scale,
+        title: format!("Deformed shape ×{} ({tag})", fmt_scale(scale)),
+    };
+    figure(
+        html,
+        &png_bytes(&def)?,
+        &format!(
+            "Deformed mesh magnified {} times over the undeformed outline (grey)",
+            fmt_scale(scale)
+        ),
+    );
+    for field in [Field::Sx, Field::S1, Field::S2] {
+        let fig = super::figures::ContourFigure {
+            grid: g,
+            values: field_values(g, field, false)?,
+            label: field.label().into(),
+            title: format!("{} (nodal, {tag})", field.label()),
+        };
+        let (lo, hi) = fig.range();
+        figure(
+            html,
+            &png_bytes(&fig)?,
+            &format!(
+                "{}: from {} to {} MPa (blue compression, red tension)",
+                field.label(),
+                num(lo),
+                num(hi)
+            ),
+        );
+    }
+    match crack_figure(g, tag) {
+        Some(f) => figure(
+            html,
+            &png_bytes(&f)?,
+            "Crack pattern: a line along each crack",
+        ),
+        None => notes.push(CRACK_NOTE.into()),
+    }
+    match joint_figure(g, tag, notes) {
+        Some(f) => figure(
+            html,
+            &png_bytes(&f)?,
+            "Joints: opening [mm] and normal stress [MPa] along the height",
+        ),
+        None => notes.push(JOINT_NOTE.into()),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolation_brackets() {
+        let p = [(0.0, 0.0), (1.0, 10.0), (2.0, 20.0)];
+        assert_eq!(interpolate(&p, 0.5), Some(5.0));
+        assert_eq!(interpolate(&p, 2.0), Some(20.0));
+        assert_eq!(interpolate(&p, 3.0), None);
+        let neg = [(0.0, 0.0), (-1.0, 10.0)];
+        assert_eq!(interpolate(&neg, -0.25), Some(2.5));
+    }
+
+    #[test]
+    fn escaping() {
+        assert_eq!(esc("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
+    }
+}

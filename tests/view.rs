@@ -1,0 +1,446 @@
+//! `segfem plot` and `segfem report` on a real run of the bundled box-beam example: valid
+//! PNG/SVG files of sensible size, plotted data equal to history.csv, figures for crack and
+//! joint data when present, bad arguments → exit status 2, and the HTML report rendered by
+//! headless Chromium when it is installed.
+
+use segfem::results::vtu::{render, render_pvd, Array, Grid as VtuGrid};
+use segfem::view::{self, report, PlotOptions, ViewError};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("segfem-view-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The box-beam example run once for all tests.
+fn run_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/box-beam.toml");
+        let out = tmp("box-beam");
+        segfem::run::run_file(&path, &out, &mut |_| {}).expect("box-beam runs");
+        out
+    })
+}
+
+/// (width, height) from the IHDR chunk, after checking the PNG signature.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR", "IHDR first");
+    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+/// Variance of the decoded pixel bytes (0 for a blank image).
+fn pixel_variance(path: &Path) -> f64 {
+    let dec = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = dec.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let px = &buf[..info.buffer_size()];
+    let n = px.len() as f64;
+    let mean = px.iter().map(|&b| b as f64).sum::<f64>() / n;
+    px.iter().map(|&b| (b as f64 - mean).powi(2)).sum::<f64>() / n
+}
+
+/// XML well-formed in the simple sense: tags balance, and there is an `<svg` root.
+fn check_svg(text: &str) {
+    assert!(text.contains("<svg"), "no <svg element");
+    let mut stack: Vec<String> = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find('<') {
+        let j = rest[i..].find('>').expect("unterminated tag") + i;
+        let tag = &rest[i + 1..j];
+        rest = &rest[j + 1..];
+        if tag.starts_with('?') || tag.starts_with('!') || tag.ends_with('/') {
+            continue;
+        }
+        let name = tag
+            .trim_start_matches('/')
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .to_string();
+        if tag.starts_with('/') {
+            assert_eq!(
+                stack.pop().as_deref(),
+                Some(name.as_str()),
+                "unbalanced </{name}>"
+            );
+        } else {
+            stack.push(name);
+        }
+    }
+    assert!(stack.is_empty(), "unclosed tags: {stack:?}");
+}
+
+/// history.csv parsed independently: (header, rows).
+fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+fn col(header: &[String], prefix: &str) -> usize {
+    header.iter().position(|h| h.starts_with(prefix)).unwrap()
+}
+
+#[test]
+fn plot_writes_valid_figures_with_the_history_data() {
+    let dir = run_dir();
+    let out = tmp("plot");
+    let reference = out.join("ref.csv");
+    std::fs::write(&reference, "u [m],Q [-]\n-0.0012,25\n-0.0021,50\n").unwrap();
+    let o = view::plot(&PlotOptions {
+        dir: dir.to_path_buf(),
+        reference: Some(reference),
+        out: Some(out.clone()),
+        ..Default::default()
+    })
+    .unwrap();
+    for stem in ["curves", "mesh", "deformed", "field_sx"] {
+        let png = out.join(format!("{stem}.png"));
+        let svg = out.join(format!("{stem}.svg"));
+        assert!(o.files.contains(&png) && o.files.contains(&svg), "{stem}");
+        let bytes = std::fs::read(&png).unwrap();
+        let (w, h) = png_size(&bytes);
+        assert!(
+            (600..=2000).contains(&w) && (150..=1500).contains(&h),
+            "{stem}: {w}×{h}"
+        );
+        assert!(
+            bytes.len() > 5_000,
+            "{stem}.png is only {} bytes",
+            bytes.len()
+        );
+        assert!(pixel_variance(&png) > 100.0, "{stem}.png looks blank");
+        let text = std::fs::read_to_string(&svg).unwrap();
+        check_svg(&text);
+        assert!(text.len() > 2_000);
+    }
+    // No crack or joint data in an elastic run without joints: one note each.
+    assert_eq!(o.notes.len(), 2, "{:?}", o.notes);
+    assert!(!out.join("cracks.png").exists() && !out.join("joints.png").exists());
+
+    // The plotted series is the history: Q against midspan_uy, row for row.
+    let (header, rows) = history(dir);
+    let (ix, iy) = (col(&header, "midspan_uy"), col(&header, "Q ["));
+    let curves = o.curves.unwrap();
+    assert_eq!(curves.x_label, "midspan_uy [m]");
+    assert_eq!(curves.y_label, "Q [-]");
+    let expected: Vec<(f64, f64)> = rows.iter().map(|r| (r[ix], r[iy])).collect();
+    assert_eq!(curves.series.len(), 1);
+    assert_eq!(curves.series[0].points, expected);
+    assert_eq!(
+        curves.reference.unwrap().points,
+        vec![(-0.0012, 25.0), (-0.0021, 50.0)]
+    );
+    // ...and the SVG has a polyline through exactly one point per row.
+    let svg = std::fs::read_to_string(out.join("curves.svg")).unwrap();
+    let counts: Vec<usize> = svg
+        .split("<polyline")
+        .skip(1)
+        .map(|p| {
+            let a = p.find("points=\"").unwrap() + 8;
+            let b = a + p[a..].find('"').unwrap();
+            p[a..b].split_whitespace().count()
+        })
+        .collect();
+    assert!(
+        counts.contains(&rows.len()),
+        "polyline point counts {counts:?}, rows {}",
+        rows.len()
+    );
+
+    // Automatic magnification: the largest displacement drawn as 5 % of the 7.2 m span.
+    let g = view::data::Grid::read(o.vtu.as_ref().unwrap()).unwrap();
+    let umax = view::displacements(&g)
+        .iter()
+        .map(|u| u[0].hypot(u[1]))
+        .fold(0.0, f64::max);
+    let scale = o.scale.unwrap();
+    assert!(
+        (scale * umax - 0.05 * 7.2).abs() < 1e-9,
+        "scale {scale}, umax {umax}"
+    );
+}
+
+#[test]
+fn several_runs_columns_step_and_field_options() {
+    let dir = run_dir();
+    let out = tmp("options");
+    let o = view::plot(&PlotOptions {
+        dir: dir.to_path_buf(),
+        x: Some("Q".into()),
+        y: vec!["R_left".into(), "midspan_uy".into()],
+        runs: vec![dir.to_path_buf()],
+        step: Some(1),
+        field: Some(view::Field::S2),
+        cells: true,
+        scale: Some(100.0),
+        out: Some(out.clone()),
+        ..Default::default()
+    })
+    .unwrap();
+    let c = o.curves.unwrap();
+    assert_eq!(c.series.len(), 4, "2 runs × 2 columns");
+    assert_eq!(c.x_label, "Q [-]");
+    assert!(c.y_label.contains("R_left [N]") && c.y_label.contains("midspan_uy [m]"));
+    assert_eq!(o.scale, Some(100.0));
+    assert!(o.vtu.unwrap().ends_with("step001_inc0001.vtu"));
+    assert!(out.join("field_s2.png").exists());
+}
+
+#[test]
+fn bad_arguments_are_usage_errors() {
+    let dir = run_dir().to_path_buf();
+    let out = tmp("bad");
+    let base = PlotOptions {
+        dir: dir.clone(),
+        out: Some(out),
+        ..Default::default()
+    };
+    let cases = [
+        PlotOptions {
+            x: Some("nope".into()),
+            ..base.clone()
+        },
+        PlotOptions {
+            step: Some(99),
+            ..base.clone()
+        },
+        PlotOptions {
+            scale: Some(-1.0),
+            ..base.clone()
+        },
+        PlotOptions {
+            dir: dir.join("missing"),
+            ..base.clone()
+        },
+        PlotOptions {
+            reference: Some(dir.join("missing.csv")),
+            ..base.clone()
+        },
+    ];
+    for c in cases {
+        let e = view::plot(&c).unwrap_err();
+        assert!(matches!(e, ViewError::Usage(_)), "{e}");
+        assert_eq!(e.exit_code(), 2);
+        assert!(!e.to_string().contains('\n'), "one line: {e}");
+    }
+    assert!("sz".parse::<view::Field>().is_err());
+
+    // Through the binary: a clear one-line error and exit status 2.
+    let bin = env!("CARGO_BIN_EXE_segfem");
+    for args in [
+        vec![
+            "plot".to_string(),
+            dir.join("missing").display().to_string(),
+        ],
+        vec![
+            "plot".into(),
+            dir.display().to_string(),
+            "--field".into(),
+            "sz".into(),
+        ],
+        vec![
+            "report".into(),
+            dir.display().to_string(),
+            "--step".into(),
+            "0".into(),
+        ],
+    ] {
+        let o = std::process::Command::new(bin)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.starts_with("error: ") && err.trim_end().lines().count() == 1,
+            "{err}"
+        );
+    }
+}
+
+/// A small run directory with cracks and a joint, as later versions will write.
+#[test]
+fn crack_pattern_and_joint_diagram_when_the_data_is_there() {
+    let dir = tmp("cracked");
+    // Two Q4 cells side by side, 1 m × 1 m each, with a joint (two line cells) at x = 1.
+    let points = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [2.0, 0.0],
+        [0.0, 1.0],
+        [1.0, 1.0],
+        [2.0, 1.0],
+        [1.0, 0.5],
+    ];
+    let cells = vec![vec![0, 1, 4, 3], vec![1, 2, 5, 4], vec![1, 6], vec![6, 4]];
+    let disp: Vec<f64> = points
+        .iter()
+        .flat_map(|p| [0.0, -1e-3 * p[0], 0.0])
+        .collect();
+    let stress: Vec<f64> = points
+        .iter()
+        .flat_map(|p| [1e6 * (p[1] - 0.5), 0.0, 0.0])
+        .collect();
+    let cstress = [1e6, 0.0, 0.0, -1e6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let doc = render(
+        &VtuGrid {
+            points: &points,
+            cells: &cells,
+            types: &[9, 9, 3, 3],
+        },
+        &[
+            Array::F64 {
+                name: "displacement",
+                components: 3,
+                values: &disp,
+            },
+            Array::F64 {
+                name: "stress",
+                components: 3,
+                values: &stress,
+            },
+        ],
+        &[
+            Array::F64 {
+                name: "stress",
+                components: 3,
+                values: &cstress,
+            },
+            Array::F64 {
+                name: "crack_angle",
+                components: 1,
+                values: &[std::f64::consts::FRAC_PI_2, 0.3, 0.0, 0.0],
+            },
+            Array::I32 {
+                name: "n_cracks",
+                values: &[1, 2, 0, 0],
+            },
+            Array::F64 {
+                name: "opening",
+                components: 1,
+                values: &[0.0, 0.0, 2e-3, 0.0],
+            },
+            Array::F64 {
+                name: "normal_stress",
+                components: 1,
+                values: &[0.0, 0.0, 0.0, -3e6],
+            },
+        ],
+    );
+    std::fs::write(dir.join("s.vtu"), doc).unwrap();
+    std::fs::write(
+        dir.join("results.pvd"),
+        render_pvd(&[(1.0, 0, "s.vtu".into())]),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("history.csv"),
+        "step,increment,iterations,factor:P [-],tip [m],P [-]\n1,1,1,1e0,-1e-3,1e0\n",
+    )
+    .unwrap();
+    let g = view::data::Grid::read(&dir.join("s.vtu")).unwrap();
+    let joints = view::joint_profiles(&g);
+    assert_eq!(joints.len(), 1);
+    // Openings in mm, normal stresses in MPa, sorted by height.
+    assert_eq!(joints[0].points, vec![(0.25, 2.0, 0.0), (0.75, 0.0, -3.0)]);
+    let o = view::plot(&PlotOptions {
+        dir: dir.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    assert!(o.notes.is_empty(), "{:?}", o.notes);
+    for stem in ["cracks", "joints"] {
+        let png = dir.join("figures").join(format!("{stem}.png"));
+        png_size(&std::fs::read(&png).unwrap());
+        assert!(pixel_variance(&png) > 50.0);
+        check_svg(
+            &std::fs::read_to_string(dir.join("figures").join(format!("{stem}.svg"))).unwrap(),
+        );
+    }
+}
+
+#[test]
+fn html_report_is_self_contained_and_renders() {
+    let dir = run_dir();
+    let out = tmp("report");
+    let reference = out.join("ref.csv");
+    std::fs::write(
+        &reference,
+        "u [m],Q [-]\n-0.0012,25\n-0.0021,50\n-0.01,99\n",
+    )
+    .unwrap();
+    let html_path = out.join("report.html");
+    let (path, notes) = report::report(&report::ReportOptions {
+        dir: dir.to_path_buf(),
+        out: Some(html_path.clone()),
+        reference: Some(reference),
+        ..Default::default()
+    })
+    .unwrap();
+    assert_eq!(path, html_path);
+    assert_eq!(notes.len(), 2);
+    let html = std::fs::read_to_string(&path).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    assert!(html.contains("Box-section beam, 7.2 m span, elastic"));
+    assert!(html.contains("<svg"), "inline SVG curve");
+    assert!(
+        html.matches("data:image/png;base64,").count() >= 5,
+        "embedded drawings"
+    );
+    assert!(html.contains("Peak load factor"));
+    assert!(html.contains("Comparison with the reference"));
+    assert!(
+        html.contains("outside the run"),
+        "the third reference point is beyond the run"
+    );
+    for bad in ["src=\"http", "href=\"http", "<script", "<link"] {
+        assert!(!html.contains(bad), "external resource: {bad}");
+    }
+
+    let chromium = Path::new("/usr/bin/chromium");
+    if !chromium.exists() {
+        println!("note: /usr/bin/chromium not found; the report screenshot check is skipped");
+        return;
+    }
+    let shot = out.join("shot.png");
+    let profile = tmp("chromium-profile");
+    let status = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            &format!("--user-data-dir={}", profile.display()),
+            &format!("--screenshot={}", shot.display()),
+            "--window-size=1200,2000",
+            &format!("file://{}", path.display()),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        shot.exists(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let bytes = std::fs::read(&shot).unwrap();
+    assert_eq!(png_size(&bytes), (1200, 2000));
+    assert!(
+        pixel_variance(&shot) > 100.0,
+        "the report screenshot is blank"
+    );
+}
