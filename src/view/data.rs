@@ -173,6 +173,46 @@ pub struct Output {
     pub time: f64,
     /// The `.vtu` file, resolved against the run directory.
     pub file: PathBuf,
+    /// The line-cell piece of the same instant (part 1: joints and tendons), if any.
+    pub lines: Option<PathBuf>,
+}
+
+impl Output {
+    /// The continuum grid with the joint line cells of the same instant appended (their
+    /// `joint_opening` and `joint_normal_stress` arrays as `opening` and `normal_stress`;
+    /// tendon spans left out), so that joint diagrams see them.
+    pub fn grid(&self) -> Result<Grid, ViewError> {
+        let mut g = Grid::read(&self.file)?;
+        let Some(lines) = &self.lines else {
+            return Ok(g);
+        };
+        let l = Grid::read(lines)?;
+        let kind = l.cell_array("cell_kind").map(|a| a.values.clone());
+        let keep: Vec<usize> = (0..l.cells.len())
+            .filter(|&i| kind.as_ref().is_none_or(|k| k[i] == 1.0))
+            .collect();
+        if keep.is_empty() || l.points.len() != g.points.len() {
+            return Ok(g);
+        }
+        let n0 = g.cells.len();
+        for a in &mut g.cell_data {
+            a.values.extend(std::iter::repeat_n(0.0, keep.len() * a.components));
+        }
+        for (src, dst) in [("joint_opening", "opening"), ("joint_normal_stress", "normal_stress")] {
+            if let Some(a) = l.cell_array(src) {
+                let mut values = vec![0.0; n0 * a.components];
+                for &i in &keep {
+                    values.extend_from_slice(&a.values[i * a.components..(i + 1) * a.components]);
+                }
+                g.cell_data.push(Array { name: dst.to_string(), components: a.components, values });
+            }
+        }
+        for &i in &keep {
+            g.cells.push(l.cells[i].clone());
+            g.types.push(l.types[i]);
+        }
+        Ok(g)
+    }
 }
 
 /// Attributes of an XML start tag (`key="value"` pairs), in order.
@@ -209,7 +249,8 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
     let path = dir.join("results.pvd");
     let text = std::fs::read_to_string(&path)
         .map_err(|e| ViewError::Usage(format!("{}: {e}", path.display())))?;
-    let mut out = Vec::new();
+    let mut out: Vec<Output> = Vec::new();
+    let mut lines: Vec<(f64, PathBuf)> = Vec::new();
     for part in text.split("<DataSet").skip(1) {
         let tag = &part[..part.find('>').unwrap_or(part.len())];
         let a = attributes(tag);
@@ -222,10 +263,15 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
         let time = attr(&a, "timestep")
             .and_then(|t| t.parse().ok())
             .unwrap_or(out.len() as f64 + 1.0);
-        out.push(Output {
-            time,
-            file: dir.join(file),
-        });
+        // Part 0 is the continuum; part 1 the joints and tendons; part 2 the bars.
+        match attr(&a, "part").and_then(|p| p.parse::<usize>().ok()).unwrap_or(0) {
+            0 => out.push(Output { time, file: dir.join(file), lines: None }),
+            1 => lines.push((time, dir.join(file))),
+            _ => {}
+        }
+    }
+    for o in &mut out {
+        o.lines = lines.iter().find(|(t, _)| *t == o.time).map(|(_, f)| f.clone());
     }
     Ok(out)
 }

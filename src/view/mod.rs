@@ -358,7 +358,7 @@ pub fn field_values(g: &Grid, field: Field, cells: bool) -> Result<FieldValues, 
 /// `n_cracks` cell arrays. Angles larger than 2π in magnitude are taken as degrees.
 pub fn cracks(g: &Grid) -> Option<Vec<(f64, usize)>> {
     let a = g.cell_array("crack_angle")?;
-    let n = g.cell_array("n_cracks")?;
+    let n = g.cell_array("n_cracks").or_else(|| g.cell_array("cracks"))?;
     let degrees = a
         .values
         .iter()
@@ -466,7 +466,7 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         }
         Err(e) => return Err(e),
     };
-    let g = Grid::read(&output.file)?;
+    let g = output.grid()?;
     let file = run_name(&output.file);
     let tag = format!("output {n}, {file}");
     outcome.vtu = Some(output.file.clone());

@@ -297,7 +297,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
     html.push_str("<h2>Model drawings</h2>\n");
     match pick_output(&opts.dir, opts.step) {
         Ok((n, output)) => {
-            let g = Grid::read(&output.file)?;
+            let g = output.grid()?;
             let tag = format!("output {n}, {}", run_name(&output.file));
             fields_section(&mut html, &g, &tag, &mut notes)?;
         }
