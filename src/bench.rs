@@ -126,6 +126,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         kind: MonitorKind::Displacement {
             node: tip,
             dir: Dir::Y,
+            since_step: None,
         },
     });
     model

@@ -97,12 +97,15 @@ pub struct LoadCase {
 /// What a monitor records.
 #[derive(Debug, Clone, Serialize)]
 pub enum MonitorKind {
-    /// Displacement component of a node [m].
+    /// Displacement component of a node [m], or its change since the end of a step.
     Displacement {
         /// Node index.
         node: usize,
         /// Component.
         dir: Dir,
+        /// Measure from the end of this step (e.g. "deflection due to Q" after prestress);
+        /// None = from the start.
+        since_step: Option<usize>,
     },
     /// Sum of the reactions of a support in one direction [N].
     Reaction {

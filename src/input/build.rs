@@ -429,9 +429,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         let kind = match m.kind.as_str() {
             "displacement" => {
                 let node = locate_nodes(ctx, &key, &model, &used, m.node, m.point, None)?[0];
+                let since_step = match &m.since_step {
+                    Some(name) => Some(index_by_name(
+                        ctx,
+                        &format!("{key}.since_step"),
+                        "step",
+                        file.steps.iter().map(|s| s.name.as_str()),
+                        name,
+                    )?),
+                    None => None,
+                };
                 MonitorKind::Displacement {
                     node,
                     dir: dir(ctx, &format!("{key}.component"), m.component.as_deref())?,
+                    since_step,
                 }
             }
             "reaction" => {

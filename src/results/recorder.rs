@@ -40,6 +40,8 @@ pub struct Recorder<'m> {
     /// Recorded rows.
     pub rows: Vec<Row>,
     pvd: Vec<(f64, usize, String)>,
+    /// Displacements at the end of each step some monitor measures from.
+    step_end_u: std::collections::HashMap<usize, Vec<f64>>,
     write_fields: bool,
 }
 
@@ -53,6 +55,7 @@ impl<'m> Recorder<'m> {
             dir,
             rows: Vec::new(),
             pvd: Vec::new(),
+            step_end_u: Default::default(),
             write_fields,
         })
     }
@@ -120,7 +123,17 @@ impl<'m> Recorder<'m> {
             .monitors
             .iter()
             .map(|m| match &m.kind {
-                MonitorKind::Displacement { node, dir } => u[2 * node + dir.index()],
+                MonitorKind::Displacement {
+                    node,
+                    dir,
+                    since_step,
+                } => {
+                    let k = 2 * node + dir.index();
+                    let base = since_step
+                        .and_then(|s| self.step_end_u.get(&s))
+                        .map_or(0.0, |u0| u0[k]);
+                    u[k] - base
+                }
                 MonitorKind::Reaction { support, dir } => self.model.supports[*support]
                     .dofs
                     .iter()
@@ -303,6 +316,12 @@ impl<'m> Recorder<'m> {
 
 impl Observer for Recorder<'_> {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let wanted = self.model.monitors.iter().any(|m| {
+            matches!(m.kind, MonitorKind::Displacement { since_step: Some(s), .. } if s == snap.step)
+        });
+        if snap.end_of_step && wanted {
+            self.step_end_u.insert(snap.step, snap.system.u.clone());
+        }
         let monitors = self.monitor_values(snap);
         self.rows.push(Row {
             step: snap.step,

@@ -196,15 +196,23 @@ impl Output {
         }
         let n0 = g.cells.len();
         for a in &mut g.cell_data {
-            a.values.extend(std::iter::repeat_n(0.0, keep.len() * a.components));
+            a.values
+                .extend(std::iter::repeat_n(0.0, keep.len() * a.components));
         }
-        for (src, dst) in [("joint_opening", "opening"), ("joint_normal_stress", "normal_stress")] {
+        for (src, dst) in [
+            ("joint_opening", "opening"),
+            ("joint_normal_stress", "normal_stress"),
+        ] {
             if let Some(a) = l.cell_array(src) {
                 let mut values = vec![0.0; n0 * a.components];
                 for &i in &keep {
                     values.extend_from_slice(&a.values[i * a.components..(i + 1) * a.components]);
                 }
-                g.cell_data.push(Array { name: dst.to_string(), components: a.components, values });
+                g.cell_data.push(Array {
+                    name: dst.to_string(),
+                    components: a.components,
+                    values,
+                });
             }
         }
         for &i in &keep {
@@ -264,14 +272,24 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
             .and_then(|t| t.parse().ok())
             .unwrap_or(out.len() as f64 + 1.0);
         // Part 0 is the continuum; part 1 the joints and tendons; part 2 the bars.
-        match attr(&a, "part").and_then(|p| p.parse::<usize>().ok()).unwrap_or(0) {
-            0 => out.push(Output { time, file: dir.join(file), lines: None }),
+        match attr(&a, "part")
+            .and_then(|p| p.parse::<usize>().ok())
+            .unwrap_or(0)
+        {
+            0 => out.push(Output {
+                time,
+                file: dir.join(file),
+                lines: None,
+            }),
             1 => lines.push((time, dir.join(file))),
             _ => {}
         }
     }
     for o in &mut out {
-        o.lines = lines.iter().find(|(t, _)| *t == o.time).map(|(_, f)| f.clone());
+        o.lines = lines
+            .iter()
+            .find(|(t, _)| *t == o.time)
+            .map(|(_, f)| f.clone());
     }
     Ok(out)
 }

@@ -358,7 +358,9 @@ pub fn field_values(g: &Grid, field: Field, cells: bool) -> Result<FieldValues, 
 /// `n_cracks` cell arrays. Angles larger than 2π in magnitude are taken as degrees.
 pub fn cracks(g: &Grid) -> Option<Vec<(f64, usize)>> {
     let a = g.cell_array("crack_angle")?;
-    let n = g.cell_array("n_cracks").or_else(|| g.cell_array("cracks"))?;
+    let n = g
+        .cell_array("n_cracks")
+        .or_else(|| g.cell_array("cracks"))?;
     let degrees = a
         .values
         .iter()
