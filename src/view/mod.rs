@@ -530,7 +530,7 @@ fn extra_figures(
 
 /// Note for a skipped crack pattern.
 pub const CRACK_NOTE: &str =
-    "crack pattern: skipped (the results carry no crack_angle/n_cracks cell arrays)";
+    "crack pattern: skipped (no cracked cells, or no crack_angle/n_cracks cell arrays)";
 /// Note for skipped joint diagrams.
 pub const JOINT_NOTE: &str =
     "joint diagrams: skipped (the results carry no joint line cells with an opening array)";
@@ -539,6 +539,10 @@ pub const JOINT_NOTE: &str =
 pub fn crack_figure<'g>(g: &'g Grid, tag: &str) -> Option<CrackFigure<'g>> {
     let cracks = cracks(g)?;
     let n = cracks.iter().filter(|c| c.1 > 0).count();
+    if n == 0 {
+        // Uncracked (or elastic) results: nothing to draw.
+        return None;
+    }
     Some(CrackFigure {
         grid: g,
         cracks,
