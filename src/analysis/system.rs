@@ -99,8 +99,9 @@ fn symmetrise(k: &mut [f64], n: usize) {
     }
 }
 
-/// Element force and row-major tangent, or the failing element and why.
-type ElementResult = Result<(Vec<f64>, Vec<f64>), (usize, UpdateError)>;
+/// Success of one element's update (its force and tangent are in the chunk buffers), or the
+/// failing element and why.
+type ElementResult = Result<(), (usize, UpdateError)>;
 
 /// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
 pub struct Assembled {
@@ -254,6 +255,11 @@ impl<'m> System<'m> {
         let n_el = model.elements.len();
         let time = self.time;
         let mut start = 0;
+        // Element vectors and matrices of one chunk, allocated once per assembly (the
+        // element loop itself does not allocate).
+        const ND: usize = 2 * crate::fem::shape::MAX_NODES;
+        let mut fbuf = vec![0.0; CHUNK * ND];
+        let mut kbuf = vec![0.0; CHUNK * ND * ND];
         // Split the state arrays per element once per chunk so that chunks can be filled in
         // parallel without aliasing.
         while start < n_el {
@@ -289,19 +295,23 @@ impl<'m> System<'m> {
             }
             let results: Vec<ElementResult> = pieces
                 .into_par_iter()
-                .map(|(e, t, o, (bt, bo))| {
+                .zip(fbuf.par_chunks_mut(ND))
+                .zip(kbuf.par_chunks_mut(ND * ND))
+                .map(|(((e, t, o, (bt, bo)), fe), ke)| {
                     let el = &model.elements[e];
                     let region = &model.regions[el.region];
                     let mat = &model.materials[region.material].law;
-                    let coords = model.element_coords(el);
-                    let nd = 2 * el.nodes.len();
-                    let ue: Vec<f64> = el
-                        .nodes
-                        .iter()
-                        .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
-                        .collect();
-                    let mut fe = vec![0.0; nd];
-                    let mut ke = vec![0.0; nd * nd];
+                    let nn = el.nodes.len();
+                    let nd = 2 * nn;
+                    let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+                    let mut ue = [0.0; ND];
+                    for (a, &n) in el.nodes.iter().enumerate() {
+                        coords[a] = model.nodes[n];
+                        ue[2 * a] = u[2 * n];
+                        ue[2 * a + 1] = u[2 * n + 1];
+                    }
+                    let (coords, ue) = (&coords[..nn], &ue[..nd]);
+                    let (fe, ke) = (&mut fe[..nd], &mut ke[..nd * nd]);
                     let c0 = gp_offset[e] - g0;
                     // Start from the latched crack states where a crack formed in this
                     // increment, from the committed states elsewhere.
@@ -323,13 +333,13 @@ impl<'m> System<'m> {
                     continuum::response_with_time(
                         el.kind,
                         el.integration,
-                        &coords,
+                        coords,
                         region.thickness,
                         mat,
                         owned.as_deref().unwrap_or(base),
-                        &ue,
-                        &mut fe,
-                        &mut ke,
+                        ue,
+                        fe,
+                        ke,
                         t,
                         o,
                         &time,
@@ -345,9 +355,9 @@ impl<'m> System<'m> {
                     {
                         let bar = &model.bars[b];
                         let bp = &bar.points[p].point;
-                        let g = bar_strain_vector(el.kind, &coords, bp);
+                        let g = bar_strain_vector(el.kind, coords, bp);
                         let eps =
-                            g.iter().zip(&ue).map(|(a, b)| a * b).sum::<f64>() + bar.prestrain();
+                            g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>() + bar.prestrain();
                         let (s_new, sig, et) =
                             update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
                         *st = s_new;
@@ -368,12 +378,15 @@ impl<'m> System<'m> {
                             }
                         }
                     }
-                    Ok((fe, ke))
+                    Ok(())
                 })
                 .collect();
             for (i, r) in results.into_iter().enumerate() {
                 let e = start + i;
-                let (fe, ke) = r?;
+                r?;
+                let nd = 2 * model.elements[e].nodes.len();
+                let fe = &fbuf[i * ND..i * ND + nd];
+                let ke = &kbuf[i * ND * ND..i * ND * ND + nd * nd];
                 for (a, &n) in model.elements[e].nodes.iter().enumerate() {
                     f_int[2 * n] += fe[2 * a];
                     f_int[2 * n + 1] += fe[2 * a + 1];
@@ -381,7 +394,7 @@ impl<'m> System<'m> {
                     f_abs[2 * n + 1] += fe[2 * a + 1].abs();
                 }
                 if let Some(k) = k_values.as_mut() {
-                    self.asm.add_matrix(e, &ke, k);
+                    self.asm.add_matrix(e, ke, k);
                 }
             }
             start = end;
