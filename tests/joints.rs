@@ -269,3 +269,103 @@ fn segmental_beam_decompresses_at_the_beam_theory_moment_then_opens() {
         "compressed depth should fall below half the depth"
     );
 }
+
+/// One opened joint between two (nearly) rigid segments: the right block rocks on the joint
+/// as a rigid block on a tensionless Winkler foundation of stiffness K_n. Under a normal
+/// force N at eccentricity e = M/N > h/6 the contact length is a = 3 (h/2 − e), the largest
+/// contact stress 2N/(a b), the rotation θ = 2N/(K_n b a²) and the opening at the far edge
+/// θ (h − a).
+#[test]
+fn single_opened_joint_rocks_like_a_rigid_block() {
+    let (h, b, kn, n) = (0.5, 0.2, 1e10, 100e3);
+    let v = 30e3; // transverse load 0.5 m from the joint: M = 15 kN·m, e = 0.15 m
+    let text = format!(
+        r#"
+[[materials]]
+name = "rigid"
+kind = "elastic"
+E = 1e13
+nu = 0.2
+[[regions]]
+name = "r"
+material = "rigid"
+thickness = {b}
+[[joint_materials]]
+name = "keyed"
+kind = "keyed"
+kn = {kn}
+kt = {kn}
+residual_stiffness_ratio = 0.0
+[mesh]
+type = "segmental"
+segments = [0.5, 0.5]
+nx_per_segment = 2
+element = "Q8"
+joint_material = "keyed"
+bands = [{{ region = "r", depth = {h}, rows = 20 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, {h}]]
+ux = 0.0
+uy = 0.0
+[[load_cases]]
+name = "N"
+line_loads = [{{ line = [[1.0, 0.0], [1.0, {h}]], q = [{qn}, 0.0] }}]
+[[load_cases]]
+name = "V"
+line_loads = [{{ line = [[1.0, 0.0], [1.0, {h}]], q = [0.0, {qv}] }}]
+[[steps]]
+name = "axial"
+kind = "load"
+loads = {{ N = 1.0 }}
+[[steps]]
+name = "bend"
+kind = "load"
+loads = {{ N = 1.0, V = 1.0 }}
+increments = 10
+"#,
+        qn = -n / h,
+        qv = -v / h
+    );
+    let model = segfem::input::parse(&text, "rocking.toml").unwrap().model;
+    #[derive(Default)]
+    struct Last(Option<segfem::results::joints::JointSummary>);
+    impl Observer for Last {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            self.0 = Some(summarise(s.system, 0));
+            Ok(())
+        }
+    }
+    let mut last = Last::default();
+    steps::run(&model, &mut last).unwrap();
+    let j = last.0.unwrap();
+    let e = v * 0.5 / n;
+    let a = 3.0 * (h / 2.0 - e);
+    let top = 2.0 * n / (kn * b * a * a) * (h - a);
+    // Contact length from the closed points' integration lengths: resolution one element
+    // edge (h/20 = 0.025 m).
+    assert!(
+        (j.contact_depth - a).abs() <= 0.025 + 1e-9,
+        "contact {} vs {a}",
+        j.contact_depth
+    );
+    // The opening at the top edge: rigid-block value within 5 % (the contact edge falls
+    // between integration points; the blocks are 1000 times stiffer than the joint).
+    let open_top = j.profile.last().unwrap().opening;
+    assert!(
+        ((open_top - top) / top).abs() < 0.05,
+        "opening {open_top} vs {top}"
+    );
+    // The opening grows linearly above the contact zone (rigid rotation θ): within 5 % of
+    // the top opening at every open point.
+    let theta = 2.0 * n / (kn * b * a * a);
+    for p in j.profile.iter().filter(|p| p.opening > 0.0) {
+        let expected = theta * (p.x[1] - a);
+        assert!(
+            (p.opening - expected).abs() < 0.05 * top,
+            "y = {}: {} vs {expected}",
+            p.x[1],
+            p.opening
+        );
+    }
+}
