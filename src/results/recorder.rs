@@ -216,6 +216,21 @@ impl<'m> Recorder<'m> {
                 reaction[3 * n + d.index()] = snap.f_int[k] - snap.f_ext[k];
             }
         }
+        // Unit normal of the widest crack of each cell, as a vector for ParaView glyphs
+        // (zero for uncracked cells); crack_angle holds the same in degrees from x.
+        let crack_normal: Vec<f64> = st
+            .angle
+            .iter()
+            .zip(&st.cracks)
+            .flat_map(|(deg, n)| {
+                let t = deg.to_radians();
+                if *n > 0 {
+                    [t.cos(), t.sin(), 0.0]
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
         let doc = render(
             &Grid {
                 points: &model.nodes,
@@ -277,6 +292,11 @@ impl<'m> Recorder<'m> {
                     name: "crack_strain",
                     components: 1,
                     values: &st.crack_strain,
+                },
+                Array::F64 {
+                    name: "crack_normal",
+                    components: 3,
+                    values: &crack_normal,
                 },
                 Array::F64 {
                     name: "plastic_strain",

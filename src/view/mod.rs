@@ -354,9 +354,24 @@ pub fn field_values(g: &Grid, field: Field, cells: bool) -> Result<FieldValues, 
     Ok(FieldValues::Nodal(from(a, g.points.len())))
 }
 
-/// Crack data per cell (angle [rad], count), when the grid has `crack_angle` and
-/// `n_cracks` cell arrays. Angles larger than 2π in magnitude are taken as degrees.
+/// Crack data per cell (angle of the crack line [rad], count): from the `crack_normal` vectors segfem
+/// writes, else from `crack_angle` with `n_cracks`/`cracks` (angles larger than 2π in
+/// magnitude are taken as degrees).
 pub fn cracks(g: &Grid) -> Option<Vec<(f64, usize)>> {
+    if let (Some(v), Some(n)) = (g.cell_array("crack_normal"), g.cell_array("cracks")) {
+        return Some(
+            (0..g.cells.len())
+                // The crack runs perpendicular to its normal.
+                .map(|i| {
+                    let normal = v.get(i, 1).atan2(v.get(i, 0));
+                    (
+                        normal + std::f64::consts::FRAC_PI_2,
+                        n.get(i, 0).max(0.0) as usize,
+                    )
+                })
+                .collect(),
+        );
+    }
     let a = g.cell_array("crack_angle")?;
     let n = g
         .cell_array("n_cracks")
