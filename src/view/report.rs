@@ -154,6 +154,72 @@ fn key_numbers(h: &Table) -> String {
     s
 }
 
+/// Engineering events read off the history, against the load measure (the load-case factor
+/// that grows most): the first joint opening (first row where a monitor named
+/// `*opening*` becomes positive), the largest opening, the tendon stress increase
+/// (`*tendon_stress*` monitors, last minus first value) and the decompression bracket.
+fn events(h: &Table) -> String {
+    let Some(load) = h
+        .factors()
+        .chain(h.monitors().filter(|c| c.unit == "-"))
+        .max_by(|a, b| {
+            let span = |c: &super::data::Column| {
+                c.values.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                    - c.values.iter().copied().fold(f64::INFINITY, f64::min)
+            };
+            span(a).total_cmp(&span(b))
+        })
+    else {
+        return String::new();
+    };
+    let mut items = Vec::new();
+    for c in h.monitors().filter(|c| c.name.contains("opening")) {
+        if let Some(k) = c.values.iter().position(|v| *v > 0.0) {
+            let before = if k > 0 {
+                format!(" (closed at {})", num(load.values[k - 1]))
+            } else {
+                String::new()
+            };
+            items.push(format!(
+                "first opening ({}): {} = {}{before}",
+                esc(&c.name),
+                esc(&load.name),
+                num(load.values[k])
+            ));
+            let max = c.values.iter().copied().fold(0.0, f64::max);
+            items.push(format!(
+                "largest {}: {} {}",
+                esc(&c.name),
+                num(max),
+                esc(&c.unit)
+            ));
+        } else {
+            items.push(format!("{}: no opening in this run", esc(&c.name)));
+        }
+    }
+    for c in h.monitors().filter(|c| c.name.contains("tendon_stress")) {
+        if let (Some(first), Some(last)) = (c.values.iter().find(|v| **v != 0.0), c.values.last()) {
+            items.push(format!(
+                "{}: {} → {} {} (increase {})",
+                esc(&c.name),
+                num(*first),
+                num(*last),
+                esc(&c.unit),
+                num(last - first)
+            ));
+        }
+    }
+    if items.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from("<h2>Events</h2>\n<ul>\n");
+    for i in items {
+        let _ = writeln!(s, "<li>{i}</li>");
+    }
+    s.push_str("</ul>\n");
+    s
+}
+
 fn summary_section(dir: &Path) -> (String, String) {
     let path = dir.join("summary.json");
     let Ok(text) = std::fs::read_to_string(&path) else {
@@ -242,6 +308,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         h.rows(),
         key_numbers(&h)
     );
+    html.push_str(&events(&h));
     let peak = h
         .factors()
         .chain(h.monitors().filter(|c| c.unit == "-"))
