@@ -64,6 +64,9 @@ enum Command {
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
+        /// Print every Newton iteration's residual and energy norms.
+        #[arg(short, long)]
+        verbose: bool,
     },
     /// Validate a model file and print a summary, without solving.
     Check {
@@ -161,7 +164,8 @@ fn main() -> ExitCode {
             model,
             output,
             quiet,
-        } => run(model, output, quiet),
+            verbose,
+        } => run(model, output, quiet, verbose),
         Command::Check { model } => check(model),
         Command::Example { name, output } => example(name, output),
         Command::Bench {
@@ -240,7 +244,7 @@ fn view_error(e: segfem::view::ViewError) -> ExitCode {
     ExitCode::from(e.exit_code())
 }
 
-fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool) -> ExitCode {
+fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool, verbose: bool) -> ExitCode {
     let out = output.unwrap_or_else(|| model.with_extension(""));
     let tty = std::io::stderr().is_terminal() && !quiet;
     let bar = if tty {
@@ -269,7 +273,7 @@ fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool) -> ExitCode {
             None => {}
         }
     };
-    let res = segfem::run::run_file(&model, &out, &mut on_inc);
+    let res = segfem::run::run_file_with(&model, &out, &mut on_inc, verbose);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

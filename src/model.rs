@@ -308,6 +308,9 @@ pub struct SolverControls {
     pub max_iterations: usize,
     /// Maximum number of times an increment may be halved.
     pub max_cuts: usize,
+    /// Print every Newton iteration's residual and energy norms to standard error
+    /// (set by `segfem run --verbose`, not by the model file).
+    pub verbose: bool,
 }
 
 impl Default for SolverControls {
@@ -317,6 +320,7 @@ impl Default for SolverControls {
             energy_tolerance: 1e-12,
             max_iterations: 25,
             max_cuts: 6,
+            verbose: false,
         }
     }
 }

@@ -118,8 +118,19 @@ pub fn run_file(
     out: &Path,
     on_increment: &mut dyn FnMut(&Snapshot),
 ) -> Result<Summary, RunError> {
+    run_file_with(path, out, on_increment, false)
+}
+
+/// As [`run_file`]; `verbose` prints every Newton iteration's norms to standard error.
+pub fn run_file_with(
+    path: &Path,
+    out: &Path,
+    on_increment: &mut dyn FnMut(&Snapshot),
+    verbose: bool,
+) -> Result<Summary, RunError> {
     let t0 = Instant::now();
-    let built = input::load(path)?;
+    let mut built = input::load(path)?;
+    built.model.controls.verbose = verbose;
     let input_s = t0.elapsed().as_secs_f64();
     let model = built.model;
     let rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {

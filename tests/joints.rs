@@ -369,3 +369,53 @@ increments = 10
         );
     }
 }
+
+/// Global equilibrium at every converged increment of a run with joints opening: the sum of
+/// the reactions balances the applied loads to 1e-8 of the load.
+#[test]
+fn equilibrium_holds_at_every_increment_with_joints_opening() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/segmental-decompression.toml"
+    ))
+    .unwrap();
+    let model = segfem::input::parse(&text, "segmental-decompression.toml")
+        .unwrap()
+        .model;
+    #[derive(Default)]
+    struct Eq(Vec<(f64, f64)>);
+    impl Observer for Eq {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            let m = s.system.model;
+            let mut applied = [0.0; 2];
+            let mut scale = 0.0f64;
+            for (k, f) in s.f_ext.iter().enumerate() {
+                applied[k % 2] += f;
+                scale = scale.max(f.abs());
+            }
+            let mut reaction = [0.0; 2];
+            for sp in &m.supports {
+                for &(n, d, _) in &sp.dofs {
+                    let k = 2 * n + d.index();
+                    reaction[d.index()] += s.f_int[k] - s.f_ext[k];
+                }
+            }
+            let err = (reaction[0] + applied[0])
+                .abs()
+                .max((reaction[1] + applied[1]).abs());
+            // Scale: the total of the applied forces' magnitudes (600 kN prestress per end).
+            let total: f64 = s.f_ext.iter().map(|f| f.abs()).sum();
+            self.0.push((err, total.max(scale)));
+            Ok(())
+        }
+    }
+    let mut eq = Eq::default();
+    steps::run(&model, &mut eq).unwrap();
+    assert!(eq.0.len() > 20);
+    for (i, (err, total)) in eq.0.iter().enumerate() {
+        assert!(
+            *err <= 1e-8 * total,
+            "increment {i}: equilibrium error {err} N of {total} N"
+        );
+    }
+}

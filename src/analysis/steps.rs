@@ -309,6 +309,12 @@ pub(super) fn newton(
             return Err(NewtonFailure::Diverged(history));
         }
         history.push(rel);
+        if c.verbose {
+            eprintln!(
+                "    iteration {it:2}: relative residual {rel:.3e}, last energy {:.3e}",
+                last_energy.unwrap_or(0.0)
+            );
+        }
         // Converged on force, or on energy (|Δu·r| of the last correction small against the
         // first one) once at least one correction has been made.
         let energy_ok = it > 1
