@@ -750,25 +750,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
             if !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
                 return Err(ctx.err("mesh", "a banded mesh takes no nodes or blocks"));
             }
-            let mut bands = Vec::new();
-            for (i, b) in mesh.bands.iter().enumerate() {
-                let region = index_by_name(
-                    ctx,
-                    &format!("mesh.bands[{i}].region"),
-                    "region",
-                    region_names(),
-                    &b.region,
-                )?;
-                let depth = positive(ctx, &format!("mesh.bands[{i}].depth"), b.depth)?;
-                if b.rows == 0 {
-                    return Err(ctx.err(format!("mesh.bands[{i}].rows"), "must be at least 1"));
-                }
-                bands.push(Band {
-                    depth,
-                    rows: b.rows,
-                    region,
-                });
-            }
+            let bands = bands_of(mesh, ctx, region_names)?;
             let origin = origin_of(mesh, ctx)?;
             let g = banded::generate(origin, length, nx, &bands, kind);
             let elements = g
