@@ -122,20 +122,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             "elastic" => {
                 check_material_keys(ctx, i, m, &["E", "nu", "density"])?;
                 let e = positive(ctx, &k("E"), m.e.ok_or_else(|| ctx.err(k("E"), "missing"))?)?;
-                let nu = m.nu.ok_or_else(|| ctx.err(k("nu"), "missing"))?;
-                if !(nu > -1.0 && nu < 0.5) {
-                    return Err(ctx.err(
-                        k("nu"),
-                        format!("Poisson ratio must lie in (-1, 0.5) (got {nu})"),
-                    ));
-                }
-                let density = m.density.unwrap_or(0.0);
-                if !(density.is_finite() && density >= 0.0) {
-                    return Err(ctx.err(
-                        k("density"),
-                        format!("must be zero or positive (got {density})"),
-                    ));
-                }
+                let (nu, density) = poisson_and_density(ctx, i, m)?;
                 if e < 1e6 {
                     warnings.push(format!(
                         "{}: {}: E = {e} Pa looks like MPa or GPa; segfem works in Pa",
@@ -2133,20 +2120,7 @@ fn creep_material(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String
             ))
         }
     };
-    let nu = m.nu.ok_or_else(|| ctx.err(k("nu"), "missing"))?;
-    if !(nu > -1.0 && nu < 0.5) {
-        return Err(ctx.err(
-            k("nu"),
-            format!("Poisson ratio must lie in (-1, 0.5) (got {nu})"),
-        ));
-    }
-    let density = m.density.unwrap_or(0.0);
-    if !(density.is_finite() && density >= 0.0) {
-        return Err(ctx.err(
-            k("density"),
-            format!("must be zero or positive (got {density})"),
-        ));
-    }
+    let (nu, density) = poisson_and_density(ctx, i, m)?;
     let n_units = m.n_units.unwrap_or(DEFAULT_UNITS);
     if !(2..=12).contains(&n_units) {
         return Err(ctx.err(
@@ -2403,4 +2377,25 @@ fn segment_regions(
         *d = None;
     }
     Ok(())
+}
+
+/// The Poisson ratio (required, in (−1, 0.5)) and density (default 0, ≥ 0 [kg/m³]) of a
+/// material table.
+fn poisson_and_density(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<(f64, f64)> {
+    let k = |f: &str| format!("materials[{i}].{f}");
+    let nu = m.nu.ok_or_else(|| ctx.err(k("nu"), "missing"))?;
+    if !(nu > -1.0 && nu < 0.5) {
+        return Err(ctx.err(
+            k("nu"),
+            format!("Poisson ratio must lie in (-1, 0.5) (got {nu})"),
+        ));
+    }
+    let density = m.density.unwrap_or(0.0);
+    if !(density.is_finite() && density >= 0.0) {
+        return Err(ctx.err(
+            k("density"),
+            format!("must be zero or positive (got {density})"),
+        ));
+    }
+    Ok((nu, density))
 }
