@@ -43,7 +43,9 @@ impl PathContext<'_, '_> {
     }
 
     /// Assemble at `u` with the tangent, factorise it (LDLᵀ fallback).
-    fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>), NewtonFailure> {
+    /// Internal forces, tangent values and the element-force scale (the residual reference
+    /// that stays finite under self-equilibrated loading) at displacements `u`.
+    fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
         let t = Instant::now();
         let a = self
             .sys
@@ -51,7 +53,7 @@ impl PathContext<'_, '_> {
             .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
         self.sys.latch_cracks();
         self.timings.assembly_s += t.elapsed().as_secs_f64();
-        Ok((a.f_int, a.k_values.expect("tangent requested")))
+        Ok((a.f_int, a.k_values.expect("tangent requested"), a.force_scale))
     }
 
     /// Add a free-equation correction to the full displacement vector.
@@ -256,13 +258,13 @@ fn newton_controlled(
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
     let mut u = ctx.u.clone();
     for it in 0..=controls.max_iterations {
-        let (f_int, mut k) = ctx.tangent(&u)?;
+        let (f_int, mut k, scale) = ctx.tangent(&u)?;
         let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
         let mut rf = ctx.sys.to_free(&r);
         for k in ctl {
             rf[k.q] = 0.0; // the reaction of the control
         }
-        let rel = norm(&rf) / norm(f_ext).max(norm(&f_int)).max(f64::MIN_POSITIVE);
+        let rel = norm(&rf) / norm(f_ext).max(norm(&f_int)).max(scale).max(f64::MIN_POSITIVE);
         history.push(rel);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
@@ -487,7 +489,7 @@ fn arc_increment(
     let controls = ctx.sys.model.controls.clone();
     let u_n = ctx.sys.u.clone();
     // Predictor: tangent at the committed state.
-    let (_, k) = ctx.tangent(&u_n)?;
+    let (_, k, _) = ctx.tangent(&u_n)?;
     ctx.solver
         .factorize_indefinite(&ctx.sys.asm.pattern, &k)
         .map_err(NewtonFailure::Singular)?;
@@ -513,7 +515,7 @@ fn arc_increment(
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
     for it in 1..=controls.max_iterations + 1 {
-        let (f_int, k) = ctx.tangent(&u)?;
+        let (f_int, k, scale) = ctx.tangent(&u)?;
         let lam = lambda_n + d_lambda;
         let r: Vec<f64> = f_base
             .iter()
@@ -529,7 +531,7 @@ fn arc_increment(
                 .map(|(b, q)| b + lam * q)
                 .collect::<Vec<_>>(),
         );
-        let rel = norm(&rf) / f_ext_norm.max(norm(&f_int)).max(f64::MIN_POSITIVE);
+        let rel = norm(&rf) / f_ext_norm.max(norm(&f_int)).max(scale).max(f64::MIN_POSITIVE);
         history.push(rel);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
