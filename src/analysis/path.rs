@@ -53,7 +53,11 @@ impl PathContext<'_, '_> {
             .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
         self.sys.latch_cracks();
         self.timings.assembly_s += t.elapsed().as_secs_f64();
-        Ok((a.f_int, a.k_values.expect("tangent requested"), a.force_scale))
+        Ok((
+            a.f_int,
+            a.k_values.expect("tangent requested"),
+            a.force_scale,
+        ))
     }
 
     /// Add a free-equation correction to the full displacement vector.
@@ -264,7 +268,11 @@ fn newton_controlled(
         for k in ctl {
             rf[k.q] = 0.0; // the reaction of the control
         }
-        let rel = norm(&rf) / norm(f_ext).max(norm(&f_int)).max(scale).max(f64::MIN_POSITIVE);
+        let rel = norm(&rf)
+            / norm(f_ext)
+                .max(norm(&f_int))
+                .max(scale)
+                .max(f64::MIN_POSITIVE);
         history.push(rel);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
@@ -531,7 +539,11 @@ fn arc_increment(
                 .map(|(b, q)| b + lam * q)
                 .collect::<Vec<_>>(),
         );
-        let rel = norm(&rf) / f_ext_norm.max(norm(&f_int)).max(scale).max(f64::MIN_POSITIVE);
+        let rel = norm(&rf)
+            / f_ext_norm
+                .max(norm(&f_int))
+                .max(scale)
+                .max(f64::MIN_POSITIVE);
         history.push(rel);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
