@@ -57,6 +57,18 @@ fn index_by_name<'a>(
     })
 }
 
+/// A required reference by name (`missing` when absent, else it must name one of `names`).
+fn required_ref<'a>(
+    ctx: &Ctx,
+    key: &str,
+    what: &str,
+    value: Option<&str>,
+    names: impl Iterator<Item = &'a str> + Clone,
+) -> R<usize> {
+    let name = value.ok_or_else(|| ctx.err(key, format!("missing (the name of a {what})")))?;
+    index_by_name(ctx, key, what, names, name)
+}
+
 fn unique_names<'a>(ctx: &Ctx, list: &str, names: impl Iterator<Item = &'a str>) -> R<()> {
     let mut seen = HashMap::new();
     for (i, n) in names.enumerate() {
@@ -433,16 +445,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 }
             }
             "reaction" => {
-                let name = m
-                    .support
-                    .as_deref()
-                    .ok_or_else(|| ctx.err(format!("{key}.support"), "missing"))?;
-                let support = index_by_name(
+                let support = required_ref(
                     ctx,
                     &format!("{key}.support"),
                     "support",
+                    m.support.as_deref(),
                     model.supports.iter().map(|s| s.name.as_str()),
-                    name,
                 )?;
                 MonitorKind::Reaction {
                     support,
@@ -450,46 +458,34 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 }
             }
             "load_factor" => {
-                let name = m
-                    .case
-                    .as_deref()
-                    .ok_or_else(|| ctx.err(format!("{key}.case"), "missing"))?;
                 MonitorKind::LoadFactor {
-                    case: index_by_name(
+                    case: required_ref(
                         ctx,
                         &format!("{key}.case"),
                         "load case",
+                        m.case.as_deref(),
                         model.load_cases.iter().map(|c| c.name.as_str()),
-                        name,
                     )?,
                 }
             }
             "tendon_force" => {
-                let name = m
-                    .tendon
-                    .as_deref()
-                    .ok_or_else(|| ctx.err(format!("{key}.tendon"), "missing (a tendon name)"))?;
-                let tendon = index_by_name(
+                let tendon = required_ref(
                     ctx,
                     &format!("{key}.tendon"),
                     "tendon",
+                    m.tendon.as_deref(),
                     model.tendons.iter().map(|t| t.name.as_str()),
-                    name,
                 )?;
                 MonitorKind::TendonForce { tendon }
             }
             "tendon_stress" | "tendon_loss" | "tendon_loss_elastic" | "tendon_loss_creep"
             | "tendon_loss_relaxation" => {
-                let name = m
-                    .tendon
-                    .as_deref()
-                    .ok_or_else(|| ctx.err(format!("{key}.tendon"), "missing (a tendon name)"))?;
-                let tendon = index_by_name(
+                let tendon = required_ref(
                     ctx,
                     &format!("{key}.tendon"),
                     "tendon",
+                    m.tendon.as_deref(),
                     model.tendons.iter().map(|t| t.name.as_str()),
-                    name,
                 )?;
                 let part = match m.kind.as_str() {
                     "tendon_stress" => None,
