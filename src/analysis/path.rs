@@ -274,6 +274,7 @@ fn newton_controlled(
                 .max(scale)
                 .max(f64::MIN_POSITIVE);
         history.push(rel);
+        ctx.sys.freeze_if_cycling(&history);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
         }
@@ -545,6 +546,7 @@ fn arc_increment(
                 .max(scale)
                 .max(f64::MIN_POSITIVE);
         history.push(rel);
+        ctx.sys.freeze_if_cycling(&history);
         if !rel.is_finite() {
             return Err(NewtonFailure::Diverged(history));
         }

@@ -306,9 +306,11 @@ pub(super) fn newton(
         let rel = rnorm / reference;
         if !rel.is_finite() {
             history.push(rel);
+            sys.freeze_if_cycling(&history);
             return Err(NewtonFailure::Diverged(history));
         }
         history.push(rel);
+        sys.freeze_if_cycling(&history);
         if c.verbose {
             eprintln!(
                 "    iteration {it:2}: relative residual {rel:.3e}, last energy {:.3e}",

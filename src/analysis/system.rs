@@ -71,6 +71,8 @@ pub struct System<'m> {
     /// updates start from until the increment ends (sorted by point index; see
     /// [`crate::materials::point::crack_base`]).
     pub latched: Vec<(usize, PointState)>,
+    /// True once the crack branches were frozen in the current increment.
+    pub frozen: bool,
     /// Time interval of the current increment on the analysis clock [d].
     pub time: TimeContext,
     /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
@@ -203,6 +205,7 @@ impl<'m> System<'m> {
             bar_out: vec![BarOutput::default(); n_bp],
             bar_out_trial: vec![BarOutput::default(); n_bp],
             latched: Vec::new(),
+            frozen: false,
             time: TimeContext::default(),
             tendon_time: vec![None; model.tendons.len()],
         }
@@ -237,6 +240,38 @@ impl<'m> System<'m> {
     /// Forget latched cracks (the increment is thrown away).
     pub fn unlatch(&mut self) {
         self.latched.clear();
+        self.frozen = false;
+    }
+
+    /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
+    /// the rest of the increment, once the residual `history` shows Newton cycling (see
+    /// [`crate::materials::point::freeze_cracks`]); at most once per increment. Returns the
+    /// number of points held.
+    pub fn freeze_if_cycling(&mut self, history: &[f64]) -> usize {
+        let n = history.len();
+        // Cycling: six iterations made and the residual not halved over the last three.
+        if self.frozen || n < 7 || history[n - 1] < 0.5 * history[n - 4] {
+            return 0;
+        }
+        self.frozen = true;
+        let mut held = Vec::new();
+        for g in 0..self.trial.len() {
+            let base = match self.latched.binary_search_by_key(&g, |x| x.0) {
+                Ok(i) => &self.latched[i].1,
+                Err(_) => &self.committed[g],
+            };
+            if let Some(f) = crate::materials::point::freeze_cracks(base, &self.trial[g]) {
+                held.push((g, f));
+            }
+        }
+        let count = held.len();
+        for (g, f) in held {
+            match self.latched.binary_search_by_key(&g, |x| x.0) {
+                Ok(i) => self.latched[i].1 = f,
+                Err(i) => self.latched.insert(i, (g, f)),
+            }
+        }
+        count
     }
 
     /// Internal forces and (optionally) tangent at displacements `u` from the committed
@@ -522,6 +557,13 @@ impl<'m> System<'m> {
         self.bar_committed.clone_from(&self.bar_trial);
         self.bar_out.clone_from(&self.bar_out_trial);
         self.latched.clear();
+        self.frozen = false;
+        // Held crack branches last one increment only.
+        for st in self.committed.iter_mut() {
+            if let PointState::Concrete(c) = st {
+                c.frozen = [0; 2];
+            }
+        }
     }
 
     /// Gather the free-equation part of a full dof vector.

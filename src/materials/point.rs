@@ -307,3 +307,39 @@ pub fn crack_base(
         _ => None,
     }
 }
+
+/// The state an update should start from for the rest of an increment whose Newton
+/// iterations cycle ("branch freezing"): `base` (the committed or latched state) with each
+/// crack held on the branch the trial state took — loading on the envelope or unloading on
+/// the secant — and a second crack that formed in the trial kept. Returns None when there is
+/// nothing to hold (not a cracked concrete point, or already frozen).
+///
+/// Smeared cracks that compete for localisation make Newton alternate between iterates in
+/// which one crack loads and its neighbour unloads and the reverse; the response has a kink
+/// at e = e_max and no smaller increment removes it. With the branches held, the remaining
+/// iterations see a smooth law and converge; the held branch can be slightly wrong at the
+/// converged state (by the cycling amplitude), which is the documented price.
+pub fn freeze_cracks(base: &PointState, trial: &PointState) -> Option<PointState> {
+    match (base, trial) {
+        (PointState::Concrete(b), PointState::Concrete(t))
+            if b.n_cracks > 0 && !b.crushed && !t.crushed && b.frozen == [0; 2] =>
+        {
+            let mut f = (**b).clone();
+            if t.n_cracks > f.n_cracks {
+                f.n_cracks = t.n_cracks;
+                f.crack_max[1] = 0.0;
+            }
+            for i in 0..f.n_cracks as usize {
+                f.frozen[i] = if t.crack_max[i] > f.crack_max[i] {
+                    1
+                } else if t.crack_strain[i] > 0.0 {
+                    -1
+                } else {
+                    0
+                };
+            }
+            (f.frozen != [0; 2]).then(|| PointState::Concrete(Box::new(f)))
+        }
+        _ => None,
+    }
+}

@@ -28,7 +28,7 @@ use crate::materials::error::MaterialError;
 const TOL: f64 = 1e-11;
 /// Residual below which a stagnating Newton iteration (round-off floor, e.g. near the
 /// Lode-angle meridians where λ(θ) is strongly curved) is accepted as converged.
-const STAGNATION_TOL: f64 = 1e-8;
+const STAGNATION_TOL: f64 = 1e-6;
 /// Maximum Newton iterations per (sub)step.
 const MAX_ITER: usize = 60;
 /// Largest number of substeps tried.

@@ -60,16 +60,30 @@ struct DirResult {
     e_el: f64,
 }
 
-/// Uniaxial law of one crack-axis direction at strain `e`.
-fn direction(
-    p: &ConcreteParams,
-    alpha: f64,
+/// Committed history of one crack-axis direction.
+#[derive(Debug, Clone, Copy)]
+struct DirHistory {
+    /// A crack normal to this direction exists.
     cracked: bool,
+    /// Largest crack strain reached [-].
     emax: f64,
+    /// Curve strain of the 1-D compression law [-].
     ebar: f64,
+    /// Compressive plastic strain magnitude [-].
     plastic: f64,
-    e: f64,
-) -> DirResult {
+    /// Held branch (see [`super::ConcreteState`]): 0 free, 1 loading, −1 unloading.
+    frozen: i8,
+}
+
+/// Uniaxial law of one crack-axis direction at strain `e`.
+fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult {
+    let DirHistory {
+        cracked,
+        emax,
+        ebar,
+        plastic,
+        frozen,
+    } = h;
     let e_el = e + plastic;
     let ebar = ebar.max(compression::initial_yield(p).0);
     let mut r = DirResult {
@@ -86,7 +100,10 @@ fn direction(
         if !cracked {
             r.sigma = p.ec * e_el;
             r.k = p.ec;
-        } else if e_el >= emax {
+        } else if frozen > 0 || (frozen == 0 && e_el >= emax) || emax <= 0.0 {
+            // Loading on the envelope (held there by a frozen branch even a little below
+            // e_max: the stress then lies slightly above the secant, an error of the order of
+            // the iterates' cycling amplitude).
             let (s, k) = tension_envelope(p, alpha, e_el);
             r.sigma = s;
             r.k = if p.secant_crack_tangent && e_el > 0.0 {
@@ -94,10 +111,12 @@ fn direction(
             } else {
                 k
             };
-            r.emax = e_el;
+            r.emax = e_el.max(emax);
             r.open = e_el > 0.0;
             r.loading_crack = e_el > 0.0;
         } else {
+            // Unloading/reloading on the secant to e_max (held there by a frozen branch
+            // even a little beyond e_max).
             let (s, _) = tension_envelope(p, alpha, emax);
             let sec = s / emax;
             r.sigma = sec * e_el;
@@ -147,15 +166,14 @@ pub fn update_cracked(
     let mut n_cracks = committed.n_cracks;
     let mut crack_max = committed.crack_max;
     let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
-        direction(
-            p,
-            alpha,
-            (i as u8) < n_cracks,
-            crack_max[i],
-            committed.dir_ebar[i],
-            committed.dir_plastic[i],
-            el[i],
-        )
+        let h = DirHistory {
+            cracked: (i as u8) < n_cracks,
+            emax: crack_max[i],
+            ebar: committed.dir_ebar[i],
+            plastic: committed.dir_plastic[i],
+            frozen: committed.frozen[i],
+        };
+        direction(p, alpha, h, el[i])
     };
     let r0 = eval(0, n_cracks, &crack_max);
     let mut r1 = eval(1, n_cracks, &crack_max);

@@ -249,6 +249,11 @@ pub struct ConcreteState {
     pub(crate) dir_ebar: [f64; 2],
     pub(crate) dir_plastic: [f64; 2],
     pub(crate) crushed: bool,
+    /// Crack branch held for the rest of an increment, per crack direction: 0 free,
+    /// 1 on the loading envelope, −1 on the unloading secant (see
+    /// [`crate::materials::point::freeze_cracks`]); always 0 in committed states.
+    #[serde(default)]
+    pub(crate) frozen: [i8; 2],
 }
 
 impl Default for ConcreteState {
@@ -273,6 +278,7 @@ impl ConcreteState {
             dir_ebar: [0.0; 2],
             dir_plastic: [0.0; 2],
             crushed: false,
+            frozen: [0; 2],
         }
     }
 
@@ -401,8 +407,13 @@ pub fn update(
             ebar_n,
             strain,
         );
+        // The returned-stress route is only open to points that have flowed already: a
+        // virgin point whose trial is tension-dominated stays elastic (else the Ottosen
+        // loading surface, which reaches into tension at ~0.3 f_tm, would pull a cracking
+        // point back into plasticity and make the response jump between iterations).
+        let flowed = committed.ebar > compression::initial_yield(p).0 + 1e-12;
         let accept = match &res {
-            Ok(u) => trial_cd || (u.plastic && p.compression_dominated(&u.stress)),
+            Ok(u) => trial_cd || (flowed && u.plastic && p.compression_dominated(&u.stress)),
             Err(_) => trial_cd,
         };
         if accept {

@@ -527,3 +527,86 @@ proptest! {
         }
     }
 }
+
+/// A virgin point whose elastic trial is tension-dominated (σ1 ≥ f_tm/2) stays elastic even
+/// though its Ottosen equivalent stress exceeds the initial yield level: only compression-
+/// dominated trials, or points that have already flowed, enter the plasticity.
+#[test]
+fn virgin_tension_dominated_point_stays_elastic() {
+    let mut p = params();
+    p.initial_yield_ratio = 0.3;
+    let st = ConcreteState::new();
+    // Tension 0.8 f_tm along y with lateral compression and shear (a state seen beside a
+    // loading plate): below the failure surface, above the 0.3 f_cm loading surface.
+    let d = d_matrix(p.ec, p.nu);
+    let target = [-0.24 * p.ftm, 0.8 * p.ftm, 0.2 * p.ftm];
+    // Strain giving that stress elastically: solve the 2×2 normal block.
+    let det = d[0][0] * d[1][1] - d[0][1] * d[1][0];
+    let e = [
+        (target[0] * d[1][1] - d[0][1] * target[1]) / det,
+        (d[0][0] * target[1] - d[1][0] * target[0]) / det,
+        target[2] / d[2][2],
+    ];
+    assert!(
+        compression::sigma_hat(&p, &target).0
+            > compression::hardening(&p, compression::initial_yield(&p).0).sigma_c
+    );
+    let (t, s, _) = upd(&p, &st, e);
+    for i in 0..3 {
+        assert!(
+            (s[i] - target[i]).abs() < 1e-6 * p.ftm,
+            "σ = {s:?}, expected {target:?}"
+        );
+    }
+    assert_eq!((t.n_cracks(), t.plastic_strain()), (0, [0.0; 3]));
+}
+
+/// Frozen crack branches: held on the envelope a little below e_max the stress is the
+/// envelope's; held on the secant a little beyond e_max it is the secant's; freeing the
+/// branch gives the usual law. Checks `freeze_cracks` picks the branch of the trial.
+#[test]
+fn frozen_crack_branches_follow_the_held_law() {
+    use crate::materials::point::{freeze_cracks, PointState};
+    let p = params();
+    let e0 = p.eps0();
+    let alpha = p.softening_alpha(0.1);
+    // Crack along x opened to 4 ε0 and committed.
+    let (mut c, _, _) = upd(&p, &ConcreteState::new(), [4.0 * e0, 0.0, 0.0]);
+    c.strain = [4.0 * e0, 0.0, 0.0];
+    let (c, _, _) = upd(&p, &c, [4.0 * e0, 0.0, 0.0]);
+    assert_eq!(c.n_cracks(), 1);
+    let emax = c.max_crack_strains()[0];
+    let env = |e: f64| tension_envelope(&p, alpha, e).0;
+    // Trial loading further: freezing holds "loading".
+    let (t_load, _, _) = upd(&p, &c, [1.2 * emax, 0.0, 0.0]);
+    let base = PointState::Concrete(Box::new(c.clone()));
+    let PointState::Concrete(f) =
+        freeze_cracks(&base, &PointState::Concrete(Box::new(t_load))).unwrap()
+    else {
+        unreachable!()
+    };
+    assert_eq!(f.frozen, [1, 0]);
+    // Held loading, strain slightly below e_max: envelope stress, not secant.
+    let e = 0.95 * emax;
+    let (_, s, _) = upd(&p, &f, [e, 0.0, 0.0]);
+    assert!(
+        (s[0] - env(e)).abs() < 1e-9 * p.ftm,
+        "{} vs {}",
+        s[0],
+        env(e)
+    );
+    // Trial unloading: freezing holds "unloading"; beyond e_max the secant is kept.
+    let (t_un, _, _) = upd(&p, &c, [0.5 * emax, 0.0, 0.0]);
+    let PointState::Concrete(f) =
+        freeze_cracks(&base, &PointState::Concrete(Box::new(t_un))).unwrap()
+    else {
+        unreachable!()
+    };
+    assert_eq!(f.frozen, [-1, 0]);
+    let e = 1.05 * emax;
+    let (_, s, _) = upd(&p, &f, [e, 0.0, 0.0]);
+    assert!((s[0] - env(emax) / emax * e).abs() < 1e-9 * p.ftm);
+    // Free again: beyond e_max the envelope.
+    let (_, s, _) = upd(&p, &c, [e, 0.0, 0.0]);
+    assert!((s[0] - env(e)).abs() < 1e-9 * p.ftm);
+}
