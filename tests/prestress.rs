@@ -448,6 +448,7 @@ fn camber_of_post_tensioned_beam_with_parabolic_tendon() {
     let camber = r.u[0][2 * mid + 1];
     let p = AP * 1000e6;
     let (exact, textbook) = camber_closed_form(p, nu);
+    eprintln!("camber {camber:.6e} m; 5PeL²/48EI {textbook:.6e}; with shear and cos θ {exact:.6e}");
     assert!(camber > 0.0, "the beam must camber upwards: {camber}");
     assert!(
         (camber / textbook - 1.0).abs() < 0.02,
@@ -535,6 +536,7 @@ increments = 2
         }
         let ds = r.bar_stress[2][0][p] - r.bar_stress[1][0][p];
         let expect = EP * section_strain(&[(AP, y)], 0.0, -ms, y);
+        eprintln!("grouted x = {x:.3}: Δσ {ds:.5e} vs {expect:.5e}");
         assert!(
             (ds / expect - 1.0).abs() < 0.01,
             "x = {x}: Δσ = {ds} vs E_p ε = {expect}"
@@ -604,6 +606,10 @@ loads = {{ g = 1.0, Q = 1.0 }}
             continue;
         }
         let d = r.bar_stress[2][0][p] - r.bar_stress[1][0][p];
+        eprintln!(
+            "staged x = {:.3}: Δσ {d:.5e} vs {expect:.5e}",
+            gp.point.x[0]
+        );
         assert!(
             (d / expect - 1.0).abs() < 0.02,
             "A at x = {}: Δσ = {d} vs {expect}",
@@ -662,6 +668,7 @@ kind = "load"
     let r = run(&m);
     let expect = EP * section_strain(&[(AP, ya)], -pb, -pb * (yb - 0.25), ya);
     let d = (r.tendon_force[1][0] - r.tendon_force[0][0]) / AP;
+    eprintln!("external A: Δσ {d:.5e} vs {expect:.5e}");
     assert!(
         (d / expect - 1.0).abs() < 0.02,
         "external A: Δσ = {d} vs {expect}"
