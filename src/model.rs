@@ -460,6 +460,29 @@ pub struct Bar {
     pub piece_ends: Vec<[[f64; 2]; 2]>,
     /// Range of `points` belonging to each piece.
     pub piece_points: Vec<(usize, usize)>,
+    /// Post-tensioning data of a bonded post-tensioned tendon (None: a bar or pre-tensioned
+    /// tendon, bonded from the start with `initial_stress`).
+    pub post_tension: Option<PostTension>,
+}
+
+/// Post-tensioning of a bonded tendon (docs/theory-prestress.md): not present before
+/// `stressed_in_step`; from then on it loads the concrete with its lock-off stresses (the
+/// equivalent forces) and no stiffness; from `grouted_in_step` on it is bonded and takes the
+/// concrete's strain increments.
+#[derive(Debug, Clone, Serialize)]
+pub struct PostTension {
+    /// Index of the step at whose start the tendon is stressed and locked off.
+    pub stressed_in_step: usize,
+    /// Index of the step at whose start the duct is grouted (None = never: the tendon keeps
+    /// its lock-off stresses).
+    pub grouted_in_step: Option<usize>,
+    /// Stress at each integration point after friction and anchorage set [Pa] (order of
+    /// [`Bar::points`]).
+    pub point_stress: Vec<f64>,
+    /// Stress at the jack σ_pi [Pa].
+    pub jacking_stress: f64,
+    /// Length affected by the anchorage set at the start and the end of the path [m].
+    pub set_length: [f64; 2],
 }
 
 impl Bar {
@@ -467,6 +490,15 @@ impl Bar {
     /// at zero displacement).
     pub fn prestrain(&self) -> f64 {
         self.initial_stress / self.steel.es
+    }
+
+    /// Stress [Pa] the bar carries at point `p` when it becomes bonded: the lock-off stress
+    /// of a post-tensioned tendon, else `initial_stress`.
+    pub fn bonding_stress(&self, p: usize) -> f64 {
+        match &self.post_tension {
+            Some(pt) => pt.point_stress[p],
+            None => self.initial_stress,
+        }
     }
 }
 

@@ -605,3 +605,100 @@ fn non_finite_origin_is_named() {
     let model = edit(BANDED, "nx = 8", "nx = 8\norigin = [nan, 0.0]");
     rejects(&model, "mesh.origin", &["finite"]);
 }
+
+// ---------------------------------------------------------------------------------------
+// Bonded post-tensioned tendons.
+// ---------------------------------------------------------------------------------------
+
+/// BANDED with a bonded tendon (`extra` lines added to its table) and a second step.
+fn bonded(extra: &str) -> String {
+    let m = edit(
+        BANDED,
+        "[[supports]]\nname = \"pin\"",
+        &format!(
+            "[[tendons]]\nname = \"T\"\nkind = \"bonded\"\narea = 1e-3\nEp = 195e9\nfptk = 1860e6\n{extra}\n\n[[supports]]\nname = \"pin\""
+        ),
+    );
+    format!("{m}\n[[steps]]\nname = \"later\"\nkind = \"load\"\nloads = {{ P = 1.0 }}\n")
+}
+
+const STRAIGHT: &str = "points = [[0.0, 0.1], [4.0, 0.1]]\njacking_stress = 1000e6";
+
+#[test]
+fn bonded_tendon_valid_base() {
+    let tmp = TempDir::new("bonded");
+    std::fs::write(
+        tmp.join("ok.toml"),
+        bonded(&format!("{STRAIGHT}\ngrouted_in_step = \"later\"")),
+    )
+    .unwrap();
+    let o = segfem(tmp.path(), &["check", "ok.toml"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+}
+
+#[test]
+fn bonded_tendon_grouted_before_stressing() {
+    rejects(
+        &bonded(&format!("{STRAIGHT}\ngrouted_in_step = \"load\"")),
+        "tendons[0].grouted_in_step",
+        &["grouted after stressing"],
+    );
+}
+
+#[test]
+fn bonded_tendon_set_larger_than_elongation() {
+    // Elastic elongation 1000 MPa / 195 GPa × 4 m = 20.5 mm < 40 mm.
+    rejects(
+        &bonded(&format!(
+            "{STRAIGHT}\njacking = \"start\"\nanchorage_set = 0.04"
+        )),
+        "tendons[0].anchorage_set",
+        &["elastic elongation"],
+    );
+}
+
+#[test]
+fn bonded_tendon_leaves_the_mesh() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.5, 0.1]]\njacking_stress = 1000e6"),
+        "tendons[0]",
+        &["tendon 'T'", "leaves the mesh"],
+    );
+}
+
+#[test]
+fn bonded_tendon_without_jacking() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.0, 0.1]]"),
+        "tendons[0].jacking_stress",
+        &["jacking_force"],
+    );
+}
+
+#[test]
+fn bonded_tendon_with_initial_stress() {
+    rejects(
+        &bonded(&format!("{STRAIGHT}\ninitial_stress = 900e6")),
+        "tendons[0].initial_stress",
+        &["[[bars]]"],
+    );
+}
+
+#[test]
+fn bonded_tendon_chain_with_a_gap() {
+    rejects(
+        &bonded("segments = [{ points = [[0.0, 0.1], [2.0, 0.1]] }, { points = [[2.5, 0.1], [4.0, 0.1]] }]\njacking_stress = 1000e6"),
+        "tendons[0]",
+        &["chain part 1"],
+    );
+}
+
+#[test]
+fn external_tendon_with_a_parabola() {
+    let m = edit(
+        BANDED,
+        "[[supports]]\nname = \"pin\"",
+        "[[tendons]]\nname = \"T\"\nkind = \"external\"\nparabola = { start = [0.0, 0.2], end = [4.0, 0.2], sag = -0.1 }\narea = 1e-3\nEp = 195e9\nfptk = 1860e6\ninitial_stress = 1e9\n\n[[supports]]\nname = \"pin\"",
+    );
+    rejects(&m, "tendons[0].parabola", &["bonded"]);
+}

@@ -77,6 +77,26 @@ pub struct System<'m> {
     pub time: TimeContext,
     /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
     pub tendon_time: Vec<Option<super::time::TendonTime>>,
+    /// Stage of each bar (index = bar): bars and pre-tensioned tendons are bonded from the
+    /// start, post-tensioned tendons go through the stages at their steps.
+    pub bar_phase: Vec<BarPhase>,
+    /// Bond strain T B u_e of each bar point when it became bonded [-] (order of `bar_gps`;
+    /// 0 for bars bonded from the start): the bar strain is measured from it.
+    pub bar_eps_ref: Vec<f64>,
+}
+
+/// Stage of an embedded bar or bonded tendon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BarPhase {
+    /// Post-tensioned tendon not yet stressed: absent.
+    Inactive,
+    /// Post-tensioned tendon stressed and locked off, duct not grouted: it loads the concrete
+    /// with its lock-off stresses (the equivalent prestressing forces, seed eq. 24–26) and
+    /// has no stiffness; its stress is held (changes of an ungrouted tendon are neglected).
+    Locked,
+    /// Bonded (perfect bond): stress from the bond strain measured since bonding plus the
+    /// bonding stress.
+    Bonded,
 }
 
 /// Values at one bar integration point for output.
@@ -208,6 +228,15 @@ impl<'m> System<'m> {
             frozen: false,
             time: TimeContext::default(),
             tendon_time: vec![None; model.tendons.len()],
+            bar_phase: model
+                .bars
+                .iter()
+                .map(|b| match b.post_tension {
+                    Some(_) => BarPhase::Inactive,
+                    None => BarPhase::Bonded,
+                })
+                .collect(),
+            bar_eps_ref: vec![0.0; n_bp],
         }
     }
 
@@ -308,6 +337,8 @@ impl<'m> System<'m> {
             let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
             let bar_committed = &self.bar_committed[b0..b1];
             let bar_gps = &self.bar_gps;
+            let bar_phase = &self.bar_phase;
+            let bar_eps_ref = &self.bar_eps_ref[b0..b1];
             let latched = &self.latched;
             let bar_offset = &self.bar_offset;
             let (mut bt_rest, mut bo_rest) =
@@ -381,7 +412,10 @@ impl<'m> System<'m> {
                     )
                     .map_err(|err| (e, err))?;
                     // Embedded bars hosted by this element: uniaxial steel at each point,
-                    // ε_b = T(φ) B u_e + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
+                    // ε_b = T(φ) B u_e − ε_ref + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
+                    // A locked-off, ungrouted tendon adds f += g σ_lock A w only: these are
+                    // the equivalent prestressing forces (anchor, curvature and friction
+                    // forces integrated by parts through the shape functions).
                     let bc0 = bar_offset[e] - b0;
                     for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
                         .iter()
@@ -390,9 +424,33 @@ impl<'m> System<'m> {
                     {
                         let bar = &model.bars[b];
                         let bp = &bar.points[p].point;
+                        match bar_phase[b] {
+                            BarPhase::Inactive => {
+                                *st = bar_committed[bc0 + i];
+                                *out = BarOutput::default();
+                                continue;
+                            }
+                            BarPhase::Locked => {
+                                let sig = bar.bonding_stress(p);
+                                *st = bar_committed[bc0 + i];
+                                *out = BarOutput {
+                                    strain: sig / bar.steel.es,
+                                    stress: sig,
+                                    plastic_strain: 0.0,
+                                };
+                                let g = bar_strain_vector(el.kind, coords, bp);
+                                let fs = sig * bar.area * bp.weight_length;
+                                for r in 0..nd {
+                                    fe[r] += g[r] * fs;
+                                }
+                                continue;
+                            }
+                            BarPhase::Bonded => {}
+                        }
                         let g = bar_strain_vector(el.kind, coords, bp);
-                        let eps =
-                            g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>() + bar.prestrain();
+                        let eps = g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>()
+                            - bar_eps_ref[bc0 + i]
+                            + bar.bonding_stress(p) / bar.steel.es;
                         let (s_new, sig, et) =
                             update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
                         *st = s_new;
@@ -509,9 +567,12 @@ impl<'m> System<'m> {
         })
     }
 
-    /// Stress the tendons assigned to step `step`: each is built on the current deformed
-    /// geometry with its span stresses (post-tensioning against the concrete as it stands).
+    /// Prestressing operations at the start of step `step`: external tendons assigned to it
+    /// are built on the current deformed geometry with their span stresses (post-tensioning
+    /// against the concrete as it stands); bonded post-tensioned tendons are locked off or
+    /// grouted (their bond strain is measured from the current displacements on).
     pub fn stress_tendons(&mut self, step: usize) {
+        self.stage_bonded_tendons(step);
         for (t, data) in self.model.tendons.iter().enumerate() {
             if data.stressed_in_step != step || self.tendons[t].is_some() {
                 continue;
@@ -542,6 +603,39 @@ impl<'m> System<'m> {
             self.tendon_trial[t] = Some(st);
             self.tendons[t] = Some(el);
             self.tendon_u0[t] = u0;
+        }
+    }
+
+    /// Lock off and grout the bonded post-tensioned tendons whose steps start now.
+    fn stage_bonded_tendons(&mut self, step: usize) {
+        let model = self.model;
+        for (b, bar) in model.bars.iter().enumerate() {
+            let Some(pt) = &bar.post_tension else {
+                continue;
+            };
+            if pt.stressed_in_step == step && self.bar_phase[b] == BarPhase::Inactive {
+                self.bar_phase[b] = BarPhase::Locked;
+            }
+            if pt.grouted_in_step == Some(step) && self.bar_phase[b] == BarPhase::Locked {
+                // The grout bonds the tendon to the concrete as it now stands: strain
+                // increments from here on, starting from the locked-off stress.
+                for (i, &(bb, p)) in self.bar_gps.iter().enumerate() {
+                    if bb != b {
+                        continue;
+                    }
+                    let gp = &bar.points[p];
+                    let el = &model.elements[gp.element];
+                    let coords = model.element_coords(el);
+                    let g = bar_strain_vector(el.kind, &coords, &gp.point);
+                    self.bar_eps_ref[i] = el
+                        .nodes
+                        .iter()
+                        .enumerate()
+                        .map(|(a, &n)| g[2 * a] * self.u[2 * n] + g[2 * a + 1] * self.u[2 * n + 1])
+                        .sum();
+                }
+                self.bar_phase[b] = BarPhase::Bonded;
+            }
         }
     }
 

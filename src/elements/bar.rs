@@ -82,6 +82,10 @@ pub enum BarPath {
         /// Polar angle of the end point [rad].
         theta_end: f64,
     },
+    /// Several of the paths above joined end to end (e.g. straight – parabola – straight for
+    /// a post-tensioned tendon): each part must start where the previous one ends (within
+    /// 1e-9 of the path size); kinks between parts are allowed. Parts may not be chains.
+    Chain(Vec<BarPath>),
 }
 
 /// A host element: kind and nodal coordinates [m] in VTK order (`kind.n_nodes()` entries).
@@ -297,6 +301,56 @@ fn norm(v: [f64; 2]) -> f64 {
     v[0].hypot(v[1])
 }
 
+fn unit(v: [f64; 2]) -> [f64; 2] {
+    let l = norm(v);
+    [v[0] / l, v[1] / l]
+}
+
+/// Unsigned angle between two unit vectors [rad], in [0, π].
+fn angle_between(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] * b[1] - a[1] * b[0])
+        .atan2(a[0] * b[0] + a[1] * b[1])
+        .abs()
+}
+
+/// Start data of one smooth segment of a path, for [`TurnTable`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SegTurn {
+    /// Arc length at the segment start [m].
+    s: f64,
+    /// Cumulative deviation at the segment start, after the kink there [rad].
+    alpha: f64,
+    /// Unit tangent at the segment start.
+    dir: [f64; 2],
+    /// Radius of a circular arc [m] (its deviation is Δs/r, which may exceed π).
+    radius: Option<f64>,
+}
+
+/// Cumulative angular deviation α(s) = ∫|dθ| of a [`BarPath`] from its start [rad]: exact
+/// for every segment kind, because within one smooth segment the tangent turns one way
+/// only (lines: not at all; quadratic curves: by less than π; arcs: by Δs/r); the kinks
+/// between polyline segments or chain parts add their angles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TurnTable {
+    segments: Vec<SegTurn>,
+    /// Total deviation from start to end [rad].
+    pub total: f64,
+    /// Path length [m].
+    pub length: f64,
+}
+
+impl TurnTable {
+    /// α at a point of path segment `segment` (as in [`BarPiece::segment`]) with arc length
+    /// `s` [m] from the path start and unit tangent `dir` (as in [`BarPoint`]) [rad].
+    pub fn at(&self, segment: usize, s: f64, dir: [f64; 2]) -> f64 {
+        let g = &self.segments[segment];
+        match g.radius {
+            Some(r) => g.alpha + (s - g.s).max(0.0) / r,
+            None => g.alpha + angle_between(g.dir, dir),
+        }
+    }
+}
+
 fn finite2(p: &[f64; 2]) -> bool {
     p[0].is_finite() && p[1].is_finite()
 }
@@ -392,7 +446,80 @@ impl BarPath {
                     th1: *theta_end,
                 }])
             }
+            BarPath::Chain(parts) => {
+                if parts.is_empty() {
+                    return Err(BarError::InvalidPath(
+                        "a chain needs at least one part".into(),
+                    ));
+                }
+                let mut segs: Vec<Seg> = Vec::new();
+                for (i, part) in parts.iter().enumerate() {
+                    if matches!(part, BarPath::Chain(_)) {
+                        return Err(BarError::InvalidPath(format!(
+                            "chain part {i} is itself a chain"
+                        )));
+                    }
+                    let ps = part.segments()?;
+                    if let (Some(last), Some(first)) = (segs.last(), ps.first()) {
+                        let (a, b) = (last.pos(1.0), first.pos(0.0));
+                        let size = norm([a[0] - segs[0].pos(0.0)[0], a[1] - segs[0].pos(0.0)[1]])
+                            .max(last.arc_length(1.0))
+                            .max(first.arc_length(1.0));
+                        let gap = norm([b[0] - a[0], b[1] - a[1]]);
+                        if gap > 1e-9 * size {
+                            return Err(BarError::InvalidPath(format!(
+                                "chain part {i} starts at ({:.6}, {:.6}) m, not where part {} ends ({:.6}, {:.6}) m",
+                                b[0],
+                                b[1],
+                                i - 1,
+                                a[0],
+                                a[1]
+                            )));
+                        }
+                    }
+                    segs.extend(ps);
+                }
+                Ok(segs)
+            }
         }
+    }
+
+    /// Cumulative angular deviation Σ|Δθ| of the path's tangent from its start [rad], for
+    /// friction losses (seed eq. 27): see [`TurnTable`].
+    pub fn turn_table(&self) -> Result<TurnTable, BarError> {
+        let segs = self.segments()?;
+        let mut starts = Vec::with_capacity(segs.len());
+        let (mut s, mut alpha) = (0.0, 0.0);
+        let mut prev_end: Option<[f64; 2]> = None;
+        for seg in &segs {
+            let d0 = unit(seg.deriv(0.0));
+            if let Some(e) = prev_end {
+                alpha += angle_between(e, d0); // kink at the joint
+            }
+            let radius = match seg {
+                Seg::Arc { r, .. } => Some(*r),
+                _ => None,
+            };
+            starts.push(SegTurn {
+                s,
+                alpha,
+                dir: d0,
+                radius,
+            });
+            alpha += match seg {
+                Seg::Line(..) => 0.0,
+                Seg::Arc { th0, th1, .. } => (th1 - th0).abs(),
+                // A quadratic curve turns monotonically by less than π.
+                Seg::Quad(..) => angle_between(d0, unit(seg.deriv(1.0))),
+            };
+            s += seg.arc_length(1.0);
+            prev_end = Some(unit(seg.deriv(1.0)));
+        }
+        Ok(TurnTable {
+            segments: starts,
+            total: alpha,
+            length: s,
+        })
     }
 
     /// Total length of the path [m] (exact for polylines and arcs, ~1e-14 relative for

@@ -20,7 +20,8 @@ use crate::materials::steel::SteelParams;
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
 use crate::model::*;
-use crate::prestress::friction::{jacking_profile, FrictionParams, Jacking, TendonPath};
+use crate::prestress::friction::{jacking_profile, AnchorEnd, FrictionParams, Jacking, TendonPath};
+use crate::prestress::posttension::{self, Samples, Stressing};
 use std::collections::HashMap;
 
 /// A validated model and the warnings met on the way (suspicious but legal values).
@@ -328,8 +329,14 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     }
     // Tendons (the step they are stressed in is resolved with the steps below).
     unique_names(ctx, "tendons", file.tendons.iter().map(|t| t.name.as_str()))?;
+    // External tendons go to `model.tendons`; bonded post-tensioned ones become bars (below).
+    let mut external_of = vec![None; file.tendons.len()];
     for (i, t) in file.tendons.iter().enumerate() {
+        if t.kind == "bonded" {
+            continue;
+        }
         let tendon = build_tendon(ctx, i, t, &model, &used, &mut warnings)?;
+        external_of[i] = Some(model.tendons.len());
         model.tendons.push(tendon);
     }
     // Unused nodes are held so that they add no zero pivots.
@@ -416,7 +423,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         model.load_cases.push(case);
     }
     // Embedded bars (needed by bar monitors).
-    build_bars(ctx, &file.bars, &steels, &mut model)?;
+    build_bars(ctx, &file.bars, &file.tendons, &steels, &mut model)?;
     // Monitors.
     unique_names(
         ctx,
@@ -477,6 +484,25 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     model.tendons.iter().map(|t| t.name.as_str()),
                 )?;
                 MonitorKind::TendonForce { tendon }
+            }
+            "tendon_stress"
+                if m.tendon.as_deref().is_some_and(|n| {
+                    model
+                        .bars
+                        .iter()
+                        .any(|b| b.name == n && b.post_tension.is_some())
+                }) =>
+            {
+                // A bonded tendon is a bar: its largest stress (or at the point nearest
+                // `point`) as for bar_stress.
+                let name = m.tendon.as_deref().expect("checked");
+                let bar = model
+                    .bars
+                    .iter()
+                    .position(|b| b.name == name)
+                    .expect("checked");
+                let point = m.point.map(|p| nearest_bar_point(&model.bars[bar], p));
+                MonitorKind::BarStress { bar, point }
             }
             "tendon_stress" | "tendon_loss" | "tendon_loss_elastic" | "tendon_loss_creep"
             | "tendon_loss_relaxation" => {
@@ -672,14 +698,44 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .unwrap_or(DEFAULT_START_DAY);
     check_ages(ctx, &model, start, &mut warnings)?;
     for (i, t) in file.tendons.iter().enumerate() {
-        if let Some(name) = &t.stressed_in_step {
-            model.tendons[i].stressed_in_step = index_by_name(
+        let step_of = |key: &str, name: &str| {
+            index_by_name(
                 ctx,
-                &format!("tendons[{i}].stressed_in_step"),
+                &format!("tendons[{i}].{key}"),
                 "step",
                 model.steps.iter().map(|s| s.name.as_str()),
                 name,
-            )?;
+            )
+        };
+        let stressed = match &t.stressed_in_step {
+            Some(name) => step_of("stressed_in_step", name)?,
+            None => 0,
+        };
+        let grouted = match &t.grouted_in_step {
+            Some(name) => Some(step_of("grouted_in_step", name)?),
+            None => None,
+        };
+        match external_of[i] {
+            Some(e) => model.tendons[e].stressed_in_step = stressed,
+            None => {
+                if grouted.is_some_and(|g| g <= stressed) {
+                    return Err(ctx.err(
+                        format!("tendons[{i}].grouted_in_step"),
+                        format!(
+                            "tendon '{}': the duct is grouted after stressing: name a step after '{}'",
+                            t.name, model.steps[stressed].name
+                        ),
+                    ));
+                }
+                let bar = model
+                    .bars
+                    .iter_mut()
+                    .find(|b| b.name == t.name && b.post_tension.is_some())
+                    .expect("bonded tendons are built with the bars");
+                let pt = bar.post_tension.as_mut().expect("checked");
+                pt.stressed_in_step = stressed;
+                pt.grouted_in_step = grouted;
+            }
         }
     }
     if let Some(sv) = &file.solver {
@@ -1343,7 +1399,21 @@ fn build_tendon(
 ) -> R<TendonEl> {
     let k = |f: &str| format!("tendons[{i}].{f}");
     if t.kind != "external" {
-        return Err(ctx.err(k("kind"), format!("unknown tendon kind '{}' (expected external; bonded tendons are [[bars]] with an initial stress)", t.kind)));
+        return Err(ctx.err(k("kind"), format!("unknown tendon kind '{}' (expected external or bonded; pre-tensioned tendons are [[bars]] with an initial stress)", t.kind)));
+    }
+    for (key, given) in [
+        ("parabola", t.parabola.is_some()),
+        ("arc", t.arc.is_some()),
+        ("segments", t.segments.is_some()),
+        ("grouted_in_step", t.grouted_in_step.is_some()),
+        ("gauss_points", t.gauss_points.is_some()),
+    ] {
+        if given {
+            return Err(ctx.err(
+                k(key),
+                "only for kind = \"bonded\": an external tendon is a chain of straight spans through its points",
+            ));
+        }
     }
     if t.points.len() < 2 {
         return Err(ctx.err(k("points"), "needs at least the two anchors"));
@@ -1393,7 +1463,8 @@ fn build_tendon(
     }
     let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| model.nodes[n]).collect();
     let n_spans = coords.len() - 1;
-    let span_stress = match (t.initial_stress, t.jacking_stress) {
+    let jacking_stress = jacking_stress_of(ctx, i, t, area, fptk)?;
+    let span_stress = match (t.initial_stress, jacking_stress) {
         (Some(s), None) => {
             if !(s.is_finite() && s >= 0.0 && s < 0.9 * fptk) {
                 return Err(ctx.err(
@@ -1401,48 +1472,42 @@ fn build_tendon(
                     format!("must lie in [0, 0.9 fptk) (got {s} Pa)"),
                 ));
             }
-            if t.friction.is_some() || t.wobble.is_some() || t.jacking.is_some() {
+            if t.friction.is_some()
+                || t.wobble.is_some()
+                || t.jacking.is_some()
+                || t.anchorage_set.is_some()
+            {
                 return Err(ctx.err(
                     k("friction"),
-                    "friction, wobble and jacking go with jacking_stress, not initial_stress",
+                    "friction, wobble, jacking and anchorage_set go with jacking_stress or jacking_force, not initial_stress",
                 ));
             }
             vec![s; n_spans]
         }
         (None, Some(s)) => {
-            if !(s.is_finite() && s > 0.0 && s < 0.9 * fptk) {
-                return Err(ctx.err(
-                    k("jacking_stress"),
-                    format!("must lie in (0, 0.9 fptk) (got {s} Pa)"),
-                ));
-            }
-            let mu = t.friction.unwrap_or(0.0);
-            let wobble = t.wobble.unwrap_or(crate::prestress::friction::SEED_WOBBLE);
-            if !(mu >= 0.0 && mu.is_finite() && wobble >= 0.0 && wobble.is_finite()) {
-                return Err(ctx.err(
-                    k("friction"),
-                    "friction and wobble must be zero or positive",
-                ));
-            }
-            let jacking = match t.jacking.as_deref() {
-                None | Some("both") => Jacking::Both,
-                Some("start") => Jacking::Start,
-                Some("end") => Jacking::End,
-                Some(o) => {
-                    return Err(ctx.err(
-                        k("jacking"),
-                        format!("unknown value '{o}' (expected start, end or both)"),
-                    ))
-                }
-            };
+            let (friction, jacking, draw_in) = friction_of(ctx, i, t)?;
             let path = TendonPath::from_points(&coords)
                 .map_err(|e| ctx.err(k("points"), e.to_string()))?;
-            jacking_profile(&path, s, &FrictionParams { mu, wobble }, jacking).segment_means()
+            let mut profile = jacking_profile(&path, s, &friction, jacking);
+            if draw_in > 0.0 {
+                let ends: &[AnchorEnd] = match jacking {
+                    Jacking::Start => &[AnchorEnd::Start],
+                    Jacking::End => &[AnchorEnd::End],
+                    Jacking::Both => &[AnchorEnd::Start, AnchorEnd::End],
+                };
+                for &end in ends {
+                    profile = profile
+                        .with_anchorage_set(end, draw_in, ep)
+                        .map_err(|e| ctx.err(k("anchorage_set"), e.to_string()))?
+                        .profile;
+                }
+            }
+            profile.segment_means()
         }
-        _ => {
+        (Some(_), Some(_)) | (None, None) => {
             return Err(ctx.err(
                 k("initial_stress"),
-                "give exactly one of initial_stress or jacking_stress [Pa]",
+                "give exactly one of initial_stress, jacking_stress or jacking_force",
             ))
         }
     };
@@ -1517,6 +1582,77 @@ fn build_tendon(
         mode,
         stressed_in_step: 0,
     })
+}
+
+/// The stress at the jack from `jacking_stress` or `jacking_force` / area (None if neither),
+/// checked to lie in (0, 0.9 fptk).
+fn jacking_stress_of(ctx: &Ctx, i: usize, t: &TendonIn, area: f64, fptk: f64) -> R<Option<f64>> {
+    let k = |f: &str| format!("tendons[{i}].{f}");
+    let (key, s) = match (t.jacking_stress, t.jacking_force) {
+        (None, None) => return Ok(None),
+        (Some(s), None) => ("jacking_stress", s),
+        (None, Some(f)) => ("jacking_force", f / area),
+        (Some(_), Some(_)) => {
+            return Err(ctx.err(
+                k("jacking_force"),
+                "give jacking_stress or jacking_force, not both",
+            ))
+        }
+    };
+    if !(s.is_finite() && s > 0.0 && s < 0.9 * fptk) {
+        return Err(ctx.err(
+            k(key),
+            format!(
+                "the stress at the jack must lie in (0, 0.9 fptk) = (0, {:.4e}) Pa (got {s:.4e} Pa)",
+                0.9 * fptk
+            ),
+        ));
+    }
+    Ok(Some(s))
+}
+
+/// Friction parameters, jacked end(s) and anchorage set of a tendon stressed with a jack.
+fn friction_of(ctx: &Ctx, i: usize, t: &TendonIn) -> R<(FrictionParams, Jacking, f64)> {
+    let k = |f: &str| format!("tendons[{i}].{f}");
+    let mu = t.friction.unwrap_or(0.0);
+    if !(mu >= 0.0 && mu.is_finite()) {
+        return Err(ctx.err(
+            k("friction"),
+            format!("must be zero or positive (got {mu})"),
+        ));
+    }
+    let wobble = t.wobble.unwrap_or(crate::prestress::friction::SEED_WOBBLE);
+    if !(wobble >= 0.0 && wobble.is_finite()) {
+        return Err(ctx.err(
+            k("wobble"),
+            format!("must be zero or positive [rad/m] (got {wobble})"),
+        ));
+    }
+    let jacking = match t.jacking.as_deref() {
+        None | Some("both") => Jacking::Both,
+        Some("start") => Jacking::Start,
+        Some("end") => Jacking::End,
+        Some(o) => {
+            return Err(ctx.err(
+                k("jacking"),
+                format!("unknown value '{o}' (expected start, end or both)"),
+            ))
+        }
+    };
+    let draw_in = t.anchorage_set.unwrap_or(0.0);
+    if !(draw_in >= 0.0 && draw_in.is_finite()) {
+        return Err(ctx.err(
+            k("anchorage_set"),
+            format!("must be zero or positive [m] (got {draw_in})"),
+        ));
+    }
+    if draw_in > 0.05 {
+        return Err(ctx.err(
+            k("anchorage_set"),
+            format!("{draw_in} m is not a wedge draw-in (units are m; typical 0.004–0.008)"),
+        ));
+    }
+    Ok((FrictionParams { mu, wobble }, jacking, draw_in))
 }
 
 fn fraction(ctx: &Ctx, key: &str, v: f64, lo: f64, hi: f64) -> R<f64> {
@@ -1730,14 +1866,138 @@ fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<SteelParams> {
     }
 }
 
-/// Cut the bars through the mesh and store their integration points.
+/// A bar or tendon path from its keys: exactly one of a polyline (`points_key`), `parabola`,
+/// `arc` or `segments` (a chain of those).
+#[allow(clippy::too_many_arguments)]
+fn path_of(
+    ctx: &Ctx,
+    key: &str,
+    named: &str,
+    points_key: &str,
+    points: Option<&Vec<[f64; 2]>>,
+    parabola: Option<&ParabolaIn>,
+    arc: Option<&ArcIn>,
+    segments: Option<&Vec<PathPartIn>>,
+) -> R<BarPath> {
+    let one = |points: Option<&Vec<[f64; 2]>>,
+               parabola: Option<&ParabolaIn>,
+               arc: Option<&ArcIn>|
+     -> Option<BarPath> {
+        if let Some(p) = points {
+            Some(BarPath::Polyline(p.clone()))
+        } else if let Some(p) = parabola {
+            Some(BarPath::Parabola {
+                start: p.start,
+                end: p.end,
+                sag: p.sag,
+            })
+        } else {
+            arc.map(|a| BarPath::Arc {
+                center: a.center,
+                radius: a.radius,
+                theta_start: a.theta_start,
+                theta_end: a.theta_end,
+            })
+        }
+    };
+    let given = points.is_some() as u8
+        + parabola.is_some() as u8
+        + arc.is_some() as u8
+        + segments.is_some() as u8;
+    if given != 1 {
+        return Err(ctx.err(
+            key,
+            format!("{named}: give exactly one of {points_key}, parabola, arc or segments"),
+        ));
+    }
+    match segments {
+        None => Ok(one(points, parabola, arc).expect("one path given")),
+        Some(parts) => {
+            if parts.is_empty() {
+                return Err(ctx.err(format!("{key}.segments"), format!("{named}: is empty")));
+            }
+            let mut out = Vec::new();
+            for (j, p) in parts.iter().enumerate() {
+                let n =
+                    p.points.is_some() as u8 + p.parabola.is_some() as u8 + p.arc.is_some() as u8;
+                if n != 1 {
+                    return Err(ctx.err(
+                        format!("{key}.segments[{j}]"),
+                        format!("{named}: give exactly one of points, parabola or arc"),
+                    ));
+                }
+                out.push(
+                    one(p.points.as_ref(), p.parabola.as_ref(), p.arc.as_ref())
+                        .expect("one part given"),
+                );
+            }
+            Ok(BarPath::Chain(out))
+        }
+    }
+}
+
+/// A path cut through the mesh: integration points, piece ends and ranges, and the path
+/// segment of each point.
+struct Embedded {
+    points: Vec<BarGaussPoint>,
+    piece_ends: Vec<[[f64; 2]; 2]>,
+    piece_points: Vec<(usize, usize)>,
+    segment: Vec<usize>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn embed_path(
+    ctx: &Ctx,
+    key: &str,
+    named: &str,
+    embedder: &BarEmbedder,
+    model: &Model,
+    coords: &[Vec<[f64; 2]>],
+    path: &BarPath,
+    n_gauss: usize,
+) -> R<Embedded> {
+    let pieces = embedder
+        .embed(
+            path,
+            &EmbedOptions {
+                n_gauss,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| ctx.err(key, format!("{named}: {e}")))?;
+    let mut out = Embedded {
+        points: Vec::new(),
+        piece_ends: Vec::new(),
+        piece_points: Vec::new(),
+        segment: Vec::new(),
+    };
+    for pc in &pieces {
+        let el = &model.elements[pc.element];
+        let c = &coords[pc.element];
+        let at = |q: [f64; 2]| map_point(&el.kind.eval(q[0], q[1]), c);
+        out.piece_ends
+            .push([at(pc.nat_nodes[0]), at(pc.nat_nodes[1])]);
+        let p0 = out.points.len();
+        out.points.extend(pc.points.iter().map(|p| BarGaussPoint {
+            element: pc.element,
+            point: *p,
+        }));
+        out.segment.extend(pc.points.iter().map(|_| pc.segment));
+        out.piece_points.push((p0, out.points.len()));
+    }
+    Ok(out)
+}
+
+/// Cut the bars and the bonded post-tensioned tendons through the mesh and store their
+/// integration points; the tendons' lock-off stresses after friction and anchorage set.
 fn build_bars(
     ctx: &Ctx,
     bars: &[BarIn],
+    tendons: &[TendonIn],
     steels: &[(String, SteelParams)],
     model: &mut Model,
 ) -> R<()> {
-    if bars.is_empty() {
+    if bars.is_empty() && !tendons.iter().any(|t| t.kind == "bonded") {
         return Ok(());
     }
     unique_names(ctx, "bars", bars.iter().map(|b| b.name.as_str()))?;
@@ -1756,6 +2016,13 @@ fn build_bars(
         })
         .collect();
     let embedder = BarEmbedder::new(&hosts).map_err(|e| ctx.err("mesh", e.to_string()))?;
+    let n_gauss_of = |key: &str, named: &str, g: Option<usize>| -> R<usize> {
+        let n = g.unwrap_or(4);
+        if !(1..=64).contains(&n) {
+            return Err(ctx.err(key, format!("{named}: must lie in 1..=64")));
+        }
+        Ok(n)
+    };
     let mut out = Vec::new();
     for (i, b) in bars.iter().enumerate() {
         let key = format!("bars[{i}]");
@@ -1792,70 +2059,142 @@ fn build_bars(
                 ),
             ));
         }
-        let given = b.path.is_some() as u8 + b.parabola.is_some() as u8 + b.arc.is_some() as u8;
-        if given != 1 {
-            return Err(ctx.err(
-                &key,
-                format!("{named}: give exactly one of path, parabola or arc"),
-            ));
-        }
-        let path = if let Some(p) = &b.path {
-            BarPath::Polyline(p.clone())
-        } else if let Some(p) = &b.parabola {
-            BarPath::Parabola {
-                start: p.start,
-                end: p.end,
-                sag: p.sag,
-            }
-        } else {
-            let a = b.arc.as_ref().expect("one path given");
-            BarPath::Arc {
-                center: a.center,
-                radius: a.radius,
-                theta_start: a.theta_start,
-                theta_end: a.theta_end,
-            }
-        };
-        let n_gauss = b.gauss_points.unwrap_or(4);
-        if !(1..=64).contains(&n_gauss) {
-            return Err(ctx.err(
-                format!("{key}.gauss_points"),
-                format!("{named}: must lie in 1..=64"),
-            ));
-        }
-        let pieces = embedder
-            .embed(
-                &path,
-                &EmbedOptions {
-                    n_gauss,
-                    ..Default::default()
-                },
-            )
-            .map_err(|e| ctx.err(format!("{key}.path"), format!("{named}: {e}")))?;
-        let mut points = Vec::new();
-        let mut piece_ends = Vec::new();
-        let mut piece_points = Vec::new();
-        for pc in &pieces {
-            let el = &model.elements[pc.element];
-            let c = &coords[pc.element];
-            let at = |q: [f64; 2]| map_point(&el.kind.eval(q[0], q[1]), c);
-            piece_ends.push([at(pc.nat_nodes[0]), at(pc.nat_nodes[1])]);
-            let p0 = points.len();
-            points.extend(pc.points.iter().map(|p| BarGaussPoint {
-                element: pc.element,
-                point: *p,
-            }));
-            piece_points.push((p0, points.len()));
-        }
+        let path = path_of(
+            ctx,
+            &key,
+            &named,
+            "path",
+            b.path.as_ref(),
+            b.parabola.as_ref(),
+            b.arc.as_ref(),
+            b.segments.as_ref(),
+        )?;
+        let n_gauss = n_gauss_of(&format!("{key}.gauss_points"), &named, b.gauss_points)?;
+        let e = embed_path(
+            ctx,
+            &format!("{key}.path"),
+            &named,
+            &embedder,
+            model,
+            &coords,
+            &path,
+            n_gauss,
+        )?;
         out.push(Bar {
             name: b.name.clone(),
             area,
             steel,
             initial_stress,
-            n_pieces: pieces.len(),
+            n_pieces: e.piece_points.len(),
+            points: e.points,
+            piece_ends: e.piece_ends,
+            piece_points: e.piece_points,
+            post_tension: None,
+        });
+    }
+    for (i, t) in tendons.iter().enumerate() {
+        if t.kind != "bonded" {
+            continue;
+        }
+        let key = format!("tendons[{i}]");
+        let k = |f: &str| format!("{key}.{f}");
+        let named = format!("tendon '{}'", t.name);
+        if bars.iter().any(|b| b.name == t.name) {
+            return Err(ctx.err(
+                k("name"),
+                format!("{named}: a bar has the same name (bonded tendons are output and monitored as bars)"),
+            ));
+        }
+        for (f, given) in [
+            ("initial_stress", t.initial_stress.is_some()),
+            ("deviators", t.deviators.is_some()),
+            ("deviator_friction", t.deviator_friction.is_some()),
+            ("relaxation_class", t.relaxation_class.is_some()),
+        ] {
+            if given {
+                return Err(ctx.err(
+                    k(f),
+                    format!("{named}: not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is a [[bars]] entry with initial_stress)"),
+                ));
+            }
+        }
+        let area = positive(ctx, &k("area"), t.area)?;
+        if area > 0.1 {
+            return Err(ctx.err(
+                k("area"),
+                format!("{named}: {area} m² is not a tendon area (units are m²)"),
+            ));
+        }
+        let ep = positive(ctx, &k("Ep"), t.ep)?;
+        let fptk = positive(ctx, &k("fptk"), t.fptk)?;
+        if fptk >= ep {
+            return Err(ctx.err(
+                k("fptk"),
+                format!("{named}: must be far below Ep (units are Pa)"),
+            ));
+        }
+        let steel = SteelParams::prestressing(ep, fptk);
+        let sigma_pi = jacking_stress_of(ctx, i, t, area, fptk)?.ok_or_else(|| {
+            ctx.err(
+                k("jacking_stress"),
+                format!("{named}: missing: give jacking_stress or jacking_force"),
+            )
+        })?;
+        let (friction, jacking, draw_in) = friction_of(ctx, i, t)?;
+        let points = (!t.points.is_empty()).then_some(&t.points);
+        let path = path_of(
+            ctx,
+            &key,
+            &named,
+            "points",
             points,
-            piece_ends,
-            piece_points,
+            t.parabola.as_ref(),
+            t.arc.as_ref(),
+            t.segments.as_ref(),
+        )?;
+        let turns = path
+            .turn_table()
+            .map_err(|e| ctx.err(&key, format!("{named}: {e}")))?;
+        let n_gauss = n_gauss_of(&k("gauss_points"), &named, t.gauss_points)?;
+        let e = embed_path(ctx, &key, &named, &embedder, model, &coords, &path, n_gauss)?;
+        let samples = Samples {
+            s: e.points.iter().map(|p| p.point.s).collect(),
+            alpha: e
+                .points
+                .iter()
+                .zip(&e.segment)
+                .map(|(p, &sg)| turns.at(sg, p.point.s, p.point.dir))
+                .collect(),
+            length: turns.length,
+            total_turn: turns.total,
+        };
+        let lock = posttension::lock_off(
+            &Stressing {
+                jacking_stress: sigma_pi,
+                friction,
+                jacking,
+                draw_in,
+                ep,
+            },
+            &samples,
+        )
+        .map_err(|err| ctx.err(k("anchorage_set"), format!("{named}: {err}")))?;
+        out.push(Bar {
+            name: t.name.clone(),
+            area,
+            steel,
+            initial_stress: 0.0,
+            n_pieces: e.piece_points.len(),
+            points: e.points,
+            piece_ends: e.piece_ends,
+            piece_points: e.piece_points,
+            post_tension: Some(PostTension {
+                stressed_in_step: 0,
+                grouted_in_step: None,
+                point_stress: lock.stress,
+                jacking_stress: sigma_pi,
+                set_length: lock.set_length,
+            }),
         });
     }
     model.bars = out;
@@ -1877,6 +2216,20 @@ fn optional_region(ctx: &Ctx, key: &str, model: &Model, name: Option<&str>) -> R
 }
 
 /// Bar-stress and concrete-state monitors.
+/// Index of the bar's integration point nearest `p` [m].
+fn nearest_bar_point(bar: &Bar, p: [f64; 2]) -> usize {
+    let pts = &bar.points;
+    (0..pts.len())
+        .min_by(|&a, &b| {
+            let d = |i: usize| {
+                let x = pts[i].point.x;
+                (x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2)
+            };
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap_or(0)
+}
+
 fn material_monitor(ctx: &Ctx, key: &str, m: &MonitorIn, model: &Model) -> R<MonitorKind> {
     if m.kind == "bar_stress" {
         let name = m
@@ -1890,18 +2243,7 @@ fn material_monitor(ctx: &Ctx, key: &str, m: &MonitorIn, model: &Model) -> R<Mon
             model.bars.iter().map(|b| b.name.as_str()),
             name,
         )?;
-        let point = m.point.map(|p| {
-            let pts = &model.bars[bar].points;
-            (0..pts.len())
-                .min_by(|&a, &b| {
-                    let d = |i: usize| {
-                        let x = pts[i].point.x;
-                        (x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2)
-                    };
-                    d(a).total_cmp(&d(b))
-                })
-                .unwrap_or(0)
-        });
+        let point = m.point.map(|p| nearest_bar_point(&model.bars[bar], p));
         return Ok(MonitorKind::BarStress { bar, point });
     }
     if m.point.is_some() || m.node.is_some() {

@@ -145,13 +145,21 @@ pub struct GmshJointIn {
 pub struct TendonIn {
     pub name: String,
     pub kind: String,
+    #[serde(default)]
     pub points: Vec<[f64; 2]>,
+    pub parabola: Option<ParabolaIn>,
+    pub arc: Option<ArcIn>,
+    pub segments: Option<Vec<PathPartIn>>,
     pub area: f64,
     #[serde(rename = "Ep")]
     pub ep: f64,
     pub fptk: f64,
     pub initial_stress: Option<f64>,
     pub jacking_stress: Option<f64>,
+    pub jacking_force: Option<f64>,
+    pub anchorage_set: Option<f64>,
+    pub grouted_in_step: Option<String>,
+    pub gauss_points: Option<usize>,
     pub jacking: Option<String>,
     pub friction: Option<f64>,
     pub wobble: Option<f64>,
@@ -274,10 +282,20 @@ pub struct BarIn {
     pub path: Option<Vec<[f64; 2]>>,
     pub parabola: Option<ParabolaIn>,
     pub arc: Option<ArcIn>,
+    pub segments: Option<Vec<PathPartIn>>,
     pub area: f64,
     pub material: String,
     pub initial_stress: Option<f64>,
     pub gauss_points: Option<usize>,
+}
+
+/// One part of a composite path: exactly one of a polyline, a parabola or an arc.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathPartIn {
+    pub points: Option<Vec<[f64; 2]>>,
+    pub parabola: Option<ParabolaIn>,
+    pub arc: Option<ArcIn>,
 }
 
 #[derive(Debug, Deserialize)]
