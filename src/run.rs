@@ -265,6 +265,21 @@ pub fn run_file_opts(
     })?;
     let (resume, failures) = match saved {
         Some((_, cp)) => {
+            // The history goes on with the same columns, or not at all.
+            if let Some(r) = cp.recorder.rows.first() {
+                if r.monitors.len() != model.monitors.len()
+                    || r.factors.len() != model.load_cases.len()
+                {
+                    return Err(RunError::Restart(format!(
+                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
+                        path.display(),
+                        r.factors.len(),
+                        r.monitors.len(),
+                        model.load_cases.len(),
+                        model.monitors.len()
+                    )));
+                }
+            }
             rec.restore(cp.recorder);
             (Some((cp.driver, cp.system)), cp.failures)
         }

@@ -256,10 +256,13 @@ pub fn run_with(
             }
             Err(AnalysisError::NotConverged(r)) if options.continue_on_failure => {
                 obs.step_failed(&r);
-                // Go on from the last converged state: the time reached, the tendons'
-                // initial strains back to their committed relaxation.
-                clock = reached_clock;
-                sys.begin_time_increment(TimeContext::at(clock));
+                // Go on from the last converged state. A load or time step set the clock of
+                // its failed attempt: back to the time reached, and the tendons' initial
+                // strains back to their committed relaxation (path steps leave both alone).
+                if step.kind != StepKind::Displacement && step.kind != StepKind::ArcLength {
+                    clock = reached_clock;
+                    sys.begin_time_increment(TimeContext::at(clock));
+                }
             }
             Err(e) => return Err(e),
         }
