@@ -262,8 +262,10 @@ fn sigint_stops_the_binary_cleanly() {
     let s = summary(&tmp.join("out"));
     assert_eq!(s["status"], "interrupted");
     assert_eq!(s["resume_step"], 2);
+    // Step 1 (one row) and what step 2 did before the signal (possibly nothing, if the
+    // signal came between the end of step 1 and the start of step 2), not all of it.
     let rows = read(&tmp.join("out/history.csv")).lines().count() - 1;
-    assert!((2..20000).contains(&rows), "{rows} rows");
+    assert!((1..20000).contains(&rows), "{rows} rows");
     assert!(tmp.join("out/checkpoint.bin").is_file());
 }
 
