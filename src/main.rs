@@ -6,6 +6,8 @@ use segfem::fem::shape::QuadKind;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, AtomicUsize};
+use std::sync::Arc;
 
 /// Bundled examples: (name, description, model file text).
 const EXAMPLES: &[(&str, &str, &str)] = &[
@@ -54,12 +56,14 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a model file and write history.csv, summary.json and results.pvd/.vtu.
+    /// Run a model file and write history.csv, summary.json, results.pvd/.vtu and a
+    /// checkpoint at every step end (exit status: docs/running.md).
     Run {
-        /// Model file (TOML).
-        model: PathBuf,
+        /// Model file (TOML); with --restart, default: the one the checkpoint names.
+        #[arg(required_unless_present = "restart")]
+        model: Option<PathBuf>,
         /// Output directory (default: the model file's name without extension, beside it).
-        #[arg(short, long)]
+        #[arg(short, long, conflicts_with = "restart")]
         output: Option<PathBuf>,
         /// Print nothing but errors.
         #[arg(short, long)]
@@ -67,6 +71,20 @@ enum Command {
         /// Print every Newton iteration's residual and energy norms.
         #[arg(short, long)]
         verbose: bool,
+        /// When a step fails after all step cuts, report it and go on with the next step
+        /// from the last converged state.
+        #[arg(long)]
+        continue_on_failure: bool,
+        /// Continue the stopped run in DIR from its last checkpoint (end of a step).
+        #[arg(long, value_name = "DIR")]
+        restart: Option<PathBuf>,
+        /// Stop after step K (1-based) once its checkpoint is written (exit status 4).
+        #[arg(long, value_name = "K")]
+        stop_after_step: Option<usize>,
+        /// Worker threads of the element loops (default: all cores; results are
+        /// bit-identical whatever the number).
+        #[arg(long, value_name = "N")]
+        threads: Option<usize>,
     },
     /// Validate a model file and print a summary, without solving.
     Check {
@@ -165,7 +183,39 @@ fn main() -> ExitCode {
             output,
             quiet,
             verbose,
-        } => run(model, output, quiet, verbose),
+            continue_on_failure,
+            restart,
+            stop_after_step,
+            threads,
+        } => {
+            if let Some(n) = threads {
+                if n == 0 {
+                    eprintln!("error: --threads: at least 1 thread");
+                    return ExitCode::from(2);
+                }
+                if let Err(e) = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build_global()
+                {
+                    eprintln!("error: --threads: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            let opts = segfem::run::RunOptions {
+                verbose,
+                continue_on_failure,
+                stop_after_step,
+                signal: Some(stop_on_signals()),
+                restart: restart.is_some(),
+            };
+            let out = match (&restart, &output, &model) {
+                (Some(d), _, _) => d.clone(),
+                (None, Some(o), _) => o.clone(),
+                (None, None, Some(m)) => m.with_extension(""),
+                (None, None, None) => unreachable!("clap requires MODEL without --restart"),
+            };
+            run(model, out, quiet, &opts)
+        }
         Command::Check { model } => check(model),
         Command::Example { name, output } => example(name, output),
         Command::Bench {
@@ -244,8 +294,31 @@ fn view_error(e: segfem::view::ViewError) -> ExitCode {
     ExitCode::from(e.exit_code())
 }
 
-fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool, verbose: bool) -> ExitCode {
-    let out = output.unwrap_or_else(|| model.with_extension(""));
+/// Make SIGINT and SIGTERM set a flag (the signal number) that the analysis reads after
+/// every increment: it then writes its results and stops. A second signal while the flag
+/// is set ends the process at once (status 128 + signal), for a run that does not answer.
+fn stop_on_signals() -> Arc<AtomicUsize> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicUsize::new(0));
+    let seen = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        // Order matters: the shutdown test runs before the flag is set by this signal.
+        let ok = signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, seen.clone())
+            .and_then(|_| signal_hook::flag::register(sig, seen.clone()))
+            .and_then(|_| signal_hook::flag::register_usize(sig, flag.clone(), sig as usize));
+        if let Err(e) = ok {
+            eprintln!("warning: cannot handle signal {sig} ({e}); it will end the run at once");
+        }
+    }
+    flag
+}
+
+fn run(
+    model: Option<PathBuf>,
+    out: PathBuf,
+    quiet: bool,
+    opts: &segfem::run::RunOptions,
+) -> ExitCode {
     let tty = std::io::stderr().is_terminal() && !quiet;
     let bar = if tty {
         let b = ProgressBar::new_spinner();
@@ -273,10 +346,13 @@ fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool, verbose: bool) -> E
             None => {}
         }
     };
-    let res = segfem::run::run_file_with(&model, &out, &mut on_inc, verbose);
+    let res = segfem::run::run_file_opts(model.as_deref(), &out, &mut on_inc, opts);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
+    let shown = model
+        .clone()
+        .unwrap_or_else(|| out.join(segfem::results::checkpoint::FILE));
     match res {
         Ok(s) => {
             for w in &s.warnings {
@@ -285,7 +361,7 @@ fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool, verbose: bool) -> E
             if !quiet {
                 println!(
                     "{}: {} nodes, {} elements, {} equations; {} increments, {} iterations in {:.3} s",
-                    model.display(),
+                    shown.display(),
                     s.size.nodes,
                     s.size.elements,
                     s.size.equations,
@@ -308,7 +384,7 @@ fn run(model: PathBuf, output: Option<PathBuf>, quiet: bool, verbose: bool) -> E
                     out.display()
                 );
             }
-            ExitCode::from(e.exit_code() as u8)
+            ExitCode::from(e.exit_code().clamp(0, 255) as u8)
         }
     }
 }

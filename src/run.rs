@@ -1,15 +1,21 @@
 //! The main job: read a model file, run its steps, write history, fields and a summary.
 
-use crate::analysis::steps::{self, AnalysisError, Observer, Snapshot, Timings};
+use crate::analysis::failure::FailureReport;
+use crate::analysis::steps::{
+    self, AnalysisError, Observer, Snapshot, StepEnd, StopReason, Timings,
+};
 use crate::input::{self, InputError};
 use crate::model::Model;
 use crate::results::atomic::write_atomic;
+use crate::results::checkpoint::{self, Origin};
 use crate::results::recorder::Recorder;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
-/// Why a run failed; each maps to an exit status.
+/// Why a run failed; each maps to an exit status (docs/running.md).
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     /// Bad input (exit 2).
@@ -23,9 +29,25 @@ pub enum RunError {
         /// What is singular.
         message: String,
     },
-    /// An increment did not converge (exit 3); results so far are written.
+    /// A restart is impossible: no or a damaged checkpoint, or the model changed (exit 2).
+    #[error("cannot restart: {0}")]
+    Restart(String),
+    /// An increment did not converge (exit 3); results so far are written. With
+    /// continue-on-failure: one or more steps failed, the others ran.
     #[error("{0}")]
     NotConverged(String),
+    /// Stopped by a signal after finishing the current increment (exit 128 + signal:
+    /// 130 for SIGINT, 143 for SIGTERM); results so far are written.
+    #[error("{message}")]
+    Interrupted {
+        /// Signal number.
+        signal: i32,
+        /// What was done and how to go on.
+        message: String,
+    },
+    /// Stopped as asked after a step (`--stop-after-step`, exit 4).
+    #[error("{0}")]
+    Stopped(String),
     /// Files could not be written (exit 1).
     #[error("{0}")]
     Io(String),
@@ -35,11 +57,28 @@ impl RunError {
     /// Process exit status for this error.
     pub fn exit_code(&self) -> i32 {
         match self {
-            RunError::Input(_) | RunError::Mechanism { .. } => 2,
+            RunError::Input(_) | RunError::Mechanism { .. } | RunError::Restart(_) => 2,
             RunError::NotConverged(_) => 3,
+            RunError::Stopped(_) => 4,
+            RunError::Interrupted { signal, .. } => 128 + signal,
             RunError::Io(_) => 1,
         }
     }
+}
+
+/// Options of [`run_file_opts`].
+#[derive(Debug, Default, Clone)]
+pub struct RunOptions {
+    /// Print every Newton iteration's norms to standard error.
+    pub verbose: bool,
+    /// Report a step that fails and go on with the next one (docs/running.md).
+    pub continue_on_failure: bool,
+    /// Stop after this step (1-based) once its checkpoint is written.
+    pub stop_after_step: Option<usize>,
+    /// Set to a signal number (non-zero) to stop after the current increment.
+    pub signal: Option<Arc<AtomicUsize>>,
+    /// Continue the run whose output directory is `out` from its checkpoint.
+    pub restart: bool,
 }
 
 /// Model size figures.
@@ -60,10 +99,18 @@ pub struct Size {
 pub struct Summary {
     /// Model title.
     pub title: String,
-    /// "completed" or "failed".
+    /// "completed", "failed" (a step did not converge), "interrupted" (signal) or
+    /// "stopped" (`--stop-after-step`).
     pub status: String,
     /// Failure message, if any.
     pub error: Option<String>,
+    /// Reports of the steps that failed (where, why), in order.
+    pub failures: Vec<FailureReport>,
+    /// Step (1-based) a `--restart` of this directory begins with, when the run stopped
+    /// early and can be continued.
+    pub resume_step: Option<usize>,
+    /// Step (1-based) this run restarted from, if it was a restart.
+    pub restarted_from_step: Option<usize>,
     /// Size.
     pub size: Size,
     /// Wall time of the whole run [s].
@@ -101,6 +148,12 @@ pub fn size_of(model: &Model, equations: usize) -> Size {
 struct Progress<'a, 'm> {
     rec: Recorder<'m>,
     on_increment: &'a mut dyn FnMut(&Snapshot),
+    dir: PathBuf,
+    origin: Origin,
+    failures: Vec<FailureReport>,
+    stop_after_step: Option<usize>,
+    stop_now: bool,
+    signal: Option<Arc<AtomicUsize>>,
 }
 
 impl Observer for Progress<'_, '_> {
@@ -108,6 +161,36 @@ impl Observer for Progress<'_, '_> {
         self.rec.increment(snap)?;
         (self.on_increment)(snap);
         Ok(())
+    }
+
+    fn step_end(&mut self, end: &StepEnd) -> std::io::Result<()> {
+        checkpoint::write(
+            &self.dir,
+            &self.origin,
+            end.driver,
+            &self.failures,
+            &self.rec.state(),
+            end.system.state(),
+        )?;
+        if self.stop_after_step == Some(end.driver.next_step) {
+            self.stop_now = true;
+        }
+        Ok(())
+    }
+
+    fn step_failed(&mut self, report: &FailureReport) {
+        self.failures.push(report.clone());
+    }
+
+    fn stop_requested(&self) -> Option<StopReason> {
+        let sig = self.signal.as_ref().map_or(0, |s| s.load(Ordering::SeqCst));
+        if sig != 0 {
+            Some(StopReason::Signal(sig as i32))
+        } else if self.stop_now {
+            self.stop_after_step.map(StopReason::AfterStep)
+        } else {
+            None
+        }
     }
 }
 
@@ -128,24 +211,115 @@ pub fn run_file_with(
     on_increment: &mut dyn FnMut(&Snapshot),
     verbose: bool,
 ) -> Result<Summary, RunError> {
+    let opts = RunOptions {
+        verbose,
+        ..Default::default()
+    };
+    run_file_opts(Some(path), out, on_increment, &opts)
+}
+
+/// Run a model file (or, with `opts.restart`, continue the run in `out`; the model file is
+/// then the one given or else the one the checkpoint names), writing into `out`.
+pub fn run_file_opts(
+    path: Option<&Path>,
+    out: &Path,
+    on_increment: &mut dyn FnMut(&Snapshot),
+    opts: &RunOptions,
+) -> Result<Summary, RunError> {
     let t0 = Instant::now();
+    let saved = if opts.restart {
+        Some(checkpoint::read(out).map_err(RunError::Restart)?)
+    } else {
+        None
+    };
+    let path: PathBuf = match (path, &saved) {
+        (Some(p), _) => p.to_path_buf(),
+        (None, Some((o, _))) => PathBuf::from(&o.model_file),
+        (None, None) => {
+            return Err(RunError::Restart(
+                "no model file given and no checkpoint to take it from".into(),
+            ))
+        }
+    };
+    let path = path.as_path();
     let mut built = input::load(path)?;
-    built.model.controls.verbose = verbose;
+    built.model.controls.verbose = opts.verbose;
+    let digest = std::fs::read(path)
+        .map(|b| checkpoint::digest(&b))
+        .unwrap_or(0);
+    if let Some((o, _)) = &saved {
+        if o.model_digest != digest {
+            built.warnings.push(format!(
+                "{}: the model file changed since the checkpoint was written; the restarted run equals an uninterrupted one only if the steps already done are unchanged",
+                path.display()
+            ));
+        }
+    }
     let input_s = t0.elapsed().as_secs_f64();
     let model = built.model;
-    let rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
+    let mut rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
         RunError::Io(format!(
             "{}: cannot create the output directory: {e}",
             out.display()
         ))
     })?;
-    let mut obs = Progress { rec, on_increment };
-    let result = steps::run(&model, &mut obs);
+    let (resume, failures) = match saved {
+        Some((_, cp)) => {
+            // The history goes on with the same columns, or not at all.
+            if let Some(r) = cp.recorder.rows.first() {
+                if r.monitors.len() != model.monitors.len()
+                    || r.factors.len() != model.load_cases.len()
+                {
+                    return Err(RunError::Restart(format!(
+                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
+                        path.display(),
+                        r.factors.len(),
+                        r.monitors.len(),
+                        model.load_cases.len(),
+                        model.monitors.len()
+                    )));
+                }
+            }
+            rec.restore(cp.recorder);
+            (Some((cp.driver, cp.system)), cp.failures)
+        }
+        None => (None, Vec::new()),
+    };
+    let restarted_from_step = resume.as_ref().map(|(d, _)| d.next_step + 1);
+    let model_file = std::fs::canonicalize(path)
+        .unwrap_or_else(|_| path.to_path_buf())
+        .display()
+        .to_string();
+    let mut obs = Progress {
+        rec,
+        on_increment,
+        dir: PathBuf::from(out),
+        origin: Origin {
+            model_file,
+            model_digest: digest,
+        },
+        failures,
+        stop_after_step: opts.stop_after_step,
+        stop_now: false,
+        signal: opts.signal.clone(),
+    };
+    let result = steps::run_with(
+        &model,
+        &mut obs,
+        steps::RunOptions {
+            continue_on_failure: opts.continue_on_failure,
+            resume,
+        },
+    );
     let rec = obs.rec;
+    let mut failures = obs.failures;
     let (timings, error) = match result {
         Ok(t) => (t, None),
         Err(e) => (Timings::default(), Some(e)),
     };
+    if let Some(AnalysisError::NotConverged(r)) = &error {
+        failures.push((**r).clone());
+    }
     // History is written whatever happened: every converged increment is kept.
     rec.write_history()
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("history.csv").display())))?;
@@ -170,14 +344,46 @@ pub fn run_file_with(
             .collect::<Vec<_>>(),
     )
     .n_eq;
+    let (status, resume_step) = match &error {
+        None if failures.is_empty() => ("completed", None),
+        None | Some(AnalysisError::NotConverged(_)) => ("failed", None),
+        Some(AnalysisError::Stopped {
+            reason,
+            resume_step,
+            ..
+        }) => (
+            match reason {
+                StopReason::Signal(_) => "interrupted",
+                StopReason::AfterStep(_) => "stopped",
+            },
+            Some(resume_step + 1),
+        ),
+        Some(_) => ("failed", None),
+    };
+    let error_text = match (&error, failures.len()) {
+        (Some(e), _) => Some(e.to_string()),
+        (None, 0) => None,
+        (None, n) => Some(format!(
+            "{n} step(s) did not converge (the run went on): {}\n{}",
+            failures
+                .iter()
+                .map(|f| format!("'{}'", f.step))
+                .collect::<Vec<_>>()
+                .join(", "),
+            failures
+                .iter()
+                .map(|f| f.to_string())
+                .collect::<Vec<_>>()
+                .join("\n")
+        )),
+    };
     let summary = Summary {
         title: model.title.clone(),
-        status: if error.is_none() {
-            "completed".into()
-        } else {
-            "failed".into()
-        },
-        error: error.as_ref().map(|e| e.to_string()),
+        status: status.into(),
+        error: error_text.clone(),
+        failures,
+        resume_step,
+        restarted_from_step,
         size: size_of(&model, equations),
         wall_s: t0.elapsed().as_secs_f64(),
         input_s,
@@ -189,17 +395,58 @@ pub fn run_file_with(
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_atomic(&out.join("summary.json"), json.as_bytes())
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("summary.json").display())))?;
+    let file = path.display();
     match error {
-        None => Ok(summary),
+        None if summary.failures.is_empty() => Ok(summary),
+        None => Err(RunError::NotConverged(format!(
+            "{file}: {}",
+            error_text.expect("set with failures")
+        ))),
         Some(AnalysisError::Mechanism(m)) => Err(RunError::Mechanism {
-            file: path.display().to_string(),
+            file: file.to_string(),
             message: m,
         }),
-        Some(AnalysisError::NotConverged { .. }) => Err(RunError::NotConverged(format!(
-            "{}: {}",
-            path.display(),
-            error.expect("matched")
-        ))),
+        Some(e @ AnalysisError::NotConverged(_)) => {
+            Err(RunError::NotConverged(format!("{file}: {e}")))
+        }
+        Some(AnalysisError::Stopped {
+            reason,
+            step,
+            increment,
+            resume_step,
+        }) => {
+            let done = if increment == 0 {
+                format!("after step {}", step + 1)
+            } else {
+                format!("at step {} increment {increment}", step + 1)
+            };
+            let how = format!(
+                "results so far are in {0}; `segfem run --restart {0}` continues with step {1}",
+                out.display(),
+                resume_step + 1
+            );
+            match reason {
+                StopReason::Signal(signal) => Err(RunError::Interrupted {
+                    signal,
+                    message: format!(
+                        "{file}: interrupted by {} {done}; {how}",
+                        signal_name(signal)
+                    ),
+                }),
+                StopReason::AfterStep(_) => Err(RunError::Stopped(format!(
+                    "{file}: stopped {done} as asked; {how}"
+                ))),
+            }
+        }
+        Some(AnalysisError::Restore(m)) => Err(RunError::Restart(format!("{file}: {m}"))),
         Some(AnalysisError::Output(e)) => Err(RunError::Io(format!("{}: {e}", out.display()))),
+    }
+}
+
+fn signal_name(s: i32) -> String {
+    match s {
+        2 => "SIGINT".into(),
+        15 => "SIGTERM".into(),
+        n => format!("signal {n}"),
     }
 }

@@ -585,9 +585,18 @@ fn box_beam_vtu_files_are_complete() {
         times.windows(2).all(|w| w[0] < w[1]),
         "timesteps increase: {times:?}"
     );
-    // Nothing but the listed files, history and summary in the directory (no temporaries).
+    // Nothing but the listed files, history, summary and checkpoint in the directory (no
+    // temporaries).
     let mut want: Vec<String> = files.clone();
-    want.extend(["history.csv", "results.pvd", "summary.json"].map(String::from));
+    want.extend(
+        [
+            "checkpoint.bin",
+            "history.csv",
+            "results.pvd",
+            "summary.json",
+        ]
+        .map(String::from),
+    );
     want.sort();
     let mut have: Vec<String> = std::fs::read_dir(&out)
         .unwrap()

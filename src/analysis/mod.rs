@@ -1,8 +1,10 @@
 //! Analysis: steps, the Newton loop, and the linear-solver wrapper.
 
+pub mod failure;
 pub mod loads;
 pub mod path;
 pub mod solver;
+pub mod state;
 pub mod steps;
 pub mod system;
 pub mod time;

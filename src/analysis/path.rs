@@ -3,9 +3,11 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
+use super::failure::{report, FailedAt};
 use super::solver::SparseCholesky;
 use super::steps::{
-    newton, norm, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot, Timings,
+    check_stop, newton, norm, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot,
+    Timings,
 };
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
@@ -108,7 +110,7 @@ impl PathContext<'_, '_> {
             control_force,
         })?;
         self.timings.output_s += t.elapsed().as_secs_f64();
-        Ok(())
+        check_stop(obs, step, increment, end_of_step)
     }
 }
 
@@ -124,9 +126,7 @@ pub(super) fn run_step(
             let dofs: Vec<usize> = nodes.iter().map(|n| 2 * n + dir.index()).collect();
             displacement_step(ctx, si, step, &dofs, *value, obs)
         }
-        (Some(PathControl::ArcLength(a)), StepKind::ArcLength) => {
-            arc_length_step(ctx, si, step, a, obs)
-        }
+        (Some(PathControl::ArcLength(a)), StepKind::ArcLength) => arc_length_step(ctx, si, a, obs),
         _ => Err(AnalysisError::Mechanism(format!(
             "step '{}': path control missing (input error)",
             step.name
@@ -134,21 +134,28 @@ pub(super) fn run_step(
     }
 }
 
+/// The error of a step that failed after all cuts, with its report (built from the trial
+/// states of the failed attempt: call before anything is reassembled).
 fn not_converged(
     ctx: &PathContext,
-    step: &Step,
+    si: usize,
     increment: usize,
     level: f64,
     cuts: usize,
     f: &NewtonFailure,
 ) -> AnalysisError {
-    AnalysisError::NotConverged {
-        step: step.name.clone(),
-        increment,
-        level,
-        cuts,
-        reason: f.describe(ctx.sys),
-    }
+    AnalysisError::NotConverged(Box::new(report(
+        ctx.sys,
+        FailedAt {
+            step: si,
+            increment,
+            level,
+            cuts,
+            factors: ctx.factors,
+            negative_pivots: ctx.solver.negative_pivots,
+        },
+        f,
+    )))
 }
 
 // ------------------------------------------------------------------------------------------
@@ -228,7 +235,7 @@ fn displacement_step(
                 ctx.u.copy_from_slice(&ctx.sys.u);
                 ctx.sys.unlatch();
                 if cuts >= ctx.sys.model.controls.max_cuts {
-                    return Err(not_converged(ctx, step, increment + 1, target, cuts, &f));
+                    return Err(not_converged(ctx, si, increment + 1, target, cuts, &f));
                 }
                 cuts += 1;
                 d_level *= 0.5;
@@ -276,7 +283,7 @@ fn newton_controlled(
         history.push(rel);
         ctx.sys.freeze_if_cycling(&history);
         if !rel.is_finite() {
-            return Err(NewtonFailure::Diverged(history));
+            return Err(NewtonFailure::diverged(history, rf));
         }
         if it > 0 {
             let energy_ok = it > 1
@@ -287,7 +294,7 @@ fn newton_controlled(
             }
         }
         if it == controls.max_iterations {
-            break;
+            return Err(NewtonFailure::diverged(history, rf));
         }
         let p = &ctx.sys.asm.pattern;
         if it == 0 {
@@ -327,7 +334,8 @@ fn newton_controlled(
         }
         ctx.add_free(&mut u, &du, 1.0);
     }
-    Err(NewtonFailure::Diverged(history))
+    // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
+    Err(NewtonFailure::diverged(history, Vec::new()))
 }
 
 // ------------------------------------------------------------------------------------------
@@ -345,7 +353,6 @@ struct ArcIncrement {
 fn arc_length_step(
     ctx: &mut PathContext,
     si: usize,
-    step: &Step,
     a: &ArcLengthControl,
     obs: &mut dyn Observer,
 ) -> Result<(), AnalysisError> {
@@ -454,7 +461,7 @@ fn arc_length_step(
                 ctx.u.copy_from_slice(&ctx.sys.u);
                 ctx.sys.unlatch();
                 if cuts >= max_cuts || dl.is_none() {
-                    return Err(not_converged(ctx, step, increment + 1, lambda, cuts, &f));
+                    return Err(not_converged(ctx, si, increment + 1, lambda, cuts, &f));
                 }
                 if cuts == 0 {
                     failed_dl = dl;
@@ -506,7 +513,7 @@ fn arc_increment(
     ctx.solver.solve_in_place(&mut dut);
     let nt = norm(&dut);
     if !(nt.is_finite() && nt > 0.0) {
-        return Err(NewtonFailure::Diverged(vec![nt]));
+        return Err(NewtonFailure::diverged(vec![nt], Vec::new()));
     }
     let l = *dl.get_or_insert(a.initial_increment * nt);
     // Direction: keep going the way the previous increment went (Feng's criterion
@@ -548,7 +555,7 @@ fn arc_increment(
         history.push(rel);
         ctx.sys.freeze_if_cycling(&history);
         if !rel.is_finite() {
-            return Err(NewtonFailure::Diverged(history));
+            return Err(NewtonFailure::diverged(history, rf));
         }
         let energy_ok = it > 2
             && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
@@ -562,7 +569,7 @@ fn arc_increment(
             });
         }
         if it > controls.max_iterations {
-            break;
+            return Err(NewtonFailure::diverged(history, rf));
         }
         ctx.solver
             .factorize_indefinite(&ctx.sys.asm.pattern, &k)
@@ -621,7 +628,8 @@ fn arc_increment(
         d_lambda += dlam;
         ctx.add_free(&mut u, &corr, 1.0);
     }
-    Err(NewtonFailure::Diverged(history))
+    // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
+    Err(NewtonFailure::diverged(history, Vec::new()))
 }
 
 /// Correction scale from the residual history: 1, or ½, ¼, … (at least 1/16) while the

@@ -86,7 +86,7 @@ pub struct System<'m> {
 }
 
 /// Stage of an embedded bar or bonded tendon.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum BarPhase {
     /// Post-tensioned tendon not yet stressed: absent.
     Inactive,
@@ -100,7 +100,7 @@ pub enum BarPhase {
 }
 
 /// Values at one bar integration point for output.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BarOutput {
     /// Total bar strain including the prestrain σ_b,0/E_s [-].
     pub strain: f64,
@@ -582,22 +582,7 @@ impl<'m> System<'m> {
                 .iter()
                 .map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
                 .collect();
-            let x: Vec<[f64; 2]> = data
-                .nodes
-                .iter()
-                .zip(&u0)
-                .map(|(&n, d)| [self.model.nodes[n][0] + d[0], self.model.nodes[n][1] + d[1]])
-                .collect();
-            let el = ExternalTendon::new(
-                &x,
-                data.area,
-                data.ep,
-                data.span_stress[0],
-                TendonLaw::prestressing_steel(data.fptk),
-                data.mode,
-            )
-            .and_then(|e| e.with_span_initial_stresses(data.span_stress.clone()))
-            .expect("tendon geometry checked at input");
+            let el = self.build_tendon(t, &u0);
             let st = el.initial_state();
             self.tendon_committed[t] = Some(st.clone());
             self.tendon_trial[t] = Some(st);
@@ -637,6 +622,27 @@ impl<'m> System<'m> {
                 self.bar_phase[b] = BarPhase::Bonded;
             }
         }
+    }
+
+    /// Tendon `t` stressed on the geometry displaced by `u0` (one entry per tendon node) [m].
+    pub(crate) fn build_tendon(&self, t: usize, u0: &[[f64; 2]]) -> ExternalTendon {
+        let data = &self.model.tendons[t];
+        let x: Vec<[f64; 2]> = data
+            .nodes
+            .iter()
+            .zip(u0)
+            .map(|(&n, d)| [self.model.nodes[n][0] + d[0], self.model.nodes[n][1] + d[1]])
+            .collect();
+        ExternalTendon::new(
+            &x,
+            data.area,
+            data.ep,
+            data.span_stress[0],
+            TendonLaw::prestressing_steel(data.fptk),
+            data.mode,
+        )
+        .and_then(|e| e.with_span_initial_stresses(data.span_stress.clone()))
+        .expect("tendon geometry checked at input")
     }
 
     /// Accept the trial states of the last assembly and the displacements `u`.

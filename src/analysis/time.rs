@@ -19,7 +19,7 @@ use crate::materials::point::TimeContext;
 use crate::model::LossPart;
 
 /// Time-dependent record of one tendon span.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SpanTime {
     /// Span stress just after stressing [Pa].
     pub sigma_initial: f64,
@@ -44,7 +44,7 @@ pub struct SpanTime {
 }
 
 /// Time-dependent record of one external tendon.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TendonTime {
     /// One entry per span.
     pub spans: Vec<SpanTime>,

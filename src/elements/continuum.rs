@@ -34,7 +34,7 @@ pub fn rule_points(kind: QuadKind, integration: Integration) -> &'static [Point2
 }
 
 /// Values computed at one Gauss point for output.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct GaussOutput {
     /// Strain (εx, εy, γxy) [-].
     pub strain: [f64; 3],

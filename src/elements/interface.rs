@@ -174,7 +174,7 @@ pub struct InterfaceElement {
 }
 
 /// Committed or trial state of one integration point, with its output quantities.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InterfacePointState {
     /// Tangential plastic slip s_p \[m\] (history variable).
     pub plastic_slip: f64,

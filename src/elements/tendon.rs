@@ -81,7 +81,7 @@ impl fmt::Debug for TendonLaw {
 }
 
 /// History of the steel law at one span.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct LawState {
     /// Plastic strain ε_p \[-\].
     pub plastic_strain: f64,
@@ -173,7 +173,7 @@ pub enum TendonError {
 }
 
 /// State of one span.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SpanState {
     /// Total mechanical strain ε \[-\] (includes the prestrain).
     pub strain: f64,
@@ -188,7 +188,7 @@ pub struct SpanState {
 }
 
 /// Committed or trial state of an external tendon.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TendonState {
     /// One entry per span (P_i → P_{i+1}).
     pub spans: Vec<SpanState>,

@@ -392,7 +392,7 @@ fn gauss_solve(a: &mut [Vec<f64>], b: &mut [f64]) -> Option<Vec<f64>> {
 /// Hidden state of a chain at one Gauss point: the stress of every unit, plane-stress Voigt
 /// (σx, σy, τxy) \[Pa\]. The total stress is the sum over units. An empty vector means a
 /// virgin (stress-free) point.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct ChainState {
     /// Unit stresses σ_μ \[Pa\], one 3-vector per unit.
     pub hidden: Vec<[f64; 3]>,
@@ -602,7 +602,7 @@ pub fn chain_step(
 /// two units per decade, τ = 10^(k/2) × 1e-3 d up to 1e5 d, plus a spring, and fits the loss
 /// with relative weights on 1e-3 … 2e4 d (≈ 1.4 min … 5·10⁵ h) under the constraint
 /// R(0) = E_p.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SteelRelaxationChain {
     /// Elastic modulus E_p \[Pa\].
     pub ep: f64,

@@ -85,7 +85,7 @@ impl Material {
 }
 
 /// State of one integration point; committed and trial copies are kept by the caller.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum PointState {
     /// Linear elastic materials keep no state.
     Elastic,
@@ -149,7 +149,7 @@ impl PointState {
 /// The time interval of the current increment on the analysis clock [days]. A load step is
 /// an instantaneous increment (`t_from == t_to`) at the current time; a time step advances
 /// the clock. Concrete ages follow as time − cast_day of the material.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, serde::Deserialize)]
 pub struct TimeContext {
     /// Analysis time at the start of the increment [d].
     pub t_from: f64,

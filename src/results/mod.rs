@@ -1,6 +1,7 @@
 //! Results: monitors recorded at converged increments, field recovery, and writers.
 
 pub mod atomic;
+pub mod checkpoint;
 pub mod fields;
 pub mod joints;
 pub mod recorder;

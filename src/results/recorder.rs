@@ -11,7 +11,7 @@ use crate::model::{Model, MonitorKind};
 use std::path::PathBuf;
 
 /// One row of the history: step, increment, iterations, load factors, monitor values.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Row {
     /// Step index (0-based).
     pub step: usize,
@@ -31,6 +31,17 @@ pub struct Row {
     pub arc_length_factor: f64,
     /// Force of the displacement control [N] (NaN outside displacement steps).
     pub control_force: f64,
+}
+
+/// The recorder's state saved in a checkpoint.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RecorderState {
+    /// History rows so far.
+    pub rows: Vec<Row>,
+    /// Entries of results.pvd: (time, part, file name).
+    pub pvd: Vec<(f64, usize, String)>,
+    /// Displacements at the end of the steps some monitor measures from (step, u) [m].
+    pub step_end_u: Vec<(usize, Vec<f64>)>,
 }
 
 /// Records history and writes outputs into a directory.
@@ -58,6 +69,28 @@ impl<'m> Recorder<'m> {
             step_end_u: Default::default(),
             write_fields,
         })
+    }
+
+    /// What a restart needs to continue the history and the .pvd collection.
+    pub fn state(&self) -> RecorderState {
+        let mut step_end_u: Vec<(usize, Vec<f64>)> = self
+            .step_end_u
+            .iter()
+            .map(|(k, v)| (*k, v.clone()))
+            .collect();
+        step_end_u.sort_by_key(|x| x.0);
+        RecorderState {
+            rows: self.rows.clone(),
+            pvd: self.pvd.clone(),
+            step_end_u,
+        }
+    }
+
+    /// Continue from a saved state (rows and field files recorded before a restart).
+    pub fn restore(&mut self, s: RecorderState) {
+        self.rows = s.rows;
+        self.pvd = s.pvd;
+        self.step_end_u = s.step_end_u.into_iter().collect();
     }
 
     /// The CSV text of the history (header with units).

@@ -1,0 +1,131 @@
+//! The checkpoint file of a run (`checkpoint.bin` in the output directory): the analysis
+//! state after the last finished step, rewritten atomically at every step end, from which
+//! `segfem run --restart DIR` continues.
+//!
+//! Encoding: postcard (serde, compact binary). Floats are stored as their 8 bytes, so a
+//! restored state is bit-identical to the saved one, NaN and infinities included (JSON
+//! would turn NaN into null and needs care to round-trip every double). A small header
+//! (magic text, format version, model file and its digest) is read first, so that an
+//! older or foreign file gives a clear message rather than a decoding error.
+
+use super::atomic::write_atomic;
+use super::recorder::RecorderState;
+use crate::analysis::failure::FailureReport;
+use crate::analysis::state::{DriverState, SystemState, SystemStateRef};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// File name of the checkpoint in the output directory.
+pub const FILE: &str = "checkpoint.bin";
+const MAGIC: &str = "segfem checkpoint";
+/// Format version; bumped whenever a saved structure changes.
+const VERSION: u32 = 1;
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    magic: String,
+    version: u32,
+    /// Model file the run read (absolute where it could be resolved).
+    model_file: String,
+    /// FNV-1a digest of the model file's bytes.
+    model_digest: u64,
+}
+
+#[derive(Serialize)]
+struct BodyRef<'a> {
+    driver: &'a DriverState,
+    failures: &'a [FailureReport],
+    recorder: &'a RecorderState,
+    system: SystemStateRef<'a>,
+}
+
+/// A checkpoint read back.
+#[derive(Deserialize)]
+pub struct Checkpoint {
+    /// The driver's state (next step, load factors, clock, counters).
+    pub driver: DriverState,
+    /// Steps that failed so far (continue on failure).
+    pub failures: Vec<FailureReport>,
+    /// History rows and field-file list so far.
+    pub recorder: RecorderState,
+    /// The committed analysis state.
+    pub system: SystemState,
+}
+
+/// What a checkpoint says about the model it belongs to.
+pub struct Origin {
+    /// Model file.
+    pub model_file: String,
+    /// Digest of its bytes when the run started.
+    pub model_digest: u64,
+}
+
+/// 64-bit FNV-1a digest of `bytes` (a change detector, not a cryptographic hash).
+pub fn digest(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Write the checkpoint into `dir` atomically.
+pub fn write(
+    dir: &Path,
+    origin: &Origin,
+    driver: &DriverState,
+    failures: &[FailureReport],
+    recorder: &RecorderState,
+    system: SystemStateRef,
+) -> std::io::Result<()> {
+    let header = Header {
+        magic: MAGIC.into(),
+        version: VERSION,
+        model_file: origin.model_file.clone(),
+        model_digest: origin.model_digest,
+    };
+    let mut bytes = postcard::to_stdvec(&header).map_err(std::io::Error::other)?;
+    let body = BodyRef {
+        driver,
+        failures,
+        recorder,
+        system,
+    };
+    bytes.extend(postcard::to_stdvec(&body).map_err(std::io::Error::other)?);
+    write_atomic(&dir.join(FILE), &bytes)
+}
+
+/// Read the checkpoint of `dir`. Errors are complete sentences naming the file.
+pub fn read(dir: &Path) -> Result<(Origin, Checkpoint), String> {
+    let path = dir.join(FILE);
+    let bytes = std::fs::read(&path).map_err(|e| {
+        format!(
+            "{}: cannot read the checkpoint ({e}); --restart needs the output directory of a run started by this version of segfem",
+            path.display()
+        )
+    })?;
+    let bad = |what: &str| format!("{}: not a segfem checkpoint ({what})", path.display());
+    let (header, rest) =
+        postcard::take_from_bytes::<Header>(&bytes).map_err(|_| bad("unreadable header"))?;
+    if header.magic != MAGIC {
+        return Err(bad("wrong magic text"));
+    }
+    if header.version != VERSION {
+        return Err(format!(
+            "{}: checkpoint format {} but this segfem reads format {VERSION}; rerun from the start",
+            path.display(),
+            header.version
+        ));
+    }
+    let cp: Checkpoint = postcard::from_bytes(rest).map_err(|e| {
+        format!(
+            "{}: the checkpoint is damaged ({e}); rerun from the start",
+            path.display()
+        )
+    })?;
+    Ok((
+        Origin {
+            model_file: header.model_file,
+            model_digest: header.model_digest,
+        },
+        cp,
+    ))
+}
