@@ -7,6 +7,10 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Large blocks on transparent huge pages (segfem::hugepages: fewer page faults).
+#[global_allocator]
+static ALLOC: segfem::hugepages::HugePageAlloc = segfem::hugepages::HugePageAlloc;
+
 /// Bundled examples: (name, description, model file text).
 const EXAMPLES: &[(&str, &str, &str)] = &[
     (
@@ -96,6 +100,10 @@ enum Command {
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 4])]
         refine: Vec<usize>,
+        /// Instead: time faer's bare Cholesky (AMD, and segfem's ordering) of this model
+        /// file's stiffness matrix, the baseline of the whole-process time; prints JSON.
+        #[arg(long)]
+        model: Option<PathBuf>,
     },
     /// Draw figures (PNG and SVG) of a finished run: curves, mesh, deformed shape, fields.
     Plot(PlotArgs),
@@ -173,7 +181,9 @@ fn main() -> ExitCode {
             element,
             case,
             refine,
+            model,
         } => match case.as_str() {
+            _ if model.is_some() => bench_bare(model.as_deref().expect("checked")),
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine),
             o => {
@@ -443,6 +453,19 @@ fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+fn bench_bare(path: &std::path::Path) -> ExitCode {
+    match segfem::bench::bare_factorisation(path) {
+        Ok(r) => {
+            println!("{}", serde_json::to_string(&r).expect("row serialises"));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
 }
 
 fn bench_seed(refine: Vec<usize>) -> ExitCode {

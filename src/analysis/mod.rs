@@ -1,6 +1,7 @@
 //! Analysis: steps, the Newton loop, and the linear-solver wrapper.
 
 pub mod loads;
+pub mod ordering;
 pub mod path;
 pub mod solver;
 pub mod steps;
