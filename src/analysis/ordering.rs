@@ -210,4 +210,55 @@ mod tests {
             }
         }
     }
+
+    /// The ordering solves a 9-point grid system correctly and fills no more than AMD does
+    /// (within 25 %): the reason to use it.
+    #[test]
+    fn factor_is_correct_and_as_sparse_as_amd() {
+        use crate::analysis::solver::{LowerPattern, SparseCholesky};
+        let m = 60;
+        let (ptr, adj, xy) = grid(m);
+        // One equation per node here (take the x dofs): the 9-point Laplacian shifted to be
+        // positive definite, lower triangle.
+        let n = m * m;
+        let mut col_ptr = vec![0];
+        let mut row_idx = vec![];
+        let mut vals = vec![];
+        for a in 0..n {
+            for &b in &adj[ptr[a]..ptr[a + 1]] {
+                let b = b as usize;
+                if b >= a {
+                    row_idx.push(b);
+                    vals.push(if b == a { 8.5 } else { -1.0 });
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let p = LowerPattern {
+            n,
+            col_ptr,
+            row_idx,
+        };
+        let eq: Vec<usize> = (0..n).flat_map(|a| [a, crate::fem::dofs::CONSTRAINED]).collect();
+        let order = nested_dissection(&ptr, &adj, &xy, &eq, n);
+        assert_eq!(order.len(), n);
+        let mut nd = SparseCholesky::with_ordering(&p, Some(&order)).unwrap();
+        let amd = SparseCholesky::with_ordering(&p, None).unwrap();
+        assert!(
+            (nd.stats.factor_nnz as f64) < 1.25 * amd.stats.factor_nnz as f64,
+            "nested dissection {} vs AMD {}",
+            nd.stats.factor_nnz,
+            amd.stats.factor_nnz
+        );
+        nd.factorize(&p, &vals).unwrap();
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let mut x = b.clone();
+        nd.solve_in_place(&mut x);
+        let mut ax = vec![0.0; n];
+        p.sym_mul(&vals, &x, &mut ax);
+        // Diagonally dominant (8.5 against 8 × 1): well conditioned, round-off only.
+        let err = ax.iter().zip(&b).map(|(a, c)| (a - c).abs()).fold(0.0, f64::max);
+        assert!(err < 1e-12, "residual {err}");
+    }
 }
+
