@@ -273,3 +273,60 @@ pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
         result: obs.0,
     })
 }
+
+/// faer's bare factorisation of a model's stiffness matrix: the baseline that the
+/// whole-process time of `segfem run` is measured against (docs/performance.md).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BareRow {
+    /// Free equations.
+    pub equations: usize,
+    /// faer's AMD ordering and symbolic analysis [s].
+    pub amd_symbolic_s: f64,
+    /// Numeric LLᵀ after AMD [s].
+    pub amd_numeric_s: f64,
+    /// Stored factor values after AMD.
+    pub amd_factor_nnz: usize,
+    /// segfem's ordering (nested dissection above its size threshold) and faer's symbolic
+    /// analysis with it [s].
+    pub own_symbolic_s: f64,
+    /// Numeric LLᵀ after segfem's ordering [s].
+    pub own_numeric_s: f64,
+    /// Stored factor values after segfem's ordering.
+    pub own_factor_nnz: usize,
+}
+
+/// Assemble the initial stiffness of the model in `path` and time faer's sequential
+/// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
+pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
+    use crate::analysis::solver::SparseCholesky;
+    use crate::analysis::system::System;
+    let model = crate::input::load(path).map_err(|e| e.to_string())?.model;
+    let mut sys = System::new(&model);
+    let u = vec![0.0; model.n_dofs()];
+    let k = sys
+        .assemble(&u, true)
+        .map_err(|(e, err)| format!("element {}: {err}", e + 1))?
+        .k_values
+        .expect("tangent requested");
+    let pattern = &sys.asm.pattern;
+    let time = |order: Option<&[usize]>, extra: f64| -> Result<(f64, f64, usize), String> {
+        let t = Instant::now();
+        let mut s = SparseCholesky::with_ordering(pattern, order).map_err(|e| e.to_string())?;
+        let sym = t.elapsed().as_secs_f64() + extra;
+        let t = Instant::now();
+        s.factorize(pattern, &k).map_err(|e| e.to_string())?;
+        Ok((sym, t.elapsed().as_secs_f64(), s.stats.factor_nnz))
+    };
+    let (amd_symbolic_s, amd_numeric_s, amd_factor_nnz) = time(None, 0.0)?;
+    let (own_symbolic_s, own_numeric_s, own_factor_nnz) =
+        time(sys.ordering.as_deref(), sys.ordering_s)?;
+    Ok(BareRow {
+        equations: pattern.n,
+        amd_symbolic_s,
+        amd_numeric_s,
+        amd_factor_nnz,
+        own_symbolic_s,
+        own_numeric_s,
+        own_factor_nnz,
+    })
+}

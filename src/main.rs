@@ -9,6 +9,10 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 use std::sync::Arc;
 
+/// Large blocks on transparent huge pages (segfem::hugepages: fewer page faults).
+#[global_allocator]
+static ALLOC: segfem::hugepages::HugePageAlloc = segfem::hugepages::HugePageAlloc;
+
 /// Bundled examples: (name, description, model file text).
 const EXAMPLES: &[(&str, &str, &str)] = &[
     (
@@ -114,6 +118,10 @@ enum Command {
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 4])]
         refine: Vec<usize>,
+        /// Instead: time faer's bare Cholesky (AMD, and segfem's ordering) of this model
+        /// file's stiffness matrix, the baseline of the whole-process time; prints JSON.
+        #[arg(long)]
+        model: Option<PathBuf>,
     },
     /// Draw figures (PNG and SVG) of a finished run: curves, mesh, deformed shape, fields.
     Plot(PlotArgs),
@@ -223,7 +231,9 @@ fn main() -> ExitCode {
             element,
             case,
             refine,
+            model,
         } => match case.as_str() {
+            _ if model.is_some() => bench_bare(model.as_deref().expect("checked")),
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine),
             o => {
@@ -519,6 +529,19 @@ fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+fn bench_bare(path: &std::path::Path) -> ExitCode {
+    match segfem::bench::bare_factorisation(path) {
+        Ok(r) => {
+            println!("{}", serde_json::to_string(&r).expect("row serialises"));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
 }
 
 fn bench_seed(refine: Vec<usize>) -> ExitCode {

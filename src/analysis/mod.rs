@@ -2,6 +2,7 @@
 
 pub mod failure;
 pub mod loads;
+pub mod ordering;
 pub mod path;
 pub mod solver;
 pub mod state;

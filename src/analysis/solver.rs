@@ -116,17 +116,58 @@ impl SparseCholesky {
         Self::with_threshold(pattern, SupernodalThreshold::AUTO)
     }
 
+    /// Symbolic analysis of `pattern` with the elimination order `order` (`order[k]`: the
+    /// equation eliminated k-th, e.g. from [`super::ordering::nested_dissection`]), or AMD
+    /// when `None`.
+    pub fn with_ordering(
+        pattern: &LowerPattern,
+        order: Option<&[usize]>,
+    ) -> Result<Self, SolverError> {
+        Self::build(pattern, SupernodalThreshold::AUTO, order)
+    }
+
     /// As [`SparseCholesky::new`], choosing simplicial or supernodal factorisation by
     /// `threshold` (faer's flop-ratio rule; AUTO in production, forced in tests).
     pub fn with_threshold(
         pattern: &LowerPattern,
         threshold: SupernodalThreshold,
     ) -> Result<Self, SolverError> {
+        Self::build(pattern, threshold, None)
+    }
+
+    fn build(
+        pattern: &LowerPattern,
+        threshold: SupernodalThreshold,
+        order: Option<&[usize]>,
+    ) -> Result<Self, SolverError> {
         let t = std::time::Instant::now();
+        let inverse: Vec<usize> = match order {
+            Some(fwd) => {
+                if fwd.len() != pattern.n {
+                    return Err(SolverError::Internal(format!(
+                        "ordering of {} equations for a matrix of order {}",
+                        fwd.len(),
+                        pattern.n
+                    )));
+                }
+                let mut inv = vec![0; fwd.len()];
+                for (k, &i) in fwd.iter().enumerate() {
+                    inv[i] = k;
+                }
+                inv
+            }
+            None => Vec::new(),
+        };
+        let ordering = match order {
+            Some(fwd) => SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(
+                fwd, &inverse, pattern.n,
+            )),
+            None => SymmetricOrdering::Amd,
+        };
         let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
-            SymmetricOrdering::Amd,
+            ordering,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: threshold,
                 ..Default::default()

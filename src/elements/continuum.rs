@@ -122,10 +122,45 @@ pub fn response_with_time(
     out: &mut [GaussOutput],
     time: &TimeContext,
 ) -> Result<(), UpdateError> {
+    response_at(
+        kind,
+        integration,
+        coords,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        Some(k),
+        trial,
+        out,
+        time,
+    )
+}
+
+/// As [`response_with_time`]; the tangent is formed only when `k` is given (a residual
+/// check or a stress recovery needs forces and stresses alone).
+#[allow(clippy::too_many_arguments)]
+pub fn response_at(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
+    mut k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);
-    k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
+    if let Some(k) = k.as_deref_mut() {
+        k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
+    }
     // Geometry of every Gauss point first: the element area (Σ w det J) gives the
     // characteristic length the material update may need.
     let pts = rule_points(kind, integration);
@@ -157,6 +192,12 @@ pub fn response_with_time(
             let (ax, ay) = (dn[a][0], dn[a][1]);
             f[2 * a] += w * (ax * sig[0] + ay * sig[2]);
             f[2 * a + 1] += w * (ay * sig[1] + ax * sig[2]);
+        }
+        let Some(k) = k.as_deref_mut() else {
+            continue;
+        };
+        for a in 0..n {
+            let (ax, ay) = (dn[a][0], dn[a][1]);
             // Rows of B_aᵀ D (2×3).
             let r0 = [
                 ax * d[0][0] + ay * d[2][0],
@@ -236,30 +277,60 @@ pub fn extrapolate_to_nodes(
     integration: Integration,
     gp_values: &[[f64; 3]],
 ) -> Vec<[f64; 3]> {
-    let pts = rule(kind, integration);
-    let order = if pts.len() == 4 { 2 } else { 3 };
-    let r = gauss(order);
-    let lag = |x: f64, i: usize| -> f64 {
-        let mut v = 1.0;
-        for (j, pj) in r.points.iter().enumerate() {
-            if j != i {
-                v *= (x - pj) / (r.points[i] - pj);
-            }
-        }
-        v
-    };
+    let w = extrapolation_weights(kind, integration);
     (0..kind.n_nodes())
         .map(|a| {
-            let [xi, eta] = crate::fem::shape::NODE_XI[a];
             let mut v = [0.0; 3];
             for (g, val) in gp_values.iter().enumerate() {
-                let (i, j) = (g % order, g / order);
-                let w = lag(xi, i) * lag(eta, j);
                 for c in 0..3 {
-                    v[c] += w * val[c];
+                    v[c] += w[a][g] * val[c];
                 }
             }
             v
         })
         .collect()
+}
+
+/// Weights of [`extrapolate_to_nodes`]: value at node a = Σ_g w\[a\]\[g\] · value at Gauss
+/// point g. Computed once per element kind and rule (the output loop must not redo it for
+/// every element).
+pub fn extrapolation_weights(
+    kind: QuadKind,
+    integration: Integration,
+) -> &'static [[f64; 9]; MAX_NODES] {
+    static TABLES: std::sync::OnceLock<Vec<[[f64; 9]; MAX_NODES]>> = std::sync::OnceLock::new();
+    const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];
+    let tables = TABLES.get_or_init(|| {
+        let mut t = Vec::new();
+        for kind in KINDS {
+            for integration in [Integration::Full, Integration::Reduced] {
+                let order = if rule_points(kind, integration).len() == 4 {
+                    2
+                } else {
+                    3
+                };
+                let r = gauss(order);
+                let lag = |x: f64, i: usize| -> f64 {
+                    let mut v = 1.0;
+                    for (j, pj) in r.points.iter().enumerate() {
+                        if j != i {
+                            v *= (x - pj) / (r.points[i] - pj);
+                        }
+                    }
+                    v
+                };
+                let mut w = [[0.0; 9]; MAX_NODES];
+                for a in 0..kind.n_nodes() {
+                    let [xi, eta] = crate::fem::shape::NODE_XI[a];
+                    for g in 0..order * order {
+                        w[a][g] = lag(xi, g % order) * lag(eta, g / order);
+                    }
+                }
+                t.push(w);
+            }
+        }
+        t
+    });
+    let k = KINDS.iter().position(|k| *k == kind).unwrap_or(0);
+    &tables[2 * k + usize::from(integration == Integration::Reduced)]
 }

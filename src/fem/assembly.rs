@@ -15,87 +15,181 @@ const SKIP: u32 = u32::MAX;
 pub struct Assembler {
     /// Lower-triangle pattern over the free equations.
     pub pattern: LowerPattern,
-    /// Per element, for each (a, b) of its dense matrix (row-major), the position in the value
-    /// array or SKIP.
-    scatter: Vec<Vec<u32>>,
+    /// Node graph (compressed rows): the neighbours of node a, itself included, sorted, are
+    /// `node_adj[node_ptr[a]..node_ptr[a + 1]]`. Kept for the fill-reducing ordering.
+    pub node_ptr: Vec<usize>,
+    /// See `node_ptr`.
+    pub node_adj: Vec<u32>,
+    /// For each (a, b) of every element's dense matrix (row-major, elements one after the
+    /// other), the position in the value array or SKIP.
+    scatter: Vec<u32>,
+    /// Start of each element's entries in `scatter` (length: elements + 1).
+    scatter_ptr: Vec<usize>,
 }
+
+/// Nodes per parallel chunk of the pattern build.
+const NODE_CHUNK: usize = 8192;
+/// Elements per parallel chunk of the scatter-map build.
+const ELEM_CHUNK: usize = 4096;
 
 impl Assembler {
     /// Build the pattern from node connectivities (each element couples all dofs of its
     /// nodes); `elem_nodes[e]` lists the nodes of element e.
     pub fn new(n_nodes: usize, elem_nodes: &[Vec<usize>], dofs: &DofMap) -> Self {
-        // Node adjacency (each node's neighbours incl. itself), sorted and unique.
-        let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n_nodes];
+        // Node → elements incidence (compressed rows), then each node's neighbours: the
+        // nodes of its elements, sorted and unique. Flat arrays built chunk-parallel: no
+        // allocation per node (a Vec per node cost more than the sorting at 1e6 dofs).
+        let mut inc_ptr = vec![0usize; n_nodes + 1];
         for nodes in elem_nodes {
             for &a in nodes {
-                for &b in nodes {
-                    adj[a].push(b as u32);
-                }
+                inc_ptr[a + 1] += 1;
             }
         }
-        adj.iter_mut().for_each(|v| {
-            v.sort_unstable();
-            v.dedup();
-        });
+        for a in 0..n_nodes {
+            inc_ptr[a + 1] += inc_ptr[a];
+        }
+        let mut fill = inc_ptr.clone();
+        let mut inc = vec![0u32; inc_ptr[n_nodes]];
+        for (e, nodes) in elem_nodes.iter().enumerate() {
+            for &a in nodes {
+                inc[fill[a]] = e as u32;
+                fill[a] += 1;
+            }
+        }
+        drop(fill);
+        let chunks: Vec<(Vec<u32>, Vec<usize>)> = (0..n_nodes.div_ceil(NODE_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (a0, a1) = (c * NODE_CHUNK, ((c + 1) * NODE_CHUNK).min(n_nodes));
+                let mut adj = Vec::with_capacity((a1 - a0) * 10);
+                let mut len = Vec::with_capacity(a1 - a0);
+                for a in a0..a1 {
+                    let s = adj.len();
+                    for &e in &inc[inc_ptr[a]..inc_ptr[a + 1]] {
+                        adj.extend(elem_nodes[e as usize].iter().map(|&b| b as u32));
+                    }
+                    let list = &mut adj[s..];
+                    list.sort_unstable();
+                    let mut k = 0;
+                    for i in 0..list.len() {
+                        if i == 0 || list[i] != list[k - 1] {
+                            list[k] = list[i];
+                            k += 1;
+                        }
+                    }
+                    adj.truncate(s + k);
+                    len.push(k);
+                }
+                (adj, len)
+            })
+            .collect();
+        drop(inc);
+        let mut node_ptr = Vec::with_capacity(n_nodes + 1);
+        node_ptr.push(0usize);
+        let mut node_adj = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
+        for (adj, len) in &chunks {
+            node_adj.extend_from_slice(adj);
+            for l in len {
+                node_ptr.push(node_ptr.last().copied().unwrap_or(0) + l);
+            }
+        }
+        drop(chunks);
         // Lower pattern over equations: column j = eq of (node a, dir), rows = eqs ≥ j among
         // the dofs of neighbours of a. Equations are numbered in node order, so sorting the
         // neighbour list sorts the rows.
         let n = dofs.n_eq;
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0usize);
-        let mut row_idx = Vec::new();
-        let mut col_of_dof = vec![usize::MAX; 2 * n_nodes];
-        for a in 0..n_nodes {
-            for da in 0..2 {
-                let j = dofs.eq[2 * a + da];
-                if j == CONSTRAINED {
-                    continue;
-                }
-                col_of_dof[2 * a + da] = j;
-                for &b in &adj[a] {
-                    for db in 0..2 {
-                        let i = dofs.eq[2 * b as usize + db];
-                        if i != CONSTRAINED && i >= j {
-                            row_idx.push(i);
+        let cols: Vec<(Vec<usize>, Vec<usize>)> = (0..n_nodes.div_ceil(NODE_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (a0, a1) = (c * NODE_CHUNK, ((c + 1) * NODE_CHUNK).min(n_nodes));
+                let mut rows = Vec::with_capacity((a1 - a0) * 20);
+                let mut len = Vec::with_capacity(2 * (a1 - a0));
+                for a in a0..a1 {
+                    for da in 0..2 {
+                        let j = dofs.eq[2 * a + da];
+                        if j == CONSTRAINED {
+                            continue;
                         }
+                        let s = rows.len();
+                        for &b in &node_adj[node_ptr[a]..node_ptr[a + 1]] {
+                            for db in 0..2 {
+                                let i = dofs.eq[2 * b as usize + db];
+                                if i != CONSTRAINED && i >= j {
+                                    rows.push(i);
+                                }
+                            }
+                        }
+                        len.push(rows.len() - s);
                     }
                 }
-                col_ptr.push(row_idx.len());
+                (rows, len)
+            })
+            .collect();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0usize);
+        let mut row_idx = Vec::with_capacity(cols.iter().map(|c| c.0.len()).sum());
+        for (rows, len) in &cols {
+            row_idx.extend_from_slice(rows);
+            for l in len {
+                col_ptr.push(col_ptr.last().copied().unwrap_or(0) + l);
             }
         }
+        drop(cols);
         let pattern = LowerPattern {
             n,
             col_ptr,
             row_idx,
         };
-        let scatter = elem_nodes
-            .par_iter()
-            .map(|nodes| {
-                let eqs: Vec<usize> = nodes
-                    .iter()
-                    .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]])
-                    .collect();
-                let mut s = Vec::with_capacity(eqs.len() * eqs.len());
-                for &i in &eqs {
-                    for &j in &eqs {
-                        let p = if i == CONSTRAINED || j == CONSTRAINED || i < j {
-                            SKIP
-                        } else {
-                            pattern.position(i, j).expect("pattern covers element") as u32
-                        };
-                        s.push(p);
+        let mut scatter_ptr = Vec::with_capacity(elem_nodes.len() + 1);
+        scatter_ptr.push(0usize);
+        for nodes in elem_nodes {
+            let nd = 2 * nodes.len();
+            scatter_ptr.push(scatter_ptr.last().copied().unwrap_or(0) + nd * nd);
+        }
+        let parts: Vec<Vec<u32>> = elem_nodes
+            .par_chunks(ELEM_CHUNK)
+            .map(|chunk| {
+                let mut s = Vec::new();
+                let mut eqs = Vec::new();
+                for nodes in chunk {
+                    eqs.clear();
+                    eqs.extend(
+                        nodes
+                            .iter()
+                            .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]]),
+                    );
+                    for &i in &eqs {
+                        for &j in &eqs {
+                            let p = if i == CONSTRAINED || j == CONSTRAINED || i < j {
+                                SKIP
+                            } else {
+                                pattern.position(i, j).expect("pattern covers element") as u32
+                            };
+                            s.push(p);
+                        }
                     }
                 }
                 s
             })
             .collect();
-        Self { pattern, scatter }
+        let mut scatter = Vec::with_capacity(scatter_ptr.last().copied().unwrap_or(0));
+        for p in &parts {
+            scatter.extend_from_slice(p);
+        }
+        Self {
+            pattern,
+            node_ptr,
+            node_adj,
+            scatter,
+            scatter_ptr,
+        }
     }
 
     /// Add the dense row-major element matrix `k` of element `e` into `values`.
     #[inline]
     pub fn add_matrix(&self, e: usize, k: &[f64], values: &mut [f64]) {
-        for (p, v) in self.scatter[e].iter().zip(k) {
+        let s = &self.scatter[self.scatter_ptr[e]..self.scatter_ptr[e + 1]];
+        for (p, v) in s.iter().zip(k) {
             if *p != SKIP {
                 values[*p as usize] += v;
             }

@@ -2,7 +2,9 @@
 //! averaged, cell averages, principal stresses.
 
 use crate::analysis::system::System;
-use crate::elements::continuum::extrapolate_to_nodes;
+use crate::elements::continuum::extrapolation_weights;
+use crate::fem::shape::MAX_NODES;
+use rayon::prelude::*;
 
 /// Nodal and cell fields of one converged state.
 pub struct Fields {
@@ -23,36 +25,48 @@ pub fn principal(s: &[f64; 3]) -> (f64, f64) {
     (c + r, c - r)
 }
 
-/// Recover the fields from the committed Gauss outputs of a system.
+/// Recover the fields from the committed Gauss outputs of a system. Element values are
+/// computed in parallel; the nodal sums run in element order (results do not depend on the
+/// thread count).
 pub fn recover(sys: &System) -> Fields {
     let model = sys.model;
     let nn = model.nodes.len();
+    type Cell = ([f64; 3], [f64; 3], [[[f64; 3]; 2]; MAX_NODES]);
+    let per_element: Vec<Cell> = model
+        .elements
+        .par_iter()
+        .enumerate()
+        .map(|(e, el)| {
+            let g = &sys.gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+            let len = g.len() as f64;
+            let (mut cs, mut ce) = ([0.0; 3], [0.0; 3]);
+            for o in g {
+                for c in 0..3 {
+                    cs[c] += o.stress[c] / len;
+                    ce[c] += o.strain[c] / len;
+                }
+            }
+            let w = extrapolation_weights(el.kind, el.integration);
+            let mut x = [[[0.0; 3]; 2]; MAX_NODES];
+            for a in 0..el.nodes.len() {
+                for (k, o) in g.iter().enumerate() {
+                    for c in 0..3 {
+                        x[a][0][c] += w[a][k] * o.stress[c];
+                        x[a][1][c] += w[a][k] * o.strain[c];
+                    }
+                }
+            }
+            (cs, ce, x)
+        })
+        .collect();
     let mut ns = vec![[0.0; 3]; nn];
     let mut ne = vec![[0.0; 3]; nn];
     let mut count = vec![0u32; nn];
-    let mut cs = Vec::with_capacity(model.elements.len());
-    let mut ce = Vec::with_capacity(model.elements.len());
-    for (e, el) in model.elements.iter().enumerate() {
-        let g = &sys.gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]];
-        let s: Vec<[f64; 3]> = g.iter().map(|o| o.stress).collect();
-        let t: Vec<[f64; 3]> = g.iter().map(|o| o.strain).collect();
-        let avg = |v: &[[f64; 3]]| {
-            let mut a = [0.0; 3];
-            for x in v {
-                for c in 0..3 {
-                    a[c] += x[c] / v.len() as f64;
-                }
-            }
-            a
-        };
-        cs.push(avg(&s));
-        ce.push(avg(&t));
-        let xs = extrapolate_to_nodes(el.kind, el.integration, &s);
-        let xe = extrapolate_to_nodes(el.kind, el.integration, &t);
+    for (el, (_, _, x)) in model.elements.iter().zip(&per_element) {
         for (a, &n) in el.nodes.iter().enumerate() {
             for c in 0..3 {
-                ns[n][c] += xs[a][c];
-                ne[n][c] += xe[a][c];
+                ns[n][c] += x[a][0][c];
+                ne[n][c] += x[a][1][c];
             }
             count[n] += 1;
         }
@@ -68,7 +82,7 @@ pub fn recover(sys: &System) -> Fields {
     Fields {
         node_stress: ns,
         node_strain: ne,
-        cell_stress: cs,
-        cell_strain: ce,
+        cell_stress: per_element.iter().map(|c| c.0).collect(),
+        cell_strain: per_element.iter().map(|c| c.1).collect(),
     }
 }
