@@ -629,6 +629,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 "must be at least 1 (and exactly 1 for a linear step)",
             ));
         }
+        if increments > limits::MAX_INCREMENTS {
+            let k = if time.is_some() {
+                "substeps"
+            } else {
+                "increments"
+            };
+            return Err(ctx.err(
+                format!("{key}.{k}"),
+                format!(
+                    "{increments} is above the limit of {} per step (a typing error?)",
+                    limits::MAX_INCREMENTS
+                ),
+            ));
+        }
         let output_every_increment = match s.output.as_deref() {
             None | Some("end") => false,
             Some("increments") => true,
@@ -695,9 +709,25 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             c.energy_tolerance = positive(ctx, "solver.energy_tolerance", v)?;
         }
         if let Some(v) = sv.max_iterations {
+            if v > limits::MAX_ITERATIONS {
+                return Err(ctx.err(
+                    "solver.max_iterations",
+                    format!("{v} is above the limit of {}", limits::MAX_ITERATIONS),
+                ));
+            }
             c.max_iterations = v.max(1);
         }
         if let Some(v) = sv.max_cuts {
+            if v > limits::MAX_CUTS {
+                return Err(ctx.err(
+                    "solver.max_cuts",
+                    format!(
+                        "{v} is above the limit of {} (2^-{} of an increment is below double precision)",
+                        limits::MAX_CUTS,
+                        limits::MAX_CUTS
+                    ),
+                ));
+            }
             c.max_cuts = v;
         }
     }
@@ -1184,6 +1214,15 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
 /// Degenerate elements of a generated mesh: tiny lengths or depths next to large ones give
 /// zero-length edges.
 fn check_generated(ctx: &Ctx, nodes: &[[f64; 2]], elements: &[(Vec<usize>, usize)]) -> R<()> {
+    if let Some(p) = nodes
+        .iter()
+        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(ctx.err(
+            "mesh",
+            format!("generated node coordinates overflow ({p:?}): the lengths, depths or origin are too large (metres)"),
+        ));
+    }
     let size = limits::extent(nodes);
     for (i, (conn, _)) in elements.iter().enumerate() {
         let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();

@@ -14,6 +14,16 @@ use super::error::{Ctx, InputError};
 /// keeps the answer the same on every machine.
 pub const MAX_DOFS: f64 = 1e7;
 
+/// Largest number of increments (or time substeps) of one step [-]: far above any real use
+/// (the seed beam needs 50), low enough that a typing error does not run for days.
+pub const MAX_INCREMENTS: usize = 100_000;
+
+/// Largest `solver.max_iterations` [-].
+pub const MAX_ITERATIONS: usize = 10_000;
+
+/// Largest `solver.max_cuts` [-]: 2^-52 of an increment is below double precision.
+pub const MAX_CUTS: usize = 52;
+
 /// Estimated peak memory per degree of freedom of a run [bytes].
 pub const BYTES_PER_DOF: f64 = 2800.0;
 
@@ -137,7 +147,7 @@ pub fn degenerate(coords: &[[f64; 2]], ids: &[u64], size: f64) -> Option<String>
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         if len.is_nan() || len <= tol {
             return Some(format!(
-                "the edge from node {} to node {} has zero length ({len:.3e} m in a model {size:.3e} m across)",
+                "the edge from node {} to node {} has (nearly) zero length: {len:.3e} m in a model {size:.3e} m across",
                 ids[k],
                 ids[(k + 1) % 4]
             ));
