@@ -273,6 +273,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             used[n] = true;
         }
     }
+    let mut tied = vec![false; model.nodes.len()];
+    for i in &model.interfaces {
+        i.nodes.iter().for_each(|&n| tied[n] = true);
+    }
+    let size = locate::model_size(&model);
+    if let (k, Some((a, b))) = limits::loose_coincident(&model.nodes, &used, &tied, size) {
+        warnings.push(format!(
+            "{}: mesh: nodes {} and {} coincide at {:?} but no element or joint connects them ({k} such pair(s)): the parts of the mesh there are not connected; a joint missing from [[mesh.joints]]?",
+            ctx.file,
+            a + 1,
+            b + 1,
+            model.nodes[a]
+        ));
+    }
     let unused = used.iter().filter(|u| !**u).count();
     if unused > 0 {
         warnings.push(format!(

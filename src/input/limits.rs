@@ -191,3 +191,79 @@ mod geometry_tests {
         assert!(degenerate(&nan, &ids, 10.0).is_some());
     }
 }
+
+/// Pairs of used nodes that coincide (within 1e-9 of the model size `size` [m]) without an
+/// interface between them: two parts of the mesh touching there are not connected, which is
+/// what a joint missing from the model (a joint face with no opposite face) looks like.
+/// `tied[n]` is true for nodes of an interface element. Returns the number of such pairs and
+/// the first one (0-based nodes). Hashing on a grid of the tolerance keeps it O(n).
+pub fn loose_coincident(
+    nodes: &[[f64; 2]],
+    used: &[bool],
+    tied: &[bool],
+    size: f64,
+) -> (usize, Option<(usize, usize)>) {
+    use std::collections::HashMap;
+    let tol = 1e-9 * size;
+    if !(tol > 0.0 && tol.is_finite()) {
+        return (0, None);
+    }
+    let cell = |p: [f64; 2]| ((p[0] / tol).floor() as i64, (p[1] / tol).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    let (mut count, mut first) = (0, None);
+    for (n, p) in nodes.iter().enumerate() {
+        if !used[n] {
+            continue;
+        }
+        let (cx, cy) = cell(*p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &m in grid
+                    .get(&(cx + dx, cy + dy))
+                    .map(Vec::as_slice)
+                    .unwrap_or(&[])
+                {
+                    let q = nodes[m];
+                    if (p[0] - q[0]).hypot(p[1] - q[1]) <= tol && !(tied[n] && tied[m]) {
+                        count += 1;
+                        first.get_or_insert((m, n));
+                    }
+                }
+            }
+        }
+        grid.entry((cx, cy)).or_default().push(n);
+    }
+    (count, first)
+}
+
+#[cfg(test)]
+mod coincident_tests {
+    use super::*;
+
+    /// Two unit squares side by side with separate nodes on the shared edge: two loose pairs,
+    /// none when those nodes are tied by an interface; distinct nodes give none.
+    #[test]
+    fn loose_pairs_found() {
+        let nodes = [
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [1.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+        ];
+        let used = [true; 8];
+        let mut tied = [false; 8];
+        assert_eq!(
+            loose_coincident(&nodes, &used, &tied, 2.2),
+            (2, Some((1, 4)))
+        );
+        for n in [1, 2, 4, 7] {
+            tied[n] = true;
+        }
+        assert_eq!(loose_coincident(&nodes, &used, &tied, 2.2), (0, None));
+        assert_eq!(loose_coincident(&nodes[..4], &used, &tied, 2.2), (0, None));
+    }
+}
