@@ -377,7 +377,7 @@ fn degenerate_element_all_nodes_collinear() {
     rejects(
         &model,
         "mesh.blocks[0].elements[1]",
-        &["inverted or degenerate"],
+        &["zero area", "nodes 1, 2, 3, 7", "collinear"],
     );
 }
 

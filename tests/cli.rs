@@ -893,3 +893,35 @@ fn every_schema_key_is_documented() {
         "keys missing from docs/input.md: {missing:?}"
     );
 }
+
+/// A unit that looks wrong (thickness in cm) is a warning: printed by `check` and `run` on
+/// standard error, listed in summary.json, and the run completes.
+#[test]
+fn unit_warning_reaches_stderr_and_summary() {
+    let tmp = TempDir::new("unitwarn");
+    assert_eq!(
+        code(&segfem(
+            tmp.path(),
+            &["example", "cantilever", "-o", "c.toml"]
+        )),
+        0
+    );
+    let text = read(&tmp.join("c.toml"));
+    assert_eq!(text.matches("thickness = 0.1\n").count(), 1);
+    std::fs::write(
+        tmp.join("c.toml"),
+        text.replace("thickness = 0.1\n", "thickness = 10.0\n"),
+    )
+    .unwrap();
+    let want = "warning: c.toml: regions[0].thickness: thickness 10 m is outside 0.001–5 m; segfem works in metres (0.3 m, not 30 cm)";
+    let o = segfem(tmp.path(), &["check", "c.toml"]);
+    assert_eq!(code(&o), 0);
+    assert_eq!(stderr(&o).trim_end(), want);
+    let o = segfem(tmp.path(), &["run", "c.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert_eq!(stderr(&o).trim_end(), want);
+    let s: serde_json::Value = serde_json::from_str(&read(&tmp.join("out/summary.json"))).unwrap();
+    let w = s["warnings"].as_array().unwrap();
+    assert_eq!(w.len(), 1);
+    assert_eq!(format!("warning: {}", w[0].as_str().unwrap()), want);
+}

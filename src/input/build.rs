@@ -3,8 +3,10 @@
 
 use super::error::{Ctx, InputError};
 use super::gmsh_mesh;
+use super::limits;
 use super::locate;
 use super::schema::*;
+use super::units;
 use crate::elements::bar::{BarEmbedder, BarPath, EmbedOptions, HostElement};
 use crate::elements::continuum::{min_jacobian, Integration};
 use crate::elements::interface::{
@@ -136,13 +138,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 check_material_keys(ctx, i, m, &["E", "nu", "density"])?;
                 let e = positive(ctx, &k("E"), m.e.ok_or_else(|| ctx.err(k("E"), "missing"))?)?;
                 let (nu, density) = poisson_and_density(ctx, i, m)?;
-                if e < 1e6 {
-                    warnings.push(format!(
-                        "{}: {}: E = {e} Pa looks like MPa or GPa; segfem works in Pa",
-                        ctx.file,
-                        k("E")
-                    ));
-                }
+                units::modulus(&mut warnings, ctx, &k("E"), e);
                 if density > 0.0 && !(100.0..=20000.0).contains(&density) {
                     warnings.push(format!(
                         "{}: {}: density {density} kg/m³ is unusual; segfem works in kg/m³",
@@ -155,7 +151,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             "elastic_creep" => creep_material(ctx, i, m, &mut warnings)?,
             "concrete" => concrete_law(ctx, i, m, &mut warnings)?,
             "rebar" | "prestressing_steel" => {
-                steels.push((m.name.clone(), steel_law(ctx, i, m)?));
+                steels.push((m.name.clone(), steel_law(ctx, i, m, &mut warnings)?));
                 continue;
             }
             other => {
@@ -191,12 +187,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             &r.material,
         )?;
         let thickness = positive(ctx, &format!("regions[{i}].thickness"), r.thickness)?;
-        if thickness > 20.0 {
-            warnings.push(format!(
-                "{}: regions[{i}].thickness: {thickness} m is very large; thickness is in metres",
-                ctx.file
-            ));
-        }
+        units::thickness(
+            &mut warnings,
+            ctx,
+            &format!("regions[{i}].thickness"),
+            thickness,
+        );
         regions.push(Region {
             name: r.name.clone(),
             material,
@@ -213,6 +209,13 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     let mut joint_materials = Vec::new();
     for (i, j) in file.joint_materials.iter().enumerate() {
         joint_materials.push(joint_material(ctx, i, j)?);
+        for (name, v) in [
+            ("tensile_strength", j.tensile_strength),
+            ("cohesion", j.cohesion),
+        ] {
+            let key = format!("joint_materials[{i}].{name}");
+            units::strength(&mut warnings, ctx, &key, v.unwrap_or(0.0));
+        }
     }
     // Mesh.
     let mesh = file
@@ -261,6 +264,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         controls: SolverControls::default(),
         bars: Vec::new(),
     };
+    units::model_size(&mut warnings, ctx, locate::model_size(&model));
     if !joints.is_empty() {
         add_joints(ctx, mesh, &mut model, &joints, &joint_materials)?;
     }
@@ -269,6 +273,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         for &n in &e.nodes {
             used[n] = true;
         }
+    }
+    let mut tied = vec![false; model.nodes.len()];
+    for i in &model.interfaces {
+        i.nodes.iter().for_each(|&n| tied[n] = true);
+    }
+    let size = locate::model_size(&model);
+    if let (k, Some((a, b))) = limits::loose_coincident(&model.nodes, &used, &tied, size) {
+        warnings.push(format!(
+            "{}: mesh: nodes {} and {} coincide at {:?} but no element or joint connects them ({k} such pair(s)): the parts of the mesh there are not connected; a joint missing from [[mesh.joints]]?",
+            ctx.file,
+            a + 1,
+            b + 1,
+            model.nodes[a]
+        ));
     }
     let unused = used.iter().filter(|u| !**u).count();
     if unused > 0 {
@@ -651,6 +669,20 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 "must be at least 1 (and exactly 1 for a linear step)",
             ));
         }
+        if increments > limits::MAX_INCREMENTS {
+            let k = if time.is_some() {
+                "substeps"
+            } else {
+                "increments"
+            };
+            return Err(ctx.err(
+                format!("{key}.{k}"),
+                format!(
+                    "{increments} is above the limit of {} per step (a typing error?)",
+                    limits::MAX_INCREMENTS
+                ),
+            ));
+        }
         let output_every_increment = match s.output.as_deref() {
             None | Some("end") => false,
             Some("increments") => true,
@@ -747,9 +779,25 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             c.energy_tolerance = positive(ctx, "solver.energy_tolerance", v)?;
         }
         if let Some(v) = sv.max_iterations {
+            if v > limits::MAX_ITERATIONS {
+                return Err(ctx.err(
+                    "solver.max_iterations",
+                    format!("{v} is above the limit of {}", limits::MAX_ITERATIONS),
+                ));
+            }
             c.max_iterations = v.max(1);
         }
         if let Some(v) = sv.max_cuts {
+            if v > limits::MAX_CUTS {
+                return Err(ctx.err(
+                    "solver.max_cuts",
+                    format!(
+                        "{v} is above the limit of {} (2^-{} of an increment is below double precision)",
+                        limits::MAX_CUTS,
+                        limits::MAX_CUTS
+                    ),
+                ));
+            }
             c.max_cuts = v;
         }
     }
@@ -791,7 +839,16 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
             }
             let bands = bands_of(mesh, ctx, region_names)?;
             let origin = origin_of(mesh, ctx)?;
+            let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
+            limits::check_size(
+                ctx,
+                "mesh.nx",
+                limits::grid_nodes(kind, nx as f64, ny),
+                nx as f64 * ny,
+                limits::available_memory(),
+            )?;
             let g = banded::generate(origin, length, nx, &bands, kind);
+            check_generated(ctx, &g.nodes, &g.elements)?;
             let elements = g
                 .elements
                 .into_iter()
@@ -838,6 +895,16 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                 }
             }
             let nn = mesh.nodes.len();
+            let n_el: usize = mesh.blocks.iter().map(|b| b.elements.len()).sum();
+            limits::check_size(
+                ctx,
+                "mesh.nodes",
+                nn as f64,
+                n_el as f64,
+                limits::available_memory(),
+            )?;
+            let size = limits::extent(&mesh.nodes);
+            let ids_of = |c: &[i64]| c.iter().map(|&i| i as u64).collect::<Vec<u64>>();
             let mut elements = Vec::new();
             for (b, blk) in mesh.blocks.iter().enumerate() {
                 let region = index_by_name(
@@ -880,6 +947,9 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                         nodes.push(n);
                     }
                     let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.nodes[n]).collect();
+                    if let Some(m) = limits::degenerate(&coords, &ids_of(conn), size) {
+                        return Err(ctx.err(&key, m));
+                    }
                     let detj = min_jacobian(kind, &coords, integ);
                     if detj.is_nan() || detj <= 0.0 {
                         return Err(ctx.err(
@@ -1176,6 +1246,15 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
     let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
     let bands = bands_of(mesh, ctx, region_names)?;
     let origin = origin_of(mesh, ctx)?;
+    let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
+    let n_seg = lengths.len() as f64;
+    limits::check_size(
+        ctx,
+        "mesh.nx_per_segment",
+        n_seg * limits::grid_nodes(kind, nx as f64, ny),
+        n_seg * nx as f64 * ny,
+        limits::available_memory(),
+    )?;
     let g = segmental::generate_segments(
         origin[0],
         origin[1],
@@ -1187,7 +1266,12 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
     let elements = g
         .elements
         .into_iter()
-        .map(|(nodes, region, _segment)| Element {
+        .map(|(nodes, region, _segment)| (nodes, region))
+        .collect::<Vec<_>>();
+    check_generated(ctx, &g.nodes, &elements)?;
+    let elements = elements
+        .into_iter()
+        .map(|(nodes, region)| Element {
             kind,
             nodes,
             region,
@@ -1195,6 +1279,35 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         })
         .collect();
     Ok((g.nodes, elements, g.joints))
+}
+
+/// Degenerate elements of a generated mesh: tiny lengths or depths next to large ones give
+/// zero-length edges.
+fn check_generated(ctx: &Ctx, nodes: &[[f64; 2]], elements: &[(Vec<usize>, usize)]) -> R<()> {
+    if let Some(p) = nodes
+        .iter()
+        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(ctx.err(
+            "mesh",
+            format!("generated node coordinates overflow ({p:?}): the lengths, depths or origin are too large (metres)"),
+        ));
+    }
+    let size = limits::extent(nodes);
+    for (i, (conn, _)) in elements.iter().enumerate() {
+        let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();
+        let ids: Vec<u64> = conn.iter().map(|&n| n as u64 + 1).collect();
+        if let Some(m) = limits::degenerate(&c, &ids, size) {
+            return Err(ctx.err(
+                "mesh",
+                format!(
+                    "generated element {}: {m}; check the lengths, depths and divisions",
+                    i + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn bands_of<'a, I: Iterator<Item = &'a str> + Clone>(
@@ -1421,13 +1534,8 @@ fn build_tendon(
     let area = positive(ctx, &k("area"), t.area)?;
     let ep = positive(ctx, &k("Ep"), t.ep)?;
     let fptk = positive(ctx, &k("fptk"), t.fptk)?;
-    if ep < 1e9 {
-        warnings.push(format!(
-            "{}: {}: Ep = {ep} Pa looks like MPa or GPa; segfem works in Pa",
-            ctx.file,
-            k("Ep")
-        ));
-    }
+    units::modulus(warnings, ctx, &k("Ep"), ep);
+    units::strength(warnings, ctx, &k("fptk"), fptk);
     let size = locate::model_size(model);
     let mut nodes = Vec::new();
     for (j, p) in t.points.iter().enumerate() {
@@ -1735,6 +1843,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
     let mut p = ConcreteParams::from_mc90_with(fcm, nu, c, tref);
     if let Some(ftm) = m.ftm {
         p.ftm = positive(ctx, &k("ftm"), ftm)?;
+        units::strength(warnings, ctx, &k("ftm"), ftm);
         if ftm >= 0.5 * fcm {
             return Err(ctx.err(k("ftm"), "must be well below fcm (ftm/fcm < 0.5)"));
         }
@@ -1742,6 +1851,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
     }
     if let Some(e) = m.e {
         p.ec = positive(ctx, &k("E"), e)?;
+        units::modulus(warnings, ctx, &k("E"), e);
     }
     if let Some(v) = m.eps_c1 {
         p.eps_c1 = positive(ctx, &k("eps_c1"), v)?;
@@ -1824,7 +1934,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
 }
 
 /// `kind = "rebar"` or `"prestressing_steel"`: the uniaxial law of embedded bars.
-fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<SteelParams> {
+fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>) -> R<SteelParams> {
     let k = |f: &str| format!("materials[{i}].{f}");
     let need = |v: Option<f64>, f: &str| -> R<f64> {
         positive(ctx, &k(f), v.ok_or_else(|| ctx.err(k(f), "missing"))?)
@@ -1833,6 +1943,8 @@ fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<SteelParams> {
         check_material_keys(ctx, i, m, &["E", "fy", "Et"])?;
         let e = need(m.e, "E")?;
         let fy = need(m.fy, "fy")?;
+        units::modulus(warnings, ctx, &k("E"), e);
+        units::strength(warnings, ctx, &k("fy"), fy);
         if fy >= e {
             return Err(ctx.err(k("fy"), "must be far below E (units are Pa)"));
         }
@@ -1847,6 +1959,8 @@ fn steel_law(ctx: &Ctx, i: usize, m: &MaterialIn) -> R<SteelParams> {
         check_material_keys(ctx, i, m, &["Ep", "fptk", "eps_uk"])?;
         let ep = need(m.ep, "Ep")?;
         let fptk = need(m.fptk, "fptk")?;
+        units::modulus(warnings, ctx, &k("Ep"), ep);
+        units::strength(warnings, ctx, &k("fptk"), fptk);
         if fptk >= ep {
             return Err(ctx.err(k("fptk"), "must be far below Ep (units are Pa)"));
         }

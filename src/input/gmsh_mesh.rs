@@ -3,6 +3,7 @@
 //! and line loads.
 
 use super::error::{Ctx, InputError};
+use super::limits::{available_memory, check_size, degenerate, extent};
 use super::schema::MeshIn;
 use crate::elements::continuum::{min_jacobian, Integration};
 use crate::fem::shape::QuadKind;
@@ -103,6 +104,14 @@ fn map(
 ) -> R<GmshBuilt> {
     let index = g.node_index();
     let nodes: Vec<[f64; 2]> = g.nodes.iter().map(|(_, x)| *x).collect();
+    check_size(
+        ctx,
+        "mesh.file",
+        nodes.len() as f64,
+        g.elements.len() as f64,
+        available_memory(),
+    )?;
+    let size = extent(&nodes);
     let mut elements = Vec::new();
     let mut groups = Groups::default();
     // Every 2-D physical group must be a region, and every 2-D element must be in one.
@@ -147,6 +156,9 @@ fn map(
                 .position(|r| r == name)
                 .expect("checked above");
             let coords: Vec<[f64; 2]> = ids.iter().map(|&i| nodes[i]).collect();
+            if let Some(m) = degenerate(&coords, &el.nodes, size) {
+                return Err(ctx.err("mesh.file", format!("{file}: element {}: {m}", el.tag)));
+            }
             let detj = min_jacobian(kind, &coords, integ);
             if detj.is_nan() || detj <= 0.0 {
                 return Err(ctx.err("mesh.file", format!("{file}: element {} is inverted or degenerate (smallest det J = {detj:.3e})", el.tag)));
@@ -231,6 +243,7 @@ fn joints(
         };
         let (ea, eb) = (get(&pair.a, "a")?, get(&pair.b, "b")?);
         let mut faces = Vec::new();
+        let mut matched_b = vec![false; eb.len()];
         for a in ea {
             // The element owning this edge, and its counter-clockwise order.
             let owners: Vec<(usize, Vec<usize>)> = elements
@@ -250,12 +263,15 @@ fn joints(
                 [] => return Err(ctx.err(format!("{key}.a"), format!("an edge of '{}' is not an edge of any element", pair.a))),
                 _ => return Err(ctx.err(format!("{key}.a"), format!("an edge of '{}' lies inside a segment (two elements share it): joint faces must be segment boundaries with their own nodes", pair.a))),
             };
-            let b = eb.iter().find(|b| {
+            let b = eb.iter().position(|b| {
                 b.len() == a.len()
                     && ((same(a[0], b[0]) && same(a[1], b[1]))
                         || (same(a[0], b[1]) && same(a[1], b[0])))
             });
-            let Some(b) = b else {
+            let Some(b) = b.map(|k| {
+                matched_b[k] = true;
+                &eb[k]
+            }) else {
                 let p = nodes[a[0]];
                 return Err(ctx.err(format!("{key}.b"), format!("no edge of '{}' faces the edge of '{}' at {p:?} (faces must coincide, node for node)", pair.b, pair.a)));
             };
@@ -270,6 +286,12 @@ fn joints(
                 b: b.clone(),
                 region: elements[owner].region,
             });
+        }
+        // Every edge of face B must face one of A too: otherwise part of the joint has no
+        // opposite face and the segments there would not touch.
+        if let Some(k) = matched_b.iter().position(|m| !m) {
+            let p = nodes[eb[k][0]];
+            return Err(ctx.err(format!("{key}.a"), format!("no edge of '{}' faces the edge of '{}' at {p:?}: the joint has no opposite face there (faces must coincide, node for node)", pair.a, pair.b)));
         }
         let x = faces.first().map(|f| nodes[f.a[0]][0]).unwrap_or(0.0);
         out.push(Joint { left: j, x, faces });

@@ -2,8 +2,10 @@
 
 pub mod build;
 pub mod error;
+pub mod limits;
 pub mod locate;
 pub mod schema;
+pub mod units;
 
 pub use build::Built;
 use error::Ctx;
