@@ -423,7 +423,10 @@ pub fn update(
             st.plastic_strain = u.plastic_strain;
             st.ebar = u.ebar;
             st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
-            if u.ebar >= p.eps_cu || compression::hardening(p, u.ebar).sigma_c <= 0.0 {
+            // σ_c = 0 means crushed only past the peak: with zero initial yield the curve
+            // also starts at σ_c = 0, where a round-off strain must not crush the point.
+            let spent = u.ebar > p.eps_c1 && compression::hardening(p, u.ebar).sigma_c <= 0.0;
+            if u.ebar >= p.eps_cu || spent {
                 st.crushed = true;
                 return Ok(crushed(p, &st, strain));
             }
