@@ -281,7 +281,9 @@ fn newton_controlled(
                 .max(scale)
                 .max(f64::MIN_POSITIVE);
         history.push(rel);
-        ctx.sys.freeze_if_cycling(&history);
+        if cycling(&history) {
+            ctx.sys.freeze_cracks();
+        }
         if !rel.is_finite() {
             return Err(NewtonFailure::diverged(history, rf));
         }
@@ -553,7 +555,9 @@ fn arc_increment(
                 .max(scale)
                 .max(f64::MIN_POSITIVE);
         history.push(rel);
-        ctx.sys.freeze_if_cycling(&history);
+        if cycling(&history) {
+            ctx.sys.freeze_cracks();
+        }
         if !rel.is_finite() {
             return Err(NewtonFailure::diverged(history, rf));
         }
@@ -630,6 +634,14 @@ fn arc_increment(
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// Newton cycles: six iterations made and the relative residual not halved over the last
+/// three (crack points alternating between loading and unloading); the drivers then hold the
+/// crack branches for the rest of the increment.
+pub(super) fn cycling(history: &[f64]) -> bool {
+    let n = history.len();
+    n >= 7 && history[n - 1] >= 0.5 * history[n - 4]
 }
 
 /// Correction scale from the residual history: 1, or ½, ¼, … (at least 1/16) while the

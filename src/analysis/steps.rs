@@ -499,7 +499,9 @@ pub(super) fn newton(
             return Err(NewtonFailure::diverged(history, rf));
         }
         history.push(rel);
-        sys.freeze_if_cycling(&history);
+        if super::path::cycling(&history) {
+            sys.freeze_cracks();
+        }
         if c.verbose {
             eprintln!(
                 "    iteration {it:2}: relative residual {rel:.3e}, last energy {:.3e}",

@@ -298,13 +298,11 @@ impl<'m> System<'m> {
     }
 
     /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
-    /// the rest of the increment, once the residual `history` shows Newton cycling (see
-    /// [`crate::materials::point::freeze_cracks`]); at most once per increment. Returns the
-    /// number of points held.
-    pub fn freeze_if_cycling(&mut self, history: &[f64]) -> usize {
-        let n = history.len();
-        // Cycling: six iterations made and the residual not halved over the last three.
-        if self.frozen || n < 7 || history[n - 1] < 0.5 * history[n - 4] {
+    /// the rest of the increment (see [`crate::materials::point::freeze_cracks`]); the Newton
+    /// drivers call it when their iterations cycle (`path::cycling`). At most once per
+    /// increment. Returns the number of points held.
+    pub fn freeze_cracks(&mut self) -> usize {
+        if self.frozen {
             return 0;
         }
         self.frozen = true;
@@ -685,11 +683,12 @@ impl<'m> System<'m> {
         self.bar_committed.clone_from(&self.bar_trial);
         self.bar_out.clone_from(&self.bar_out_trial);
         self.latched.clear();
-        self.frozen = false;
         // Held crack branches last one increment only.
-        for st in self.committed.iter_mut() {
-            if let PointState::Concrete(c) = st {
-                c.frozen = [0; 2];
+        if std::mem::take(&mut self.frozen) {
+            for st in self.committed.iter_mut() {
+                if let PointState::Concrete(c) = st {
+                    c.frozen = [0; 2];
+                }
             }
         }
     }

@@ -396,7 +396,8 @@ pub fn update(
     // with dilatancy does exactly that).
     let trial_cd = p.compression_dominated(&s_tr);
     // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
-    let ebar_n = committed.ebar.max(compression::initial_yield(p).0);
+    let ebar0 = compression::initial_yield(p).0;
+    let ebar_n = committed.ebar.max(ebar0);
     let yields = compression::sigma_hat(p, &s_tr).0
         > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
     if trial_cd || yields {
@@ -411,7 +412,7 @@ pub fn update(
         // virgin point whose trial is tension-dominated stays elastic (else the Ottosen
         // loading surface, which reaches into tension at ~0.3 f_tm, would pull a cracking
         // point back into plasticity and make the response jump between iterations).
-        let flowed = committed.ebar > compression::initial_yield(p).0 + 1e-12;
+        let flowed = committed.ebar > ebar0 + 1e-12;
         let accept = match &res {
             Ok(u) => trial_cd || (flowed && u.plastic && p.compression_dominated(&u.stress)),
             Err(_) => trial_cd,
