@@ -205,13 +205,22 @@ fn displacement_step(
     let n_inc = step.increments.max(1);
     let (mut level, mut d_level) = (0.0, 1.0 / n_inc as f64);
     let (mut increment, mut cuts) = (0, 0);
+    // The last increment's move of the first controlled dof (whatever step it belonged to)
+    // scales the first extrapolation; then the increments of this step.
+    let c0 = ctl[0].c;
+    let last_move = (ctx.sys.u[c0] - ctx.sys.u_prev[c0]).abs();
+    let full = (value - v0).abs();
+    let mut prev_size: Option<f64> = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
     while level < 1.0 - 1e-12 {
         let target = (level + d_level).min(1.0);
         let shift = (value - v0) * target;
+        // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
+        ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
         match newton_controlled(ctx, &f_ext, &ctl, shift) {
             Ok((f_int, iterations)) => {
                 let u = ctx.u.clone();
                 ctx.sys.commit(&u);
+                prev_size = Some(target - level);
                 level = target;
                 increment += 1;
                 let force: f64 = ctl.iter().map(|k| f_int[k.c] - f_ext[k.c]).sum();
@@ -326,7 +335,15 @@ fn newton_controlled(
         // two sides of a kink of the material response (a crack closing/reopening, a point
         // switching between elastic and plastic); a shorter step lands between them.
         let damp = damping(&history);
-        if damp < 1.0 {
+        if damp < 1.0 && it > 0 {
+            // Stagnating iterations: a line search on the work of the residual along the
+            // correction, g(s) = δu·r(u + s δu), which has a zero in (0, 1] when the
+            // correction overshoots a kink of the material response; fall back to the
+            // plain halving when g does not change sign.
+            let s = line_search(ctx, &u, &du, &rf, f_ext, ctl)?;
+            let s = s.unwrap_or(damp);
+            du.iter_mut().for_each(|v| *v *= s);
+        } else if damp < 1.0 {
             du.iter_mut().for_each(|v| *v *= damp);
         }
         if it > 0 {
@@ -338,6 +355,62 @@ fn newton_controlled(
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// Step length s ∈ (0, 1] along the correction `du` (free equations) from `u` where the
+/// work of the residual g(s) = du·r(u + s du) vanishes (regula falsi with the Illinois
+/// modification, at most 6 evaluations, |g| ≤ ½ |g(0)| accepted). None when g(1) keeps the
+/// sign of g(0) (no overshoot: the full step is as good as any shorter one).
+fn line_search(
+    ctx: &mut PathContext,
+    u: &[f64],
+    du: &[f64],
+    r0: &[f64],
+    f_ext: &[f64],
+    ctl: &[Controlled],
+) -> Result<Option<f64>, NewtonFailure> {
+    let g0 = dot(du, r0);
+    if g0.is_nan() || g0 <= 0.0 {
+        return Ok(None);
+    }
+    let g_at = |s: f64, ctx: &mut PathContext| -> Result<f64, NewtonFailure> {
+        let mut ut = u.to_vec();
+        ctx.add_free(&mut ut, du, s);
+        let a = ctx
+            .sys
+            .assemble(&ut, false)
+            .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+        let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
+        let mut rf = ctx.sys.to_free(&r);
+        for k in ctl {
+            rf[k.q] = 0.0;
+        }
+        Ok(dot(du, &rf))
+    };
+    let g1 = g_at(1.0, ctx)?;
+    if g1 >= 0.0 {
+        return Ok(None);
+    }
+    let (mut a, mut ga, mut b, mut gb) = (0.0, g0, 1.0, g1);
+    let mut best = (1.0, g1.abs());
+    for _ in 0..6 {
+        let s = (a * gb - b * ga) / (gb - ga);
+        let g = g_at(s, ctx)?;
+        if g.abs() < best.1 {
+            best = (s, g.abs());
+        }
+        if g.abs() <= 0.5 * g0 {
+            return Ok(Some(s));
+        }
+        if g > 0.0 {
+            (a, ga) = (s, g);
+            gb *= 0.5;
+        } else {
+            (b, gb) = (s, g);
+            ga *= 0.5;
+        }
+    }
+    Ok(Some(best.0))
 }
 
 // ------------------------------------------------------------------------------------------
@@ -378,9 +451,17 @@ fn arc_length_step(
             .collect()
     };
     let mut failed_dl: Option<f64> = None;
+    let mut prev_dl: Option<f64> = None;
     while increment < a.max_increments {
+        // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
+        ctx.sys.time.extrapolation = match (prev_dl, dl) {
+            (Some(p), Some(l)) if p > 0.0 => l / p,
+            _ => 0.0,
+        };
+        let dl_try = dl;
         match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
             Ok(inc) => {
+                prev_dl = dl_try.or(dl);
                 if dl0 == 0.0 {
                     dl0 = dl.expect("set by the first increment");
                 }

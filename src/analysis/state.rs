@@ -74,6 +74,8 @@ pub struct SystemState {
     pub bar_eps_ref: Vec<f64>,
     /// Time interval of the last increment [d].
     pub time: TimeContext,
+    /// Displacements before the last committed increment [m].
+    pub u_prev: Vec<f64>,
 }
 
 /// The committed state of a [`System`], borrowed for writing. Same fields in the same order
@@ -91,6 +93,7 @@ pub struct SystemStateRef<'a> {
     bar_phase: &'a [BarPhase],
     bar_eps_ref: &'a [f64],
     time: TimeContext,
+    u_prev: &'a [f64],
 }
 
 impl System<'_> {
@@ -121,6 +124,7 @@ impl System<'_> {
             bar_phase: &self.bar_phase,
             bar_eps_ref: &self.bar_eps_ref,
             time: self.time,
+            u_prev: &self.u_prev,
         }
     }
 
@@ -176,6 +180,7 @@ impl System<'_> {
             check("tendon span states", saved.state.spans.len(), n - 1)?;
         }
         self.u = s.u;
+        self.u_prev = s.u_prev;
         self.trial.clone_from(&s.committed);
         self.committed = s.committed;
         self.gauss_trial.clone_from(&s.gauss);

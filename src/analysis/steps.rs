@@ -318,6 +318,7 @@ fn load_step(
     let mut d_level = 1.0 / n_inc as f64;
     let mut increment = 0;
     let mut cuts = 0;
+    let mut prev_size: Option<f64> = None;
     while level < 1.0 - 1e-12 {
         let target = (level + d_level).min(1.0);
         let lam: Vec<f64> = start
@@ -335,9 +336,12 @@ fn load_step(
             Some(span) => TimeContext {
                 t_from: span.time_at(level),
                 t_to: span.time_at(target),
+                extrapolation: 0.0,
             },
             None => TimeContext::at(clock),
         });
+        // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
+        ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
         match newton(
             ctx.sys,
             ctx.solver,
@@ -349,6 +353,7 @@ fn load_step(
         ) {
             Ok((f_int, iterations)) => {
                 ctx.sys.commit(ctx.u);
+                prev_size = Some(target - level);
                 level = target;
                 increment += 1;
                 *ctx.factors = lam;

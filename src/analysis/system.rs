@@ -7,7 +7,7 @@ use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{crack_base, PointState, TimeContext, UpdateError};
+use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext, UpdateError};
 use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::Model;
 use rayon::prelude::*;
@@ -33,6 +33,9 @@ pub struct System<'m> {
     pub gp_offset: Vec<usize>,
     /// Committed displacements (all dofs) [m].
     pub u: Vec<f64>,
+    /// Displacements before the last committed increment [m] (its size sets the history
+    /// extrapolation of the next increment).
+    pub u_prev: Vec<f64>,
     /// Committed point states.
     pub committed: Vec<PointState>,
     /// Trial point states (of the last assembly).
@@ -78,6 +81,8 @@ pub struct System<'m> {
     pub latched: Vec<(usize, PointState)>,
     /// True once the crack branches were frozen in the current increment.
     pub frozen: bool,
+    /// Some point was held on the plastic route in this increment (commit clears the holds).
+    pub held_plastic: bool,
     /// Time interval of the current increment on the analysis clock [d].
     pub time: TimeContext,
     /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
@@ -230,6 +235,7 @@ impl<'m> System<'m> {
             ordering_s,
             gp_offset,
             u: vec![0.0; model.n_dofs()],
+            u_prev: vec![0.0; model.n_dofs()],
             trial: committed.clone(),
             committed,
             gauss: vec![GaussOutput::default(); n_gp],
@@ -251,6 +257,7 @@ impl<'m> System<'m> {
             bar_out_trial: vec![BarOutput::default(); n_bp],
             latched: Vec::new(),
             frozen: false,
+            held_plastic: false,
             time: TimeContext::default(),
             tendon_time: vec![None; model.tendons.len()],
             bar_phase: model
@@ -276,10 +283,14 @@ impl<'m> System<'m> {
                 continue;
             }
             for g in self.gp_offset[e]..self.gp_offset[e + 1] {
+                if self.latched.binary_search_by_key(&g, |x| x.0).is_ok() {
+                    continue;
+                }
                 if let Some(b) = crack_base(mat, &self.committed[g], &self.trial[g]) {
-                    if self.latched.binary_search_by_key(&g, |x| x.0).is_err() {
-                        new.push((g, b));
-                    }
+                    new.push((g, b));
+                } else if let Some(b) = plastic_base(&self.committed[g], &self.trial[g]) {
+                    self.held_plastic = true;
+                    new.push((g, b));
                 }
             }
         }
@@ -674,6 +685,7 @@ impl<'m> System<'m> {
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
         self.commit_time_dependent();
+        std::mem::swap(&mut self.u, &mut self.u_prev);
         self.u.copy_from_slice(u);
         std::mem::swap(&mut self.committed, &mut self.trial);
         self.trial.clone_from(&self.committed);
@@ -683,11 +695,13 @@ impl<'m> System<'m> {
         self.bar_committed.clone_from(&self.bar_trial);
         self.bar_out.clone_from(&self.bar_out_trial);
         self.latched.clear();
-        // Held crack branches last one increment only.
-        if std::mem::take(&mut self.frozen) {
+        // Held crack branches and plastic routes last one increment only.
+        let frozen = std::mem::take(&mut self.frozen);
+        if std::mem::take(&mut self.held_plastic) || frozen {
             for st in self.committed.iter_mut() {
                 if let PointState::Concrete(c) = st {
                     c.frozen = [0; 2];
+                    c.hold_plastic = false;
                 }
             }
         }

@@ -1454,6 +1454,7 @@ fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
         f(m.shear_beta_min.is_some(), "shear_beta_min"),
         f(m.residual_stiffness.is_some(), "residual_stiffness"),
         f(m.secant_crack_tangent.is_some(), "secant_crack_tangent"),
+        f(m.crack_integration.is_some(), "crack_integration"),
         f(
             m.normalize_equivalent_stress.is_some(),
             "normalize_equivalent_stress",
@@ -1799,6 +1800,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             "shear_beta_min",
             "residual_stiffness",
             "secant_crack_tangent",
+            "crack_integration",
             "normalize_equivalent_stress",
         ],
     )?;
@@ -1873,6 +1875,18 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
     }
     if let Some(v) = m.secant_crack_tangent {
         p.secant_crack_tangent = v;
+    }
+    if let Some(v) = &m.crack_integration {
+        p.implex = match v.as_str() {
+            "implicit" => false,
+            "implex" => true,
+            _ => {
+                return Err(ctx.err(
+                    k("crack_integration"),
+                    format!("must be \"implicit\" or \"implex\", got \"{v}\""),
+                ))
+            }
+        };
     }
     if let Some(v) = m.normalize_equivalent_stress {
         p.normalize_equivalent_stress = v;

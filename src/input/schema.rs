@@ -61,6 +61,7 @@ pub struct MaterialIn {
     pub shear_beta_min: Option<f64>,
     pub residual_stiffness: Option<f64>,
     pub secant_crack_tangent: Option<bool>,
+    pub crack_integration: Option<String>,
     pub normalize_equivalent_stress: Option<bool>,
     // steel
     pub fy: Option<f64>,

@@ -155,12 +155,20 @@ pub struct TimeContext {
     pub t_from: f64,
     /// Analysis time at the end of the increment [d] (≥ `t_from`).
     pub t_to: f64,
+    /// Size of this increment over the previous converged one [-], for materials that
+    /// extrapolate their history (IMPL-EX cracking); 0 = do not extrapolate.
+    #[serde(default)]
+    pub extrapolation: f64,
 }
 
 impl TimeContext {
     /// An instantaneous increment at time `t` [d].
     pub fn at(t: f64) -> Self {
-        Self { t_from: t, t_to: t }
+        Self {
+            t_from: t,
+            t_to: t,
+            extrapolation: 0.0,
+        }
     }
 
     /// Length of the increment Δt [d].
@@ -212,8 +220,9 @@ pub fn update_with_time(
             Ok((PointState::Elastic, mul3(&d, strain), d))
         }
         (Material::Concrete { params, .. }, PointState::Concrete(c)) => {
-            let (st, sig, mut d) = concrete::update(params, c, strain, char_length)
-                .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
+            let (st, sig, mut d) =
+                concrete::update_extrapolated(params, c, strain, char_length, time.extrapolation)
+                    .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
             // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
             // the symmetric solvers take its symmetric part (same converged answer, possibly
             // more iterations).
@@ -293,7 +302,7 @@ pub fn crack_base(
 ) -> Option<PointState> {
     match (mat, committed, trial) {
         (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t))
-            if c.n_cracks == 0 && t.n_cracks > 0 && !c.crushed && !t.crushed =>
+            if !params.implex && c.n_cracks == 0 && t.n_cracks > 0 && !c.crushed && !t.crushed =>
         {
             let mut b = (**c).clone();
             let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
@@ -308,10 +317,39 @@ pub fn crack_base(
     }
 }
 
+/// The state an update should start from for the rest of an increment once an uncracked
+/// concrete point has flowed plastically in one of its iterations ("plastic latching"): the
+/// committed (or latched) state held on the compression-plasticity route. Returns None when
+/// there is nothing to hold (not concrete, cracked, crushed, no flow, already held).
+///
+/// The route between compression plasticity and the elastic/cracking branch is decided on
+/// the trial stress; near that boundary a point can alternate between the returned stress
+/// and an elastic trial beyond the loading surface, a jump that keeps Newton cycling. The
+/// return mapping itself is continuous (it unloads elastically), so holding the route makes
+/// the rest of the increment smooth; the route is free again in the next increment.
+pub fn plastic_base(base: &PointState, trial: &PointState) -> Option<PointState> {
+    match (base, trial) {
+        (PointState::Concrete(b), PointState::Concrete(t))
+            if b.n_cracks == 0
+                && t.n_cracks == 0
+                && !b.crushed
+                && !t.crushed
+                && !b.hold_plastic
+                && t.ebar > b.ebar =>
+        {
+            let mut h = (**b).clone();
+            h.hold_plastic = true;
+            Some(PointState::Concrete(Box::new(h)))
+        }
+        _ => None,
+    }
+}
+
 /// The state an update should start from for the rest of an increment whose Newton
 /// iterations cycle ("branch freezing"): `base` (the committed or latched state) with each
 /// crack held on the branch the trial state took — loading on the envelope or unloading on
-/// the secant — and a second crack that formed in the trial kept. Returns None when there is
+/// the secant — and a second crack that formed in the trial kept (IMPL-EX cracks follow a
+/// law without loading/unloading branches and ignore the hold). Returns None when there is
 /// nothing to hold (not a cracked concrete point, or already frozen).
 ///
 /// Smeared cracks that compete for localisation make Newton alternate between iterates in

@@ -73,6 +73,9 @@ struct DirHistory {
     plastic: f64,
     /// Held branch (see [`super::ConcreteState`]): 0 free, 1 loading, −1 unloading.
     frozen: i8,
+    /// IMPL-EX: the extrapolated largest crack strain [-] whose secant this direction
+    /// follows in tension (None: implicit law).
+    extrapolated: Option<f64>,
 }
 
 /// Uniaxial law of one crack-axis direction at strain `e`.
@@ -83,6 +86,7 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         ebar,
         plastic,
         frozen,
+        extrapolated,
     } = h;
     let e_el = e + plastic;
     let ebar = ebar.max(compression::initial_yield(p).0);
@@ -100,6 +104,22 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         if !cracked {
             r.sigma = p.ec * e_el;
             r.k = p.ec;
+        } else if let Some(ex) = extrapolated {
+            // IMPL-EX: secant at the extrapolated e_max up to it, then capped at the
+            // envelope's stress there (a residual slope keeps the tangent regular): a
+            // monotone law in the increment, never above the envelope at ẽ_max. e_max itself
+            // is updated implicitly for the next extrapolation.
+            let ex = ex.max(p.eps0());
+            let s_ex = tension_envelope(p, alpha, ex).0;
+            if e_el <= ex {
+                r.sigma = s_ex / ex * e_el;
+                r.k = s_ex / ex;
+            } else {
+                r.k = p.residual_stiffness * p.ec;
+                r.sigma = s_ex + r.k * (e_el - ex);
+            }
+            r.emax = e_el.max(emax);
+            r.open = e_el > 0.0;
         } else if frozen > 0 || (frozen == 0 && e_el >= emax) || emax <= 0.0 {
             // Loading on the envelope (held there by a frozen branch even a little below
             // e_max: the stress then lies slightly above the secant, an error of the order of
@@ -151,6 +171,7 @@ pub fn update_cracked(
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
+    ratio: f64,
 ) -> UpdateResult {
     if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
         && !(char_length > 0.0 && char_length.is_finite())
@@ -165,22 +186,36 @@ pub fn update_cracked(
     let el: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * ee[j]).sum());
     let mut n_cracks = committed.n_cracks;
     let mut crack_max = committed.crack_max;
+    // IMPL-EX: e_max extrapolated linearly from the last two committed states.
+    let extrapolate = |i: usize| {
+        let (m, o) = (committed.crack_max[i], committed.crack_max_old[i]);
+        m + ratio.max(0.0) * (m - o).max(0.0)
+    };
     let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
+        let cracked = (i as u8) < n_cracks;
         let h = DirHistory {
-            cracked: (i as u8) < n_cracks,
+            cracked,
             emax: crack_max[i],
             ebar: committed.dir_ebar[i],
             plastic: committed.dir_plastic[i],
             frozen: committed.frozen[i],
+            extrapolated: (p.implex && cracked).then(|| extrapolate(i)),
         };
         direction(p, alpha, h, el[i])
     };
     let r0 = eval(0, n_cracks, &crack_max);
     let mut r1 = eval(1, n_cracks, &crack_max);
+    let mut formed_second = false;
     if n_cracks == 1 && r1.sigma >= p.ftm {
         n_cracks = 2;
-        crack_max[1] = 0.0;
-        r1 = eval(1, n_cracks, &crack_max);
+        if p.implex {
+            // Explicit formation: elastic in this increment, e_max = strain at formation.
+            formed_second = true;
+            r1.emax = r1.e_el;
+        } else {
+            crack_max[1] = 0.0;
+            r1 = eval(1, n_cracks, &crack_max);
+        }
     }
     let g = 0.5 * p.ec / (1.0 + p.nu);
     let mut st = committed.clone();
@@ -190,6 +225,10 @@ pub fn update_cracked(
     st.crack_strain = [r0.e_el, if n_cracks >= 2 { r1.e_el } else { 0.0 }];
     st.dir_ebar = [r0.ebar, r1.ebar];
     st.dir_plastic = [r0.plastic, r1.plastic];
+    st.crack_max_old = committed.crack_max;
+    if formed_second {
+        st.crack_max_old[1] = st.crack_max[1];
+    }
     if r0.ebar >= p.eps_cu || r1.ebar >= p.eps_cu {
         st.crushed = true;
         st.stress = [0.0; 3];
@@ -198,7 +237,16 @@ pub fn update_cracked(
     }
     let mut sl = [0.0; 3];
     let mut dl = [[0.0; 3]; 3];
-    if n_cracks >= 2 && r0.open && r1.open {
+    // Both cracks open → no stress; IMPL-EX decides on the committed state (explicitly), so
+    // that the stress stays linear in the increment.
+    let both_open = if p.implex {
+        committed.n_cracks >= 2
+            && committed.crack_strain[0] > 0.0
+            && committed.crack_strain[1] > 0.0
+    } else {
+        n_cracks >= 2 && r0.open && r1.open
+    };
+    if both_open {
         let rs = p.residual_stiffness;
         dl[0][0] = rs * p.ec;
         dl[1][1] = rs * p.ec;
@@ -209,10 +257,22 @@ pub fn update_cracked(
         dl[0][0] = r0.k;
         dl[1][1] = r1.k;
         // Shear retention at the largest crack strain reached by the existing cracks.
-        let (imax, emax) = if n_cracks >= 2 && st.crack_max[1] > st.crack_max[0] {
-            (1, st.crack_max[1])
+        let reached = if p.implex {
+            [
+                extrapolate(0),
+                if committed.n_cracks >= 2 {
+                    extrapolate(1)
+                } else {
+                    0.0
+                },
+            ]
         } else {
-            (0, st.crack_max[0])
+            st.crack_max
+        };
+        let (imax, emax) = if n_cracks >= 2 && reached[1] > reached[0] {
+            (1, reached[1])
+        } else {
+            (0, reached[0])
         };
         let (beta, dbeta) = p.shear.beta(emax);
         sl[2] = beta * g * el[2];
@@ -222,7 +282,7 @@ pub fn update_cracked(
         } else {
             r1.loading_crack
         };
-        if loading && !p.secant_crack_tangent {
+        if loading && !p.secant_crack_tangent && !p.implex {
             dl[2][imax] = dbeta * g * el[2];
         }
     }

@@ -122,6 +122,14 @@ pub struct ConcreteParams {
     /// Use secant (non-negative, symmetric) crack-direction stiffness instead of the
     /// consistent tangent for cracked points (robust for modified Newton; default false).
     pub secant_crack_tangent: bool,
+    /// IMPL-EX integration of the crack laws (Oliver, Huespe & Cante 2008): within an
+    /// increment each crack follows the secant at its largest crack strain extrapolated from
+    /// the two previous increments, and cracks form at the end of the increment in which the
+    /// converged stress reaches the surface. The tangent of cracked points is then positive
+    /// and constant in the increment (no softening, no loading/unloading switch), at the
+    /// price of a first-order error in the increment size. Default false (implicit).
+    #[serde(default)]
+    pub implex: bool,
 }
 
 impl ConcreteParams {
@@ -154,6 +162,7 @@ impl ConcreteParams {
             shear: ShearRetention::default(),
             residual_stiffness: 1e-6,
             secant_crack_tangent: false,
+            implex: false,
         }
     }
 
@@ -254,6 +263,15 @@ pub struct ConcreteState {
     /// [`crate::materials::point::freeze_cracks`]); always 0 in committed states.
     #[serde(default)]
     pub(crate) frozen: [i8; 2],
+    /// Largest crack strains of the state before the committed one [-] (IMPL-EX
+    /// extrapolation; equal to `crack_max` in the increment a crack forms).
+    #[serde(default)]
+    pub(crate) crack_max_old: [f64; 2],
+    /// Held on the compression-plasticity route for the rest of an increment (set on the
+    /// base state once the point has flowed in one of its iterations, see
+    /// [`crate::materials::point::plastic_base`]); always false in committed states.
+    #[serde(default)]
+    pub(crate) hold_plastic: bool,
 }
 
 impl Default for ConcreteState {
@@ -279,6 +297,8 @@ impl ConcreteState {
             dir_plastic: [0.0; 2],
             crushed: false,
             frozen: [0; 2],
+            crack_max_old: [0.0; 2],
+            hold_plastic: false,
         }
     }
 
@@ -376,6 +396,19 @@ pub fn update(
     strain: &[f64; 3],
     char_length: f64,
 ) -> UpdateResult {
+    update_extrapolated(p, committed, strain, char_length, 1.0)
+}
+
+/// As [`update`] with the IMPL-EX extrapolation ratio `ratio` [-] = size of this increment /
+/// size of the previous one (0 = no extrapolation: the cracks keep their committed
+/// secant); used only when `p.implex`.
+pub fn update_extrapolated(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    ratio: f64,
+) -> UpdateResult {
     if !strain.iter().all(|v| v.is_finite()) {
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
@@ -383,7 +416,7 @@ pub fn update(
         return Ok(crushed(p, committed, strain));
     }
     if committed.n_cracks > 0 {
-        return cracking::update_cracked(p, committed, strain, char_length);
+        return cracking::update_cracked(p, committed, strain, char_length, ratio);
     }
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
@@ -400,7 +433,7 @@ pub fn update(
     let ebar_n = committed.ebar.max(ebar0);
     let yields = compression::sigma_hat(p, &s_tr).0
         > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
-    if trial_cd || yields {
+    if trial_cd || yields || committed.hold_plastic {
         let res = compression::update(
             p,
             &committed.strain,
@@ -413,9 +446,12 @@ pub fn update(
         // loading surface, which reaches into tension at ~0.3 f_tm, would pull a cracking
         // point back into plasticity and make the response jump between iterations).
         let flowed = committed.ebar > ebar0 + 1e-12;
+        let held = committed.hold_plastic;
         let accept = match &res {
-            Ok(u) => trial_cd || (flowed && u.plastic && p.compression_dominated(&u.stress)),
-            Err(_) => trial_cd,
+            Ok(u) => {
+                held || trial_cd || (flowed && u.plastic && p.compression_dominated(&u.stress))
+            }
+            Err(_) => held || trial_cd,
         };
         if accept {
             let u = res?;
@@ -444,7 +480,19 @@ pub fn update(
         st.crack_max = [0.0; 2];
         st.dir_ebar = [ebar_n; 2];
         st.dir_plastic = [0.0; 2];
-        return cracking::update_cracked(p, &st, strain, char_length);
+        if p.implex {
+            // Explicit formation: the stress stays elastic in this increment; the crack
+            // carries its strain at formation as e_max with zero rate.
+            let t = cracking::strain_transform(phi);
+            let e_n: f64 = (0..3).map(|j| t[0][j] * ee[j]).sum();
+            st.crack_max = [e_n, 0.0];
+            st.crack_max_old = st.crack_max;
+            st.crack_strain = [e_n, 0.0];
+            st.strain = *strain;
+            st.stress = s_tr;
+            return Ok((st, s_tr, d));
+        }
+        return cracking::update_cracked(p, &st, strain, char_length, ratio);
     }
     let mut st = committed.clone();
     st.strain = *strain;

@@ -608,3 +608,93 @@ fn frozen_crack_branches_follow_the_held_law() {
     let (_, s, _) = upd(&p, &c, [e, 0.0, 0.0]);
     assert!((s[0] - env(e)).abs() < 1e-9 * p.ftm);
 }
+
+/// IMPL-EX uniaxial tension, strain driven in equal increments: the crack forms at the end
+/// of the increment that passes f_tm; afterwards the stress never exceeds the envelope at
+/// the extrapolated largest strain, the tangent stays positive, and the error against the
+/// implicit envelope is first order in the increment (a 4× finer path has ≤ 1/2 the error;
+/// first order predicts 1/4, the bound leaves room for the formation increment).
+#[test]
+fn implex_tension_follows_the_envelope_to_first_order() {
+    let mut p = params();
+    p.implex = true;
+    let alpha = p.softening_alpha(0.1);
+    let e0 = p.eps0();
+    let e_end = e0 + 4.0 * alpha;
+    let max_error = |n: usize| {
+        let mut c = ConcreteState::new();
+        let mut err: f64 = 0.0;
+        let mut prev: f64 = 0.0;
+        for i in 1..=n {
+            let e = e_end * i as f64 / n as f64;
+            let ratio = if i > 1 { 1.0 } else { 0.0 };
+            let (t, s, d) = update_extrapolated(&p, &c, &[e, 0.0, 0.0], 0.1, ratio).unwrap();
+            assert!(d[0][0] > 0.0, "tangent {d:?} at ε = {e:.3e}");
+            if c.n_cracks > 0 {
+                // Bounded by the envelope at the largest strain reached before this step,
+                // plus the residual slope over one increment.
+                let slack = p.residual_stiffness * p.ec * (e - prev) + 1e-9 * p.ftm;
+                let bound = tension_envelope(&p, alpha, prev.max(e0)).0 + slack;
+                assert!(s[0] <= bound, "σ {:.6e} > {bound:.6e} at ε = {e:.3e}", s[0]);
+                if e > 1.5 * e0 {
+                    let exact = tension_envelope(&p, alpha, e).0;
+                    err = err.max((s[0] - exact).abs());
+                }
+            }
+            prev = e;
+            c = t;
+        }
+        assert_eq!(c.n_cracks, 1);
+        err
+    };
+    let (coarse, fine) = (max_error(50), max_error(200));
+    assert!(fine <= 0.5 * coarse, "errors {coarse:.3e} → {fine:.3e}");
+    assert!(
+        fine < 0.05 * p.ftm,
+        "error {fine:.3e} vs f_tm {:.3e}",
+        p.ftm
+    );
+}
+
+/// A point held on the plastic route ("plastic latching") answers a trial beyond its
+/// loading surface with the return-mapped stress, not with the elastic trial, even when the
+/// trial is tension-dominated (the jump that made Newton cycle beside a loading plate).
+#[test]
+fn held_plastic_point_returns_instead_of_jumping_to_the_trial() {
+    use crate::materials::point::{plastic_base, PointState};
+    let mut p = params();
+    p.initial_yield_ratio = 0.3;
+    // Biaxial compression past initial yield: flows.
+    let e_c = -0.6 * p.fcm / p.ec;
+    let c = ConcreteState::new();
+    let (t, _, _) = upd(&p, &c, [e_c, 0.3 * e_c, 0.0]);
+    assert!(t.ebar > compression::initial_yield(&p).0);
+    let base = plastic_base(
+        &PointState::Concrete(Box::new(c.clone())),
+        &PointState::Concrete(Box::new(t)),
+    )
+    .expect("a flowing uncracked point is held");
+    let PointState::Concrete(h) = base else {
+        unreachable!()
+    };
+    assert!(h.hold_plastic);
+    // Tension-dominated trial beyond the loading surface (the state of the test above).
+    let target = [-0.24 * p.ftm, 0.8 * p.ftm, 0.2 * p.ftm];
+    let d = d_matrix(p.ec, p.nu);
+    let det = d[0][0] * d[1][1] - d[0][1] * d[1][0];
+    let e = [
+        (target[0] * d[1][1] - d[0][1] * target[1]) / det,
+        (d[0][0] * target[1] - d[1][0] * target[0]) / det,
+        target[2] / d[2][2],
+    ];
+    let (free, s_free, _) = upd(&p, &c, e);
+    let (held, s_held, _) = upd(&p, &h, e);
+    // Free: elastic trial (as `virgin_tension_dominated_point_stays_elastic`); held: on the
+    // loading surface, so strictly below the trial in equivalent stress, and plastic.
+    assert_eq!(free.plastic_strain(), [0.0; 3]);
+    assert!((s_free[1] - target[1]).abs() < 1e-6 * p.ftm);
+    assert!(held.plastic_strain() != [0.0; 3]);
+    let on = compression::sigma_hat(&p, &s_held).0;
+    let sc = compression::hardening(&p, held.ebar).sigma_c;
+    assert!((on - sc).abs() < 1e-6 * p.fcm, "σ̂ {on:.4e} vs σ_c {sc:.4e}");
+}
