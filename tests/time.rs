@@ -539,3 +539,48 @@ fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
         "{fe_loss} of {s0}"
     );
 }
+
+#[test]
+fn path_steps_after_a_time_step_are_instantaneous() {
+    // A displacement step after a time step runs at the clock the time step reached, with
+    // no time passing: the controlled dof (uy of the bottom-right corner, which is 0 under
+    // uniaxial σx) is held at its current value, so nothing may change — in particular the
+    // concrete must not creep further. A program that keeps the last substep's interval
+    // (≈ 270 d here) for the path increments adds creep at every increment (εx grows by
+    // several % of the elastic strain each), and reports the wrong time. Round-off tolerance.
+    let sigma = -4e6;
+    let text = format!(
+        "{}\n[[steps]]\nname = \"hold\"\nkind = \"displacement\"\nincrements = 3\ncontrol = {{ point = [0.1, 0.0], component = \"y\", value = 0.0 }}\n",
+        specimen(false, sigma, 28.0, "to = 1028.0\nsubsteps = 10")
+    );
+    let rec = run(&text);
+    assert_eq!(
+        rec.len(),
+        1 + 10 + 3,
+        "load, 10 substeps, 3 path increments"
+    );
+    let end_of_creep = &rec[10];
+    assert!((end_of_creep.time - 1028.0).abs() < 1e-9);
+    for r in &rec[11..] {
+        assert_eq!(r.time, 1028.0, "path increments run at the clock");
+        for c in 0..2 {
+            assert!(
+                (r.strain[c] - end_of_creep.strain[c]).abs() < 1e-9 * end_of_creep.strain[0].abs(),
+                "no creep during a path step: {:?} vs {:?}",
+                r.strain,
+                end_of_creep.strain
+            );
+        }
+    }
+    // A path step before any time step runs at the start clock (28 d by default), not 0.
+    let first = format!(
+        "{CONCRETE}shrinkage = false\n[[regions]]\nname = \"r\"\nmaterial = \"c\"\nthickness = 0.1\n[mesh]\ntype = \"banded\"\nlength = 0.1\nnx = 1\nelement = \"Q4\"\nbands = [{{ region = \"r\", depth = 0.1, rows = 1 }}]\n[[supports]]\nname = \"left\"\nline = [[0.0, 0.0], [0.0, 0.1]]\nux = 0.0\n[[supports]]\nname = \"corner\"\npoint = [0.0, 0.0]\nuy = 0.0\n[[steps]]\nname = \"push\"\nkind = \"displacement\"\nincrements = 2\ncontrol = {{ line = [[0.1, 0.0], [0.1, 0.1]], component = \"x\", value = -1e-5 }}\n"
+    );
+    let rec = run(&first);
+    assert_eq!(rec.len(), 2);
+    assert!(
+        rec.iter().all(|r| r.time == 28.0),
+        "{:?}",
+        rec.iter().map(|r| r.time).collect::<Vec<_>>()
+    );
+}
