@@ -122,6 +122,10 @@ pub struct ConcreteParams {
     /// Use secant (non-negative, symmetric) crack-direction stiffness instead of the
     /// consistent tangent for cracked points (robust for modified Newton; default false).
     pub secant_crack_tangent: bool,
+    /// Owen–Hinton elasto-viscoplastic compression plasticity (None: rate-independent
+    /// return mapping, the default; see [`compression::viscoplastic_update`]).
+    #[serde(default)]
+    pub viscoplastic: Option<compression::Viscoplastic>,
 }
 
 impl ConcreteParams {
@@ -154,6 +158,7 @@ impl ConcreteParams {
             shear: ShearRetention::default(),
             residual_stiffness: 1e-6,
             secant_crack_tangent: false,
+            viscoplastic: None,
         }
     }
 
@@ -376,6 +381,18 @@ pub fn update(
     strain: &[f64; 3],
     char_length: f64,
 ) -> UpdateResult {
+    update_timed(p, committed, strain, char_length, 0.0)
+}
+
+/// As [`update`] for an increment lasting `dt` days (only the viscoplastic option of the
+/// compression plasticity depends on it; `dt` = 0 is a load increment).
+pub fn update_timed(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    dt: f64,
+) -> UpdateResult {
     if !strain.iter().all(|v| v.is_finite()) {
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
@@ -401,8 +418,9 @@ pub fn update(
     let yields = compression::sigma_hat(p, &s_tr).0
         > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
     if trial_cd || yields {
-        let res = compression::update(
+        let res = compression::update_rate(
             p,
+            dt,
             &committed.strain,
             &committed.plastic_strain,
             ebar_n,
