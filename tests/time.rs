@@ -732,3 +732,118 @@ fn viscoplastic_option_bad_input_names_the_key() {
         );
     }
 }
+
+/// Per increment: time, first point's crack count, crack strain, strain and stress.
+#[derive(Default)]
+struct Cracks(Vec<(f64, usize, f64, [f64; 3], [f64; 3])>);
+
+impl Observer for Cracks {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let sys = s.system;
+        let p = &sys.committed[0];
+        self.0.push((
+            sys.time.t_to,
+            p.n_cracks(),
+            p.crack_strain(),
+            sys.gauss[0].strain,
+            sys.gauss[0].stress,
+        ));
+        Ok(())
+    }
+}
+
+#[test]
+fn cracked_point_does_not_creep_open_or_closed() {
+    // One Q4 of cracking concrete (with the viscoplastic option, so that time does enter
+    // its update): pulled in x until it cracks (ε = 3e-4 ≈ 2.8 ε0), pushed back to zero
+    // strain (the crack closes on its secant: unloaded, σx = 0, the point stays cracked),
+    // released with σy = −4 MPa acting along the crack, then held for 1e4 days. Chosen
+    // coupling (docs/theory-time.md §9): the crack laws are rate-independent and a cracked
+    // point does not creep, so the crack strain (1e-13 absolute), the strains (1e-13) and
+    // the stresses (4e-3 Pa) must not change over the time step, and σx must stay ≈ 0. A
+    // coupling that let time act on the crack direction would open or close it here.
+    let text = viscoplastic_specimen(0.0, "")
+        .replace(
+            "viscoplastic = { fluidity = 1e-3, load_steps = \"elastic\" }",
+            "viscoplastic = { fluidity = 1e-3 }",
+        )
+        .replace(
+            "[[supports]]\nname = \"right\"\nline = [[0.1, 0.0], [0.1, 0.1]]\nux = 0\n",
+            "",
+        )
+        .replace(
+            "[[steps]]\nname = \"push\"\nkind = \"load\"\n",
+            r#"[[supports]]
+name = "bottom"
+line = [[0.0, 0.0], [0.1, 0.0]]
+uy = 0.0
+[[load_cases]]
+name = "Y"
+line_loads = [{ line = [[0.0, 0.1], [0.1, 0.1]], q = [0.0, -4e5] }]
+[[steps]]
+name = "pull"
+kind = "displacement"
+increments = 6
+control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = 3e-5 }
+[[steps]]
+name = "close"
+kind = "displacement"
+increments = 3
+control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = 0.0 }
+[[steps]]
+name = "release"
+kind = "load"
+loads = { Y = 1.0 }
+[[steps]]
+name = "hold"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#,
+        );
+    assert!(
+        text.contains("name = \"hold\"") && !text.contains("name = \"right\""),
+        "{text}"
+    );
+    let model = segfem::input::parse(&text, "crack.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let mut k = Cracks::default();
+    steps::run(&model, &mut k).unwrap();
+    let rec = k.0;
+    let released = &rec[9];
+    assert_eq!(released.1, 1, "cracked: {released:?}");
+    assert!(
+        released.4[0].abs() < 1e-3 * 45e6 * 0.01,
+        "σx released: {released:?}"
+    );
+    assert!(
+        (released.4[1] / -4e6 - 1.0).abs() < 1e-6,
+        "σy: {released:?}"
+    );
+    let held = &rec[10..];
+    assert!(held.len() > 20 && (held.last().unwrap().0 - 10028.0).abs() < 1e-6);
+    for r in held {
+        assert_eq!(r.1, 1);
+        assert!(
+            (r.2 - released.2).abs() <= 1e-13,
+            "crack strain {} vs {}",
+            r.2,
+            released.2
+        );
+        for c in 0..3 {
+            assert!(
+                (r.3[c] - released.3[c]).abs() <= 1e-9 * 1e-4,
+                "strain {:?} vs {:?}",
+                r.3,
+                released.3
+            );
+            assert!(
+                (r.4[c] - released.4[c]).abs() <= 1e-9 * 4e6,
+                "stress {:?} vs {:?}",
+                r.4,
+                released.4
+            );
+        }
+    }
+}
