@@ -734,8 +734,10 @@ fn viscoplastic_option_bad_input_names_the_key() {
 }
 
 /// Per increment: time, first point's crack count, crack strain, strain and stress.
+type CrackRec = (f64, usize, f64, [f64; 3], [f64; 3]);
+
 #[derive(Default)]
-struct Cracks(Vec<(f64, usize, f64, [f64; 3], [f64; 3])>);
+struct Cracks(Vec<CrackRec>);
 
 impl Observer for Cracks {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
