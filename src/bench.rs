@@ -274,6 +274,64 @@ pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
     })
 }
 
+/// The seed beam (bundled example, mesh refined `refine` times as in [`seed_case`]) held
+/// for 10⁴ days (issue #6 item 8): its elastic concrete replaced by MC90 creep and shrinkage
+/// (ageing Maxwell chain, f_cm 45 MPa, RH 70 %, h0 0.2 m), tendon relaxation class 2;
+/// self weight and prestress on day 28, then one time step of 50 log-spaced substeps to
+/// day 10 028. Reports the final midspan deflection.
+pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
+    let r = refine.max(1);
+    let seed = include_str!("../examples/seed-beam.toml");
+    let head = &seed[..seed
+        .find("[[steps]]")
+        .ok_or("seed-beam.toml has no steps")?];
+    let text = head
+        .replace(
+            "kind = \"elastic\"\nE = 35.5e9          # MC90 Eci for fcm = 45 MPa",
+            "kind = \"elastic_creep\"\nfcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"",
+        )
+        .replace(
+            "deviators = \"held\"",
+            "deviators = \"held\"\nrelaxation_class = 2",
+        )
+        .replace(
+            "nx_per_segment = 6 ",
+            &format!("nx_per_segment = {} ", 6 * r),
+        )
+        .replace(
+            "depth = 0.10, rows = 1 ",
+            &format!("depth = 0.10, rows = {r} "),
+        )
+        .replace(
+            "depth = 0.40, rows = 4 ",
+            &format!("depth = 0.40, rows = {} ", 4 * r),
+        );
+    if !text.contains("elastic_creep") || !text.contains("relaxation_class") {
+        return Err("seed-beam.toml changed: cannot build the long-term case".into());
+    }
+    let text = format!(
+        "{text}\n[[steps]]\nname = \"prestress\"\nkind = \"load\"\nloads = {{ self_weight = 1.0 }}\n\n[[steps]]\nname = \"long_term\"\nkind = \"time\"\nfrom = 28.0\nduration = 1e4\nsubsteps = 50\n"
+    );
+    let t0 = Instant::now();
+    let model = crate::input::parse(&text, "seed-beam-long-term.toml")
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = Nothing(0.0);
+    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
+    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(NonlinearRow {
+        case: format!("seed 1e4 d, {} rows", 6 * r),
+        equations,
+        increments: t.increments,
+        iterations: t.iterations,
+        factorisations: t.solver.factorisations,
+        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
+        assembly_s: t.assembly_s,
+        total_s: t0.elapsed().as_secs_f64(),
+        result: obs.0,
+    })
+}
+
 /// faer's bare factorisation of a model's stiffness matrix: the baseline that the
 /// whole-process time of `segfem run` is measured against (docs/performance.md).
 #[derive(Debug, Clone, serde::Serialize)]

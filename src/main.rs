@@ -111,8 +111,9 @@ enum Command {
         /// Element kinds, comma separated (Q4, Q8, Q9).
         #[arg(long, value_delimiter = ',', default_values_t = vec!["Q4".to_string(), "Q8".to_string()])]
         element: Vec<String>,
-        /// Benchmark: "linear" (banded beams of --dofs) or "seed" (the seed beam through joint
-        /// opening, refined by each factor of --refine).
+        /// Benchmark: "linear" (banded beams of --dofs), "seed" (the seed beam through joint
+        /// opening, refined by each factor of --refine) or "long_term" (the seed beam with
+        /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -235,9 +236,10 @@ fn main() -> ExitCode {
         } => match case.as_str() {
             _ if model.is_some() => bench_bare(model.as_deref().expect("checked")),
             "linear" => bench(dofs, element),
-            "seed" => bench_seed(refine),
+            "seed" => bench_seed(refine, segfem::bench::seed_case),
+            "long_term" => bench_seed(refine, segfem::bench::seed_long_term_case),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear or seed)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed or long_term)");
                 ExitCode::from(2)
             }
         },
@@ -544,7 +546,11 @@ fn bench_bare(path: &std::path::Path) -> ExitCode {
     }
 }
 
-fn bench_seed(refine: Vec<usize>) -> ExitCode {
+/// Print one row per refinement factor of a seed-beam benchmark `case`.
+fn bench_seed(
+    refine: Vec<usize>,
+    case: fn(usize) -> Result<segfem::bench::NonlinearRow, String>,
+) -> ExitCode {
     println!(
         "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10} {:>9} {:>8} {:>13}",
         "case",
@@ -558,7 +564,7 @@ fn bench_seed(refine: Vec<usize>) -> ExitCode {
         "midspan uy [m]"
     );
     for r in refine {
-        match segfem::bench::seed_case(r) {
+        match case(r) {
             Ok(x) => println!(
                 "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10.2} {:>9.3} {:>8.3} {:>13.5e}",
                 x.case,

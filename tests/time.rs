@@ -539,3 +539,313 @@ fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
         "{fe_loss} of {s0}"
     );
 }
+
+#[test]
+fn path_steps_after_a_time_step_are_instantaneous() {
+    // A displacement step after a time step runs at the clock the time step reached, with
+    // no time passing: the controlled dof (uy of the bottom-right corner, which is 0 under
+    // uniaxial σx) is held at its current value, so nothing may change — in particular the
+    // concrete must not creep further. A program that keeps the last substep's interval
+    // (≈ 270 d here) for the path increments adds creep at every increment (εx grows by
+    // several % of the elastic strain each), and reports the wrong time. Round-off tolerance.
+    let sigma = -4e6;
+    let text = format!(
+        "{}\n[[steps]]\nname = \"hold\"\nkind = \"displacement\"\nincrements = 3\ncontrol = {{ point = [0.1, 0.0], component = \"y\", value = 0.0 }}\n",
+        specimen(false, sigma, 28.0, "to = 1028.0\nsubsteps = 10")
+    );
+    let rec = run(&text);
+    assert_eq!(
+        rec.len(),
+        1 + 10 + 3,
+        "load, 10 substeps, 3 path increments"
+    );
+    let end_of_creep = &rec[10];
+    assert!((end_of_creep.time - 1028.0).abs() < 1e-9);
+    for r in &rec[11..] {
+        assert_eq!(r.time, 1028.0, "path increments run at the clock");
+        for c in 0..2 {
+            assert!(
+                (r.strain[c] - end_of_creep.strain[c]).abs() < 1e-9 * end_of_creep.strain[0].abs(),
+                "no creep during a path step: {:?} vs {:?}",
+                r.strain,
+                end_of_creep.strain
+            );
+        }
+    }
+    // A path step before any time step runs at the start clock (28 d by default), not 0.
+    let first = format!(
+        "{CONCRETE}shrinkage = false\n[[regions]]\nname = \"r\"\nmaterial = \"c\"\nthickness = 0.1\n[mesh]\ntype = \"banded\"\nlength = 0.1\nnx = 1\nelement = \"Q4\"\nbands = [{{ region = \"r\", depth = 0.1, rows = 1 }}]\n[[supports]]\nname = \"left\"\nline = [[0.0, 0.0], [0.0, 0.1]]\nux = 0.0\n[[supports]]\nname = \"corner\"\npoint = [0.0, 0.0]\nuy = 0.0\n[[steps]]\nname = \"push\"\nkind = \"displacement\"\nincrements = 2\ncontrol = {{ line = [[0.1, 0.0], [0.1, 0.1]], component = \"x\", value = -1e-5 }}\n"
+    );
+    let rec = run(&first);
+    assert_eq!(rec.len(), 2);
+    assert!(
+        rec.iter().all(|r| r.time == 28.0),
+        "{:?}",
+        rec.iter().map(|r| r.time).collect::<Vec<_>>()
+    );
+}
+
+/// One Q4 of `concrete` with the viscoplastic option (`load_steps = "elastic"`) under
+/// uniaxial stress: the right edge is moved by the prescribed `u0` [m] in a load step
+/// (instantaneous, elastic), then held over the time step given.
+fn viscoplastic_specimen(u0: f64, steps: &str) -> String {
+    format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 45e6
+nu = 0.2
+viscoplastic = {{ fluidity = 1e-3, load_steps = "elastic" }}
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 0.1
+nx = 1
+element = "Q4"
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[supports]]
+name = "right"
+line = [[0.1, 0.0], [0.1, 0.1]]
+ux = {u0}
+[[steps]]
+name = "push"
+kind = "load"
+{steps}
+"#
+    )
+}
+
+#[test]
+fn viscoplastic_overstress_relaxes_exponentially() {
+    // Initial yield at the peak of the MC90 curve (σ_c = f_cm, dσ_c/dκ = 0 there), uniaxial
+    // stress. The right edge is moved elastically to σ = −1.02 f_cm (Δt = 0, load_steps =
+    // "elastic"), then held for 5 t_r. With the linear overstress function and no hardening
+    // the Perzyna law gives the closed form x(t) = x0 exp(−t/t_r), t_r = f_cm/(γ E),
+    // x = (|σ| − f_cm)/f_cm (uniaxial stress: n_x = −1, σ_y = 0 by equilibrium).
+    // Tolerance 5 % of x0, from the time discretisation: each FE time increment holds its
+    // end strain over the whole increment, and at fixed strain the Ottosen flow at uniaxial
+    // compression (n_y = 3.3: strongly dilatant) relaxes 11× faster than under uniaxial
+    // stress, so the error is first order in Δt/(t_r/11): 10.3 % with 100 log-spaced
+    // substeps, 3.8 % with the 400 used here (last substeps ≈ 0.08 t_r). The curvature of
+    // the MC90 peak changes σ_c by < 1e-4 f_cm.
+    let fcm = 45e6;
+    let e = segfem::materials::mc90::eci(fcm);
+    let gamma = 1e-3;
+    let t_r = fcm / (gamma * e);
+    let x0 = 0.02;
+    let u0 = -(1.0 + x0) * fcm / e * 0.1;
+    let text = viscoplastic_specimen(
+        u0,
+        &format!(
+        "[[steps]]\nname = \"hold\"\nkind = \"time\"\nfrom = 28.0\nduration = {}\nfirst_substep = {}\nsubsteps = 400\n",
+        5.0 * t_r,
+        0.01 * t_r),
+    );
+    let mut model = segfem::input::parse(&text, "vp.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    match &mut model.materials[0].law {
+        segfem::materials::point::Material::Concrete { params, .. } => {
+            params.initial_yield_ratio = 1.0
+        }
+        _ => unreachable!(),
+    }
+    let mut k = Keep::default();
+    steps::run(&model, &mut k).unwrap();
+    let rec = k.0;
+    let first = &rec[0];
+    assert!(
+        (first.stress[0] / (-(1.0 + x0) * fcm) - 1.0).abs() < 1e-6,
+        "elastic push: {:?}",
+        first.stress
+    );
+    let mut worst: f64 = 0.0;
+    for r in &rec[1..] {
+        let t = r.time - 28.0;
+        let x = -r.stress[0] / fcm - 1.0;
+        let want = x0 * (-t / t_r).exp();
+        assert!(r.stress[1].abs() < 1e-3 * fcm, "uniaxial: {:?}", r.stress);
+        worst = worst.max((x - want).abs() / x0);
+    }
+    eprintln!("viscoplastic relaxation: worst |x − x0 e^(−t/t_r)|/x0 = {worst:.4}");
+    assert!(worst < 0.05, "{worst}");
+    // Relaxed: within 1 % of x0 of the steady state σ = −f_cm after 5 t_r.
+    let last = -rec.last().unwrap().stress[0] / fcm - 1.0;
+    assert!(last < 0.01 * x0 + x0 * (-5f64).exp(), "{last}");
+}
+
+#[test]
+fn viscoplastic_option_bad_input_names_the_key() {
+    let base = viscoplastic_specimen(-1e-5, "");
+    for (vp, key, what) in [
+        (
+            "{ load_steps = \"elastic\" }",
+            "viscoplastic.fluidity",
+            "missing",
+        ),
+        ("{ fluidity = -1.0 }", "viscoplastic.fluidity", ""),
+        (
+            "{ fluidity = 1.0, overstress = \"cubic\" }",
+            "viscoplastic.overstress",
+            "cubic",
+        ),
+        (
+            "{ fluidity = 1.0, overstress = \"power\" }",
+            "viscoplastic.exponent",
+            "missing",
+        ),
+        (
+            "{ fluidity = 1.0, exponent = 2.0 }",
+            "viscoplastic.exponent",
+            "only",
+        ),
+        ("{ fluidity = 1.0, theta = 2.0 }", "viscoplastic.theta", ""),
+        (
+            "{ fluidity = 1.0, load_steps = \"never\" }",
+            "viscoplastic.load_steps",
+            "never",
+        ),
+    ] {
+        let text = base.replace(
+            "viscoplastic = { fluidity = 1e-3, load_steps = \"elastic\" }",
+            &format!("viscoplastic = {vp}"),
+        );
+        let err = match segfem::input::parse(&text, "vp.toml") {
+            Ok(_) => panic!("{vp}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            err.contains(&format!("materials[0].{key}")) && err.contains(what),
+            "{vp}: {err}"
+        );
+    }
+}
+
+/// Per increment: time, first point's crack count, crack strain, strain and stress.
+type CrackRec = (f64, usize, f64, [f64; 3], [f64; 3]);
+
+#[derive(Default)]
+struct Cracks(Vec<CrackRec>);
+
+impl Observer for Cracks {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let sys = s.system;
+        let p = &sys.committed[0];
+        self.0.push((
+            sys.time.t_to,
+            p.n_cracks(),
+            p.crack_strain(),
+            sys.gauss[0].strain,
+            sys.gauss[0].stress,
+        ));
+        Ok(())
+    }
+}
+
+#[test]
+fn cracked_point_does_not_creep_open_or_closed() {
+    // One Q4 of cracking concrete (with the viscoplastic option, so that time does enter
+    // its update): pulled in x until it cracks (ε = 3e-4 ≈ 2.8 ε0), pushed back to zero
+    // strain (the crack closes on its secant: unloaded, σx = 0, the point stays cracked),
+    // released with σy = −4 MPa acting along the crack, then held for 1e4 days. Chosen
+    // coupling (docs/theory-time.md §9): the crack laws are rate-independent and a cracked
+    // point does not creep, so the crack strain (1e-13 absolute), the strains (1e-13) and
+    // the stresses (4e-3 Pa) must not change over the time step, and σx must stay ≈ 0. A
+    // coupling that let time act on the crack direction would open or close it here.
+    let text = viscoplastic_specimen(0.0, "")
+        .replace(
+            "viscoplastic = { fluidity = 1e-3, load_steps = \"elastic\" }",
+            "viscoplastic = { fluidity = 1e-3 }",
+        )
+        .replace(
+            "[[supports]]\nname = \"right\"\nline = [[0.1, 0.0], [0.1, 0.1]]\nux = 0\n",
+            "",
+        )
+        .replace(
+            "[[steps]]\nname = \"push\"\nkind = \"load\"\n",
+            r#"[[supports]]
+name = "bottom"
+line = [[0.0, 0.0], [0.1, 0.0]]
+uy = 0.0
+[[load_cases]]
+name = "Y"
+line_loads = [{ line = [[0.0, 0.1], [0.1, 0.1]], q = [0.0, -4e5] }]
+[[steps]]
+name = "pull"
+kind = "displacement"
+increments = 6
+control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = 3e-5 }
+[[steps]]
+name = "close"
+kind = "displacement"
+increments = 3
+control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = 0.0 }
+[[steps]]
+name = "release"
+kind = "load"
+loads = { Y = 1.0 }
+[[steps]]
+name = "hold"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#,
+        );
+    assert!(
+        text.contains("name = \"hold\"") && !text.contains("name = \"right\""),
+        "{text}"
+    );
+    let model = segfem::input::parse(&text, "crack.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let mut k = Cracks::default();
+    steps::run(&model, &mut k).unwrap();
+    let rec = k.0;
+    let released = &rec[9];
+    assert_eq!(released.1, 1, "cracked: {released:?}");
+    assert!(
+        released.4[0].abs() < 1e-3 * 45e6 * 0.01,
+        "σx released: {released:?}"
+    );
+    assert!(
+        (released.4[1] / -4e6 - 1.0).abs() < 1e-6,
+        "σy: {released:?}"
+    );
+    let held = &rec[10..];
+    assert!(held.len() > 20 && (held.last().unwrap().0 - 10028.0).abs() < 1e-6);
+    for r in held {
+        assert_eq!(r.1, 1);
+        assert!(
+            (r.2 - released.2).abs() <= 1e-13,
+            "crack strain {} vs {}",
+            r.2,
+            released.2
+        );
+        for c in 0..3 {
+            assert!(
+                (r.3[c] - released.3[c]).abs() <= 1e-9 * 1e-4,
+                "strain {:?} vs {:?}",
+                r.3,
+                released.3
+            );
+            assert!(
+                (r.4[c] - released.4[c]).abs() <= 1e-9 * 4e6,
+                "stress {:?} vs {:?}",
+                r.4,
+                released.4
+            );
+        }
+    }
+}

@@ -228,6 +228,11 @@ pub fn run_with(
     for si in driver.next_step..model.steps.len() {
         let step = &model.steps[si];
         sys.stress_tendons(si);
+        // Every step starts as an instantaneous increment at the current clock: path steps
+        // keep this context for all their increments (no creep, shrinkage or relaxation
+        // while they run; their time is the clock), load steps set it again per increment,
+        // and time steps replace it with their substeps.
+        sys.begin_time_increment(TimeContext::at(clock));
         let mut reached_clock = clock;
         let mut ctx = super::path::PathContext {
             sys: &mut sys,

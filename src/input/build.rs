@@ -1459,6 +1459,7 @@ fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
             m.normalize_equivalent_stress.is_some(),
             "normalize_equivalent_stress",
         ),
+        f(m.viscoplastic.is_some(), "viscoplastic"),
         f(m.fy.is_some(), "fy"),
         f(m.et.is_some(), "Et"),
         f(m.ep.is_some(), "Ep"),
@@ -1772,6 +1773,68 @@ fn fraction(ctx: &Ctx, key: &str, v: f64, lo: f64, hi: f64) -> R<f64> {
     }
 }
 
+/// `viscoplastic = { ... }` of a concrete: the Owen–Hinton option (docs/input.md).
+fn viscoplastic_option(
+    ctx: &Ctx,
+    i: usize,
+    v: &super::schema::ViscoplasticIn,
+) -> R<crate::materials::concrete::compression::Viscoplastic> {
+    use crate::materials::viscoplastic::OverstressFunction;
+    let k = |f: &str| format!("materials[{i}].viscoplastic.{f}");
+    let d = crate::materials::concrete::compression::Viscoplastic::default();
+    let fluidity = positive(
+        ctx,
+        &k("fluidity"),
+        v.fluidity
+            .ok_or_else(|| ctx.err(k("fluidity"), "missing (fluidity γ [1/d])"))?,
+    )?;
+    let exponent = v
+        .exponent
+        .map(|e| positive(ctx, &k("exponent"), e))
+        .transpose()?;
+    let overstress = match (v.overstress.as_deref(), exponent) {
+        (None | Some("linear"), None) => OverstressFunction::Linear,
+        (None | Some("linear"), Some(_)) => {
+            return Err(ctx.err(
+                k("exponent"),
+                "is used by overstress = \"power\" or \"exponential\" only",
+            ))
+        }
+        (Some("power"), Some(n)) => OverstressFunction::Power(n),
+        (Some("exponential"), Some(m)) => OverstressFunction::Exponential(m),
+        (Some("power" | "exponential"), None) => {
+            return Err(ctx.err(
+                k("exponent"),
+                "missing (N of the power law, M of the exponential)",
+            ))
+        }
+        (Some(o), _) => {
+            return Err(ctx.err(
+                k("overstress"),
+                format!("unknown value '{o}' (expected linear, power or exponential)"),
+            ))
+        }
+    };
+    let load_steps = match v.load_steps.as_deref() {
+        None | Some("steady") => true,
+        Some("elastic") => false,
+        Some(o) => {
+            return Err(ctx.err(
+                k("load_steps"),
+                format!("unknown value '{o}' (expected steady or elastic)"),
+            ))
+        }
+    };
+    Ok(crate::materials::concrete::compression::Viscoplastic {
+        fluidity,
+        overstress,
+        theta: fraction(ctx, &k("theta"), v.theta.unwrap_or(d.theta), 0.0, 1.0)?,
+        safety: fraction(ctx, &k("safety"), v.safety.unwrap_or(d.safety), 1e-3, 1.0)?,
+        tau: fraction(ctx, &k("tau"), v.tau.unwrap_or(d.tau), 1e-4, 1.0)?,
+        steady_load_steps: load_steps,
+    })
+}
+
 /// `kind = "concrete"`: MC90 defaults from f_cm, each overridable.
 fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>) -> R<Material> {
     let k = |f: &str| format!("materials[{i}].{f}");
@@ -1802,6 +1865,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             "secant_crack_tangent",
             "crack_integration",
             "normalize_equivalent_stress",
+            "viscoplastic",
         ],
     )?;
     let fcm = positive(
@@ -1939,6 +2003,9 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             ))
         }
     };
+    if let Some(v) = &m.viscoplastic {
+        p.viscoplastic = Some(viscoplastic_option(ctx, i, v)?);
+    }
     p.validate()
         .map_err(|e| ctx.err(format!("materials[{i}]"), e.to_string()))?;
     Ok(Material::Concrete {

@@ -32,6 +32,19 @@ pub struct File {
     pub bars: Vec<BarIn>,
 }
 
+/// `viscoplastic = { ... }` of a concrete material (Owen–Hinton option).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViscoplasticIn {
+    pub fluidity: Option<f64>,
+    pub overstress: Option<String>,
+    pub exponent: Option<f64>,
+    pub theta: Option<f64>,
+    pub safety: Option<f64>,
+    pub tau: Option<f64>,
+    pub load_steps: Option<String>,
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialIn {
@@ -63,6 +76,7 @@ pub struct MaterialIn {
     pub secant_crack_tangent: Option<bool>,
     pub crack_integration: Option<String>,
     pub normalize_equivalent_stress: Option<bool>,
+    pub viscoplastic: Option<ViscoplasticIn>,
     // steel
     pub fy: Option<f64>,
     #[serde(rename = "Et")]

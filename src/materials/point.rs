@@ -220,9 +220,15 @@ pub fn update_with_time(
             Ok((PointState::Elastic, mul3(&d, strain), d))
         }
         (Material::Concrete { params, .. }, PointState::Concrete(c)) => {
-            let (st, sig, mut d) =
-                concrete::update_extrapolated(params, c, strain, char_length, time.extrapolation)
-                    .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
+            let (st, sig, mut d) = concrete::update_full(
+                params,
+                c,
+                strain,
+                char_length,
+                time.dt(),
+                time.extrapolation,
+            )
+            .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
             // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
             // the symmetric solvers take its symmetric part (same converged answer, possibly
             // more iterations).

@@ -42,6 +42,19 @@ pub fn overstress(law: OverstressFunction, f: f64, f0: f64) -> f64 {
     }
 }
 
+/// Overstress function Φ(x) \[-\] and its derivative dΦ/dx \[-\] for the normalised
+/// overstress x = (F − F0)/F_ref (any positive reference F_ref); both zero for x ≤ 0.
+pub fn overstress_of_ratio(law: OverstressFunction, x: f64) -> (f64, f64) {
+    if x <= 0.0 {
+        return (0.0, 0.0);
+    }
+    match law {
+        OverstressFunction::Linear => (x, 1.0),
+        OverstressFunction::Power(n) => (x.powf(n), n * x.powf(n - 1.0)),
+        OverstressFunction::Exponential(m) => ((m * x).exp_m1(), m * (m * x).exp()),
+    }
+}
+
 /// Viscoplastic strain rate ε̇_vp = γ ⟨Φ(F)⟩ a \[1/time\] (MODEL.md §5.1) for fluidity `gamma`
 /// \[1/time\], yield-function value `f`, yield stress `f0` and flow vector `flow` = ∂Q/∂σ
 /// [per unit of F/stress; dimensionless when F is a stress].

@@ -130,6 +130,10 @@ pub struct ConcreteParams {
     /// price of a first-order error in the increment size. Default false (implicit).
     #[serde(default)]
     pub implex: bool,
+    /// Owen–Hinton elasto-viscoplastic compression plasticity (None: rate-independent
+    /// return mapping, the default; see [`compression::viscoplastic_update`]).
+    #[serde(default)]
+    pub viscoplastic: Option<compression::Viscoplastic>,
 }
 
 impl ConcreteParams {
@@ -163,6 +167,7 @@ impl ConcreteParams {
             residual_stiffness: 1e-6,
             secant_crack_tangent: false,
             implex: false,
+            viscoplastic: None,
         }
     }
 
@@ -396,7 +401,19 @@ pub fn update(
     strain: &[f64; 3],
     char_length: f64,
 ) -> UpdateResult {
-    update_extrapolated(p, committed, strain, char_length, 1.0)
+    update_full(p, committed, strain, char_length, 0.0, 1.0)
+}
+
+/// As [`update`] for an increment lasting `dt` days (only the viscoplastic option of the
+/// compression plasticity depends on it; `dt` = 0 is a load increment).
+pub fn update_timed(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    dt: f64,
+) -> UpdateResult {
+    update_full(p, committed, strain, char_length, dt, 1.0)
 }
 
 /// As [`update`] with the IMPL-EX extrapolation ratio `ratio` [-] = size of this increment /
@@ -407,6 +424,19 @@ pub fn update_extrapolated(
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
+    ratio: f64,
+) -> UpdateResult {
+    update_full(p, committed, strain, char_length, 0.0, ratio)
+}
+
+/// The general update: increment of `dt` days (viscoplastic option) and IMPL-EX
+/// extrapolation ratio `ratio` (see [`update_timed`], [`update_extrapolated`]).
+pub fn update_full(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    dt: f64,
     ratio: f64,
 ) -> UpdateResult {
     if !strain.iter().all(|v| v.is_finite()) {
@@ -434,8 +464,9 @@ pub fn update_extrapolated(
     let yields = compression::sigma_hat(p, &s_tr).0
         > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
     if trial_cd || yields || committed.hold_plastic {
-        let res = compression::update(
+        let res = compression::update_rate(
             p,
+            dt,
             &committed.strain,
             &committed.plastic_strain,
             ebar_n,
