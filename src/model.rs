@@ -167,6 +167,25 @@ pub enum MonitorKind {
         /// Region index.
         region: Option<usize>,
     },
+    /// Force of a bonded tendon or bar [N]: area × stress at the integration point nearest a
+    /// point, or of largest magnitude along it.
+    BarForce {
+        /// Bar index.
+        bar: usize,
+        /// Index into the bar's points, or None for the extreme value.
+        point: Option<usize>,
+    },
+    /// Prestress loss of a bonded tendon since it was stressed (pre-tensioned: since its
+    /// initial stress) [Pa] (positive = loss), total or one part of the split: at the
+    /// integration point nearest a point, or the length-weighted mean along the tendon.
+    BarLoss {
+        /// Bar index.
+        bar: usize,
+        /// Index into the bar's points, or None for the mean.
+        point: Option<usize>,
+        /// Which part.
+        part: LossPart,
+    },
     /// Prestress loss of a tendon since stressing, length-weighted mean over its spans
     /// [Pa] (positive = loss), total or one part of the split (docs/theory-time.md).
     TendonLoss {
@@ -215,7 +234,8 @@ impl Monitor {
             MonitorKind::MaxCrackStrain { .. }
             | MonitorKind::MaxPlasticStrain { .. }
             | MonitorKind::CrushedPoints { .. } => "-",
-            MonitorKind::TendonLoss { .. } => "Pa",
+            MonitorKind::TendonLoss { .. } | MonitorKind::BarLoss { .. } => "Pa",
+            MonitorKind::BarForce { .. } => "N",
         }
     }
 }
@@ -463,6 +483,9 @@ pub struct Bar {
     /// Post-tensioning data of a bonded post-tensioned tendon (None: a bar or pre-tensioned
     /// tendon, bonded from the start with `initial_stress`).
     pub post_tension: Option<PostTension>,
+    /// Relaxation of a tendon's steel during time steps: MC90 class and f_ptk [Pa] (None =
+    /// no relaxation).
+    pub relaxation: Option<(RelaxationClass, f64)>,
 }
 
 /// Post-tensioning of a bonded tendon (docs/theory-prestress.md): not present before

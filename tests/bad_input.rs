@@ -680,7 +680,35 @@ fn bonded_tendon_with_initial_stress() {
     rejects(
         &bonded(&format!("{STRAIGHT}\ninitial_stress = 900e6")),
         "tendons[0].initial_stress",
-        &["[[bars]]"],
+        &["pretensioned"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_without_initial_stress() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.0, 0.1]]").replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].initial_stress",
+        &["missing", "before release"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_with_jacking() {
+    rejects(
+        &bonded(STRAIGHT).replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].jacking_stress",
+        &["pre-tensioned"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_above_yield() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.0, 0.1]]\ninitial_stress = 1700e6")
+            .replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].initial_stress",
+        &["0.9 fptk"],
     );
 }
 

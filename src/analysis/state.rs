@@ -7,6 +7,7 @@
 //! states equal the committed ones, no crack is latched, and every factorisation is
 //! recomputed from the same matrix.
 
+use super::bonded_time::BarPointTime;
 use super::system::{BarOutput, BarPhase, System};
 use super::time::TendonTime;
 use crate::elements::continuum::GaussOutput;
@@ -74,6 +75,8 @@ pub struct SystemState {
     pub bar_eps_ref: Vec<f64>,
     /// Time interval of the last increment [d].
     pub time: TimeContext,
+    /// Relaxation and loss records of the bonded-tendon points.
+    pub bar_time: Vec<Option<BarPointTime>>,
 }
 
 /// The committed state of a [`System`], borrowed for writing. Same fields in the same order
@@ -91,6 +94,7 @@ pub struct SystemStateRef<'a> {
     bar_phase: &'a [BarPhase],
     bar_eps_ref: &'a [f64],
     time: TimeContext,
+    bar_time: &'a [Option<BarPointTime>],
 }
 
 impl System<'_> {
@@ -121,6 +125,7 @@ impl System<'_> {
             bar_phase: &self.bar_phase,
             bar_eps_ref: &self.bar_eps_ref,
             time: self.time,
+            bar_time: &self.bar_time,
         }
     }
 
@@ -157,6 +162,7 @@ impl System<'_> {
         check("bar outputs", s.bar_out.len(), self.bar_out.len())?;
         check("bars", s.bar_phase.len(), self.bar_phase.len())?;
         check("bar strains", s.bar_eps_ref.len(), self.bar_eps_ref.len())?;
+        check("bar records", s.bar_time.len(), self.bar_time.len())?;
         if let Some(p) = s
             .committed
             .iter()
@@ -207,6 +213,7 @@ impl System<'_> {
         self.bar_out = s.bar_out;
         self.bar_phase = s.bar_phase;
         self.bar_eps_ref = s.bar_eps_ref;
+        self.bar_time = s.bar_time;
         self.time = s.time;
         self.latched.clear();
         Ok(())

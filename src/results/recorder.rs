@@ -199,6 +199,12 @@ impl<'m> Recorder<'m> {
                     .map(|j| summarise(snap.system, j).max_slip)
                     .fold(0.0, f64::max),
                 MonitorKind::BarStress { bar, point } => bar_stress(snap, *bar, *point),
+                MonitorKind::BarForce { bar, point } => {
+                    self.model.bars[*bar].area * bar_stress(snap, *bar, *point)
+                }
+                MonitorKind::BarLoss { bar, point, part } => {
+                    snap.system.bar_loss(*bar, *point, *part)
+                }
                 MonitorKind::MaxCrackStrain { region } => {
                     point_extreme(snap, *region, |p| p.crack_strain())
                 }
