@@ -41,6 +41,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/box-beam.toml"),
     ),
     (
+        "pt-beam",
+        "12 m post-tensioned beam: bonded parabolic tendon, stressing, grouting, service load",
+        include_str!("../examples/pt-beam.toml"),
+    ),
+    (
         "rc-beam",
         "RC beam in four-point bending to failure (concrete, embedded bars, displacement control)",
         include_str!("../examples/rc-beam.toml"),
