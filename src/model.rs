@@ -396,7 +396,9 @@ pub struct TendonEl {
     pub ep: f64,
     /// Characteristic tensile strength f_ptk [Pa] (yield at 0.9 f_ptk).
     pub fptk: f64,
-    /// Stress of each span just after stressing (friction losses included) [Pa].
+    /// Stress of each span as stressed, on the geometry at the start of its stressing step
+    /// (friction and set losses included, its own elastic shortening not: the tendon loses
+    /// that during the step) [Pa].
     pub span_stress: Vec<f64>,
     /// Deviator behaviour.
     #[serde(skip)]
