@@ -373,11 +373,11 @@ fn single_deviator_raises_ultimate_load_and_tendon_stress_increase() {
     );
 }
 
-/// What an external tendon's given stress means (docs/input.md, theory-prestress.md): the
+/// What an external tendon's given stress means (docs/input.md, theory-joints-tendons.md): the
 /// stress of its spans on the geometry at the start of its stressing step, *before* the
 /// member's elastic shortening under this tendon. The engine stresses the tendon and the
 /// concrete then shortens under it, so the tendon loses its own elastic shortening (a jack
-/// that does not re-adjust, the seed's dummy mesh), and `tendon_loss_elastic` reports it.
+/// that does not re-adjust), and `tendon_loss_elastic` reports it.
 /// Concentric straight tendon anchored at the end faces of an 80 m elastic prism,
 /// 0.5 × 0.3 m, no self weight:
 ///
