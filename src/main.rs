@@ -116,8 +116,10 @@ enum Command {
         /// Element kinds, comma separated (Q4, Q8, Q9).
         #[arg(long, value_delimiter = ',', default_values_t = vec!["Q4".to_string(), "Q8".to_string()])]
         element: Vec<String>,
-        /// Benchmark: "linear" (banded beams of --dofs) or "seed" (the seed beam through joint
-        /// opening, refined by each factor of --refine).
+        /// Benchmark: "linear" (banded beams of --dofs), "seed" (the seed beam through joint
+        /// opening, refined by each factor of --refine), "seed-failure" (the seed beam on to
+        /// failure by arc length, each --refine) or "seed-failure-concrete" (the same with
+        /// the MC90/Ottosen concrete).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -241,8 +243,10 @@ fn main() -> ExitCode {
             _ if model.is_some() => bench_bare(model.as_deref().expect("checked")),
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine),
+            "seed-failure" => bench_seed_failure(refine, false),
+            "seed-failure-concrete" => bench_seed_failure(refine, true),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear or seed)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, seed-failure or seed-failure-concrete)");
                 ExitCode::from(2)
             }
         },
@@ -547,6 +551,45 @@ fn bench_bare(path: &std::path::Path) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
+    println!(
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  end",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "total s",
+        "Q max",
+        "uy [m]",
+        "σp [MPa]",
+        "open [mm]",
+        "crushed"
+    );
+    for r in refine {
+        match segfem::bench::seed_failure_case(r, concrete) {
+            Ok(x) => println!(
+                "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.total_s,
+                x.q_max,
+                x.deflection,
+                x.tendon_stress / 1e6,
+                x.max_opening * 1e3,
+                x.crushed,
+                x.end
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
 }
 
 fn bench_seed(refine: Vec<usize>) -> ExitCode {

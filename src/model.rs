@@ -129,15 +129,19 @@ pub enum MonitorKind {
         /// Joint index.
         joint: usize,
     },
-    /// Largest span stress of a tendon [Pa].
+    /// Stress of one span of an external tendon, or the largest span stress [Pa].
     TendonStress {
         /// Tendon index.
         tendon: usize,
+        /// Span index (0-based, from the first point), or None for the largest.
+        span: Option<usize>,
     },
-    /// Largest span force of a tendon [N].
+    /// Force of one span of an external tendon, or the largest span force [N].
     TendonForce {
         /// Tendon index.
         tendon: usize,
+        /// Span index (0-based, from the first point), or None for the largest.
+        span: Option<usize>,
     },
     /// Largest slip (relative tangential displacement) of a joint, or of all joints [m].
     JointSlip {

@@ -722,6 +722,16 @@ fn bonded_tendon_chain_with_a_gap() {
 }
 
 #[test]
+fn tendon_monitor_span_out_of_range() {
+    let m = edit(
+        BANDED,
+        "[[supports]]\nname = \"pin\"",
+        "[[tendons]]\nname = \"T\"\nkind = \"external\"\npoints = [[0.0, 0.2], [4.0, 0.2]]\narea = 1e-3\nEp = 195e9\nfptk = 1860e6\ninitial_stress = 1e9\n\n[[monitors]]\nname = \"F\"\nkind = \"tendon_force\"\ntendon = \"T\"\nspan = 2\n\n[[supports]]\nname = \"pin\"",
+    );
+    rejects(&m, "monitors[0].span", &["spans 1 to 1"]);
+}
+
+#[test]
 fn external_tendon_with_a_parabola() {
     let m = edit(
         BANDED,

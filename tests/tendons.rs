@@ -466,3 +466,57 @@ kind = "load"
         s0 - closed
     );
 }
+
+/// History per segment between deviators: `tendon_force`/`tendon_stress` monitors with
+/// `span` record each span of an external tendon at every increment. With held deviators
+/// under an unsymmetric load the two spans differ; the monitors equal the spans' own forces
+/// and stresses (exactly), and the monitor without `span` is the larger one.
+#[test]
+fn span_monitors_record_each_segment_at_every_increment() {
+    use segfem::results::recorder::Recorder;
+    let points = "[[0.0, 0.3], [3.0, 0.1], [6.0, 0.3]]";
+    let load = "{ point = [1.5, 0.6], force = [0.0, -200e3] }";
+    let text = format!(
+        "{}{}",
+        beam(points, "held", load, 30e9),
+        r#"
+[[monitors]]
+name = "F1"
+kind = "tendon_force"
+tendon = "T"
+span = 1
+[[monitors]]
+name = "F2"
+kind = "tendon_force"
+tendon = "T"
+span = 2
+[[monitors]]
+name = "Fmax"
+kind = "tendon_force"
+tendon = "T"
+[[monitors]]
+name = "S2"
+kind = "tendon_stress"
+tendon = "T"
+span = 2
+"#
+    );
+    let model = segfem::input::parse(&text, "tendon.toml").unwrap().model;
+    let dir = std::env::temp_dir().join(format!("segfem-span-{}", std::process::id()));
+    let mut rec = Recorder::new(&model, dir.clone(), false).unwrap();
+    steps::run(&model, &mut rec).unwrap();
+    let rows: Vec<Vec<f64>> = rec.rows.iter().map(|r| r.monitors.clone()).collect();
+    drop(rec);
+    let _ = std::fs::remove_dir_all(dir);
+    let k = run(&text);
+    assert_eq!(rows.len(), 5, "one row per increment");
+    let last = rows.last().unwrap();
+    assert_eq!(last[0], k.forces[0]);
+    assert_eq!(last[1], k.forces[1]);
+    assert_eq!(last[2], k.forces[0].max(k.forces[1]));
+    assert!((last[3] - last[1] / AP).abs() < 1e-9 * S0);
+    assert!(
+        (last[0] - last[1]).abs() > 1e-4 * last[0],
+        "held deviators: the spans differ ({last:?})"
+    );
+}

@@ -509,7 +509,8 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     m.tendon.as_deref(),
                     model.tendons.iter().map(|t| t.name.as_str()),
                 )?;
-                MonitorKind::TendonForce { tendon }
+                let span = span_of(ctx, &key, m, &model.tendons[tendon])?;
+                MonitorKind::TendonForce { tendon, span }
             }
             "tendon_stress" | "tendon_force" | "tendon_loss" | "tendon_loss_elastic"
             | "tendon_loss_creep" | "tendon_loss_relaxation"
@@ -518,6 +519,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 // A bonded tendon is a bar: at the point nearest `point`, else its largest
                 // stress or force, or its mean loss.
                 let bar = bonded_bar.expect("guarded");
+                if m.span.is_some() {
+                    return Err(ctx.err(
+                        format!("{key}.span"),
+                        "spans are for external tendons: a bonded tendon takes `point`",
+                    ));
+                }
                 let point = m.point.map(|p| nearest_bar_point(&model.bars[bar], p));
                 match m.kind.as_str() {
                     "tendon_stress" => MonitorKind::BarStress { bar, point },
@@ -543,7 +550,10 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     kind => Some(loss_part(kind)),
                 };
                 match part {
-                    None => MonitorKind::TendonStress { tendon },
+                    None => MonitorKind::TendonStress {
+                        tendon,
+                        span: span_of(ctx, &key, m, &model.tendons[tendon])?,
+                    },
                     Some(part) => MonitorKind::TendonLoss { tendon, part },
                 }
             }
@@ -1683,6 +1693,23 @@ fn build_tendon(
         mode,
         stressed_in_step: 0,
     })
+}
+
+/// The span (0-based) a `tendon_stress`/`tendon_force` monitor of an external tendon names
+/// with its 1-based `span` key (None: the largest over the spans).
+fn span_of(ctx: &Ctx, key: &str, m: &MonitorIn, tendon: &TendonEl) -> R<Option<usize>> {
+    let Some(k) = m.span else { return Ok(None) };
+    let n = tendon.nodes.len() - 1;
+    if k < 1 || k as usize > n {
+        return Err(ctx.err(
+            format!("{key}.span"),
+            format!(
+                "tendon '{}' has spans 1 to {n} (between its anchors and deviators), not {k}",
+                tendon.name
+            ),
+        ));
+    }
+    Ok(Some(k as usize - 1))
 }
 
 /// The loss part of a `tendon_loss*` monitor kind.
