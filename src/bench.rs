@@ -236,12 +236,11 @@ impl Observer for Nothing {
     }
 }
 
-/// The seed beam (bundled example) with its mesh refined `refine` times in both directions
-/// (refine = 1: the seed's coarse mesh, 6 rows through the depth), self weight, prestress and
-/// Q up to 140 kN, joints opening on the way.
-pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
+/// The seed beam's model file (bundled example) with its mesh refined `refine` times in both
+/// directions (1: the seed's coarse mesh, 6 rows through the depth).
+fn seed_text(refine: usize) -> String {
     let r = refine.max(1);
-    let text = include_str!("../examples/seed-beam.toml")
+    include_str!("../examples/seed-beam.toml")
         .replace(
             "nx_per_segment = 6 ",
             &format!("nx_per_segment = {} ", 6 * r),
@@ -253,7 +252,15 @@ pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
         .replace(
             "depth = 0.40, rows = 4 ",
             &format!("depth = 0.40, rows = {} ", 4 * r),
-        );
+        )
+}
+
+/// The seed beam (bundled example) with its mesh refined `refine` times in both directions
+/// (refine = 1: the seed's coarse mesh, 6 rows through the depth), self weight, prestress and
+/// Q up to 140 kN, joints opening on the way.
+pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
+    let r = refine.max(1);
+    let text = seed_text(r);
     let t0 = Instant::now();
     let model = crate::input::parse(&text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
@@ -329,6 +336,131 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
         assembly_s: t.assembly_s,
         total_s: t0.elapsed().as_secs_f64(),
         result: obs.0,
+    })
+}
+
+/// Figures of a run of the seed beam to failure.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FailureRow {
+    /// Case name.
+    pub case: String,
+    /// Free equations.
+    pub equations: usize,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations of the converged increments.
+    pub iterations: usize,
+    /// Whole run, including any failed last increment [s].
+    pub total_s: f64,
+    /// Largest load Q reached [kN].
+    pub q_max: f64,
+    /// Midspan deflection at the last converged increment [m] (downward negative).
+    pub deflection: f64,
+    /// Largest tendon span stress at the last converged increment [Pa].
+    pub tendon_stress: f64,
+    /// Largest joint opening at the last converged increment [m].
+    pub max_opening: f64,
+    /// Crushed concrete integration points at the last converged increment [-].
+    pub crushed: usize,
+    /// How the run ended.
+    pub end: String,
+}
+
+/// Records what a failure run reaches.
+#[derive(Default)]
+struct Reach {
+    increments: usize,
+    iterations: usize,
+    q_max: f64,
+    deflection: f64,
+    tendon_stress: f64,
+    max_opening: f64,
+    crushed: usize,
+}
+
+impl Observer for Reach {
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let sys = snap.system;
+        let m = sys.model;
+        self.increments += 1;
+        self.iterations += snap.iterations;
+        self.q_max = self.q_max.max(snap.factors[1]);
+        if let Some(n) = m
+            .nodes
+            .iter()
+            .position(|p| (p[0] - 3.6).abs() < 1e-9 && p[1].abs() < 1e-9)
+        {
+            self.deflection = sys.u[2 * n + 1];
+        }
+        self.tendon_stress = sys.tendon_committed[0]
+            .as_ref()
+            .map_or(0.0, |t| t.stresses().into_iter().fold(0.0, f64::max));
+        self.max_opening = (0..m.joints.len())
+            .map(|j| crate::results::joints::summarise(sys, j).max_opening)
+            .fold(0.0, f64::max);
+        self.crushed = sys.committed.iter().filter(|p| p.is_crushed()).count();
+        Ok(())
+    }
+}
+
+/// The seed beam taken to failure: the bundled example (self weight, prestress, Q to 140 kN)
+/// refined `refine` times, then an arc-length step on Q until the midspan deflection reaches
+/// 0.12 m (L/60), Newton gives up (the furthest point the model reaches), or 400
+/// increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
+/// the same strength (fcm = 45 MPa, VALIDATION.md §1) with the solver settings of the RC
+/// beam example.
+pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, String> {
+    let r = refine.max(1);
+    let mut text = seed_text(r);
+    if concrete {
+        text = text.replace(
+            "kind = \"elastic\"\nE = 35.5e9",
+            "kind = \"concrete\"\nfcm = 45e6\nE = 35.5e9",
+        );
+        text.push_str("\n[solver]\nforce_tolerance = 1e-4\nmax_iterations = 30\nmax_cuts = 8\n");
+    }
+    text.push_str(
+        r#"
+[[steps]]
+name = "failure"
+kind = "arc_length"
+loads = { Q = 1.0 }
+initial_increment = 4.0
+stop_displacement = { point = [3.6, 0.0], component = "y", value = -0.12 }
+increments = 400
+"#,
+    );
+    let t0 = Instant::now();
+    let model = crate::input::parse(&text, "seed-beam.toml")
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = Reach::default();
+    let end = match steps::run(&model, &mut obs) {
+        Ok(_) if obs.deflection <= -0.12 + 1e-9 => "deflection L/60 reached".to_string(),
+        Ok(_) => "increment limit".to_string(),
+        Err(steps::AnalysisError::NotConverged(rep)) => format!(
+            "no convergence beyond this point (step '{}', increment {})",
+            rep.step, rep.increment
+        ),
+        Err(e) => return Err(e.to_string()),
+    };
+    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(FailureRow {
+        case: format!(
+            "seed beam {}, {} rows",
+            if concrete { "concrete" } else { "elastic" },
+            6 * r
+        ),
+        equations,
+        increments: obs.increments,
+        iterations: obs.iterations,
+        total_s: t0.elapsed().as_secs_f64(),
+        q_max: obs.q_max,
+        deflection: obs.deflection,
+        tendon_stress: obs.tendon_stress,
+        max_opening: obs.max_opening,
+        crushed: obs.crushed,
+        end,
     })
 }
 

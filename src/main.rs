@@ -41,6 +41,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/box-beam.toml"),
     ),
     (
+        "pt-beam",
+        "12 m post-tensioned beam: bonded parabolic tendon, stressing, grouting, service load",
+        include_str!("../examples/pt-beam.toml"),
+    ),
+    (
         "rc-beam",
         "RC beam in four-point bending to failure (concrete, embedded bars, displacement control)",
         include_str!("../examples/rc-beam.toml"),
@@ -112,8 +117,10 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = vec!["Q4".to_string(), "Q8".to_string()])]
         element: Vec<String>,
         /// Benchmark: "linear" (banded beams of --dofs), "seed" (the seed beam through joint
-        /// opening, refined by each factor of --refine) or "long_term" (the seed beam with
-        /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine).
+        /// opening, refined by each factor of --refine), "long_term" (the seed beam with
+        /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine),
+        /// "seed-failure" (the seed beam on to failure by arc length, each --refine) or
+        /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -238,8 +245,10 @@ fn main() -> ExitCode {
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine, segfem::bench::seed_case),
             "long_term" => bench_seed(refine, segfem::bench::seed_long_term_case),
+            "seed-failure" => bench_seed_failure(refine, false),
+            "seed-failure-concrete" => bench_seed_failure(refine, true),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed or long_term)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure or seed-failure-concrete)");
                 ExitCode::from(2)
             }
         },
@@ -544,6 +553,45 @@ fn bench_bare(path: &std::path::Path) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
+    println!(
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  end",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "total s",
+        "Q max",
+        "uy [m]",
+        "σp [MPa]",
+        "open [mm]",
+        "crushed"
+    );
+    for r in refine {
+        match segfem::bench::seed_failure_case(r, concrete) {
+            Ok(x) => println!(
+                "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.total_s,
+                x.q_max,
+                x.deflection,
+                x.tendon_stress / 1e6,
+                x.max_opening * 1e3,
+                x.crushed,
+                x.end
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
 }
 
 /// Print one row per refinement factor of a seed-beam benchmark `case`.

@@ -129,15 +129,19 @@ pub enum MonitorKind {
         /// Joint index.
         joint: usize,
     },
-    /// Largest span stress of a tendon [Pa].
+    /// Stress of one span of an external tendon, or the largest span stress [Pa].
     TendonStress {
         /// Tendon index.
         tendon: usize,
+        /// Span index (0-based, from the first point), or None for the largest.
+        span: Option<usize>,
     },
-    /// Largest span force of a tendon [N].
+    /// Force of one span of an external tendon, or the largest span force [N].
     TendonForce {
         /// Tendon index.
         tendon: usize,
+        /// Span index (0-based, from the first point), or None for the largest.
+        span: Option<usize>,
     },
     /// Largest slip (relative tangential displacement) of a joint, or of all joints [m].
     JointSlip {
@@ -166,6 +170,25 @@ pub enum MonitorKind {
     CrushedPoints {
         /// Region index.
         region: Option<usize>,
+    },
+    /// Force of a bonded tendon or bar [N]: area × stress at the integration point nearest a
+    /// point, or of largest magnitude along it.
+    BarForce {
+        /// Bar index.
+        bar: usize,
+        /// Index into the bar's points, or None for the extreme value.
+        point: Option<usize>,
+    },
+    /// Prestress loss of a bonded tendon since it was stressed (pre-tensioned: since its
+    /// initial stress) [Pa] (positive = loss), total or one part of the split: at the
+    /// integration point nearest a point, or the length-weighted mean along the tendon.
+    BarLoss {
+        /// Bar index.
+        bar: usize,
+        /// Index into the bar's points, or None for the mean.
+        point: Option<usize>,
+        /// Which part.
+        part: LossPart,
     },
     /// Prestress loss of a tendon since stressing, length-weighted mean over its spans
     /// [Pa] (positive = loss), total or one part of the split (docs/theory-time.md).
@@ -215,7 +238,8 @@ impl Monitor {
             MonitorKind::MaxCrackStrain { .. }
             | MonitorKind::MaxPlasticStrain { .. }
             | MonitorKind::CrushedPoints { .. } => "-",
-            MonitorKind::TendonLoss { .. } => "Pa",
+            MonitorKind::TendonLoss { .. } | MonitorKind::BarLoss { .. } => "Pa",
+            MonitorKind::BarForce { .. } => "N",
         }
     }
 }
@@ -376,7 +400,9 @@ pub struct TendonEl {
     pub ep: f64,
     /// Characteristic tensile strength f_ptk [Pa] (yield at 0.9 f_ptk).
     pub fptk: f64,
-    /// Stress of each span just after stressing (friction losses included) [Pa].
+    /// Stress of each span as stressed, on the geometry at the start of its stressing step
+    /// (friction and set losses included, its own elastic shortening not: the tendon loses
+    /// that during the step) [Pa].
     pub span_stress: Vec<f64>,
     /// Deviator behaviour.
     #[serde(skip)]
@@ -463,6 +489,9 @@ pub struct Bar {
     /// Post-tensioning data of a bonded post-tensioned tendon (None: a bar or pre-tensioned
     /// tendon, bonded from the start with `initial_stress`).
     pub post_tension: Option<PostTension>,
+    /// Relaxation of a tendon's steel during time steps: MC90 class and f_ptk [Pa] (None =
+    /// no relaxation).
+    pub relaxation: Option<(RelaxationClass, f64)>,
 }
 
 /// Post-tensioning of a bonded tendon (docs/theory-prestress.md): not present before

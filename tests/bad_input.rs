@@ -680,7 +680,35 @@ fn bonded_tendon_with_initial_stress() {
     rejects(
         &bonded(&format!("{STRAIGHT}\ninitial_stress = 900e6")),
         "tendons[0].initial_stress",
-        &["[[bars]]"],
+        &["pretensioned"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_without_initial_stress() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.0, 0.1]]").replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].initial_stress",
+        &["missing", "before release"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_with_jacking() {
+    rejects(
+        &bonded(STRAIGHT).replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].jacking_stress",
+        &["pre-tensioned"],
+    );
+}
+
+#[test]
+fn pretensioned_tendon_above_yield() {
+    rejects(
+        &bonded("points = [[0.0, 0.1], [4.0, 0.1]]\ninitial_stress = 1700e6")
+            .replace("\"bonded\"", "\"pretensioned\""),
+        "tendons[0].initial_stress",
+        &["0.9 fptk"],
     );
 }
 
@@ -691,6 +719,16 @@ fn bonded_tendon_chain_with_a_gap() {
         "tendons[0]",
         &["chain part 1"],
     );
+}
+
+#[test]
+fn tendon_monitor_span_out_of_range() {
+    let m = edit(
+        BANDED,
+        "[[supports]]\nname = \"pin\"",
+        "[[tendons]]\nname = \"T\"\nkind = \"external\"\npoints = [[0.0, 0.2], [4.0, 0.2]]\narea = 1e-3\nEp = 195e9\nfptk = 1860e6\ninitial_stress = 1e9\n\n[[monitors]]\nname = \"F\"\nkind = \"tendon_force\"\ntendon = \"T\"\nspan = 2\n\n[[supports]]\nname = \"pin\"",
+    );
+    rejects(&m, "monitors[0].span", &["spans 1 to 1"]);
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Analysis: steps, the Newton loop, and the linear-solver wrapper.
 
+pub mod bonded_time;
 pub mod failure;
 pub mod loads;
 pub mod ordering;

@@ -7,6 +7,7 @@
 //! states equal the committed ones, no crack is latched, and every factorisation is
 //! recomputed from the same matrix.
 
+use super::bonded_time::BarPointTime;
 use super::system::{BarOutput, BarPhase, System};
 use super::time::TendonTime;
 use crate::elements::continuum::GaussOutput;
@@ -76,6 +77,8 @@ pub struct SystemState {
     pub time: TimeContext,
     /// Displacements before the last committed increment [m].
     pub u_prev: Vec<f64>,
+    /// Relaxation and loss records of the bonded-tendon points.
+    pub bar_time: Vec<Option<BarPointTime>>,
 }
 
 /// The committed state of a [`System`], borrowed for writing. Same fields in the same order
@@ -94,6 +97,7 @@ pub struct SystemStateRef<'a> {
     bar_eps_ref: &'a [f64],
     time: TimeContext,
     u_prev: &'a [f64],
+    bar_time: &'a [Option<BarPointTime>],
 }
 
 impl System<'_> {
@@ -125,6 +129,7 @@ impl System<'_> {
             bar_eps_ref: &self.bar_eps_ref,
             time: self.time,
             u_prev: &self.u_prev,
+            bar_time: &self.bar_time,
         }
     }
 
@@ -161,6 +166,7 @@ impl System<'_> {
         check("bar outputs", s.bar_out.len(), self.bar_out.len())?;
         check("bars", s.bar_phase.len(), self.bar_phase.len())?;
         check("bar strains", s.bar_eps_ref.len(), self.bar_eps_ref.len())?;
+        check("bar records", s.bar_time.len(), self.bar_time.len())?;
         if let Some(p) = s
             .committed
             .iter()
@@ -212,6 +218,7 @@ impl System<'_> {
         self.bar_out = s.bar_out;
         self.bar_phase = s.bar_phase;
         self.bar_eps_ref = s.bar_eps_ref;
+        self.bar_time = s.bar_time;
         self.time = s.time;
         self.latched.clear();
         Ok(())

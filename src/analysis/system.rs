@@ -93,6 +93,9 @@ pub struct System<'m> {
     /// Bond strain T B u_e of each bar point when it became bonded [-] (order of `bar_gps`;
     /// 0 for bars bonded from the start): the bar strain is measured from it.
     pub bar_eps_ref: Vec<f64>,
+    /// Relaxation and loss records of the bonded-tendon points (order of `bar_gps`; None
+    /// for plain bars and tendons not yet stressed; see `analysis::bonded_time`).
+    pub bar_time: Vec<Option<super::bonded_time::BarPointTime>>,
 }
 
 /// Stage of an embedded bar or bonded tendon.
@@ -269,6 +272,7 @@ impl<'m> System<'m> {
                 })
                 .collect(),
             bar_eps_ref: vec![0.0; n_bp],
+            bar_time: vec![None; n_bp],
         }
     }
 
@@ -376,6 +380,7 @@ impl<'m> System<'m> {
             let bar_gps = &self.bar_gps;
             let bar_phase = &self.bar_phase;
             let bar_eps_ref = &self.bar_eps_ref[b0..b1];
+            let bar_time = &self.bar_time[b0..b1];
             let latched = &self.latched;
             let bar_offset = &self.bar_offset;
             let (mut bt_rest, mut bo_rest) =
@@ -461,6 +466,10 @@ impl<'m> System<'m> {
                     {
                         let bar = &model.bars[b];
                         let bp = &bar.points[p].point;
+                        // Relaxation of a tendon's steel: a stress-free strain.
+                        let relax = bar_time[bc0 + i]
+                            .as_ref()
+                            .map_or(0.0, |r| r.relax_strain_trial);
                         match bar_phase[b] {
                             BarPhase::Inactive => {
                                 *st = bar_committed[bc0 + i];
@@ -468,7 +477,7 @@ impl<'m> System<'m> {
                                 continue;
                             }
                             BarPhase::Locked => {
-                                let sig = bar.bonding_stress(p);
+                                let sig = bar.bonding_stress(p) - bar.steel.es * relax;
                                 *st = bar_committed[bc0 + i];
                                 *out = BarOutput {
                                     strain: sig / bar.steel.es,
@@ -487,7 +496,8 @@ impl<'m> System<'m> {
                         let g = bar_strain_vector(el.kind, coords, bp);
                         let eps = g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>()
                             - bar_eps_ref[bc0 + i]
-                            + bar.bonding_stress(p) / bar.steel.es;
+                            + bar.bonding_stress(p) / bar.steel.es
+                            - relax;
                         let (s_new, sig, et) =
                             update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
                         *st = s_new;

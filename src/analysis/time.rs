@@ -81,6 +81,7 @@ impl System<'_> {
     pub fn begin_time_increment(&mut self, time: TimeContext) {
         self.time = time;
         let dt = time.dt();
+        self.begin_bonded_time(dt);
         for t in 0..self.tendons.len() {
             let Some(el) = self.tendons[t].as_ref() else {
                 continue;
@@ -164,6 +165,7 @@ impl System<'_> {
     /// tendon states replace the committed ones: the loss split and the relaxation chains.
     pub(crate) fn commit_time_dependent(&mut self) {
         let dt = self.time.dt();
+        self.commit_bonded_time(dt);
         for t in 0..self.tendon_time.len() {
             let (Some(tt), Some(old), Some(new)) = (
                 self.tendon_time[t].as_mut(),

@@ -350,7 +350,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     // External tendons go to `model.tendons`; bonded post-tensioned ones become bars (below).
     let mut external_of = vec![None; file.tendons.len()];
     for (i, t) in file.tendons.iter().enumerate() {
-        if t.kind == "bonded" {
+        if is_bonded_kind(&t.kind) {
             continue;
         }
         let tendon = build_tendon(ctx, i, t, &model, &used, &mut warnings)?;
@@ -450,6 +450,14 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     )?;
     for (i, m) in file.monitors.iter().enumerate() {
         let key = format!("monitors[{i}]");
+        // The bar of a bonded (post- or pre-tensioned) tendon named by `tendon`.
+        let bonded_bar = m.tendon.as_deref().and_then(|n| {
+            file.tendons
+                .iter()
+                .any(|t| t.name == n && is_bonded_kind(&t.kind))
+                .then(|| model.bars.iter().position(|b| b.name == n))
+                .flatten()
+        });
         let kind = match m.kind.as_str() {
             "displacement" => {
                 let node = locate_nodes(ctx, &key, &model, &used, m.node, m.point, None)?[0];
@@ -493,7 +501,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     )?,
                 }
             }
-            "tendon_force" => {
+            "tendon_force" if bonded_bar.is_none() => {
                 let tendon = required_ref(
                     ctx,
                     &format!("{key}.tendon"),
@@ -501,26 +509,32 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     m.tendon.as_deref(),
                     model.tendons.iter().map(|t| t.name.as_str()),
                 )?;
-                MonitorKind::TendonForce { tendon }
+                let span = span_of(ctx, &key, m, &model.tendons[tendon])?;
+                MonitorKind::TendonForce { tendon, span }
             }
-            "tendon_stress"
-                if m.tendon.as_deref().is_some_and(|n| {
-                    model
-                        .bars
-                        .iter()
-                        .any(|b| b.name == n && b.post_tension.is_some())
-                }) =>
+            "tendon_stress" | "tendon_force" | "tendon_loss" | "tendon_loss_elastic"
+            | "tendon_loss_creep" | "tendon_loss_relaxation"
+                if bonded_bar.is_some() =>
             {
-                // A bonded tendon is a bar: its largest stress (or at the point nearest
-                // `point`) as for bar_stress.
-                let name = m.tendon.as_deref().expect("checked");
-                let bar = model
-                    .bars
-                    .iter()
-                    .position(|b| b.name == name)
-                    .expect("checked");
+                // A bonded tendon is a bar: at the point nearest `point`, else its largest
+                // stress or force, or its mean loss.
+                let bar = bonded_bar.expect("guarded");
+                if m.span.is_some() {
+                    return Err(ctx.err(
+                        format!("{key}.span"),
+                        "spans are for external tendons: a bonded tendon takes `point`",
+                    ));
+                }
                 let point = m.point.map(|p| nearest_bar_point(&model.bars[bar], p));
-                MonitorKind::BarStress { bar, point }
+                match m.kind.as_str() {
+                    "tendon_stress" => MonitorKind::BarStress { bar, point },
+                    "tendon_force" => MonitorKind::BarForce { bar, point },
+                    kind => MonitorKind::BarLoss {
+                        bar,
+                        point,
+                        part: loss_part(kind),
+                    },
+                }
             }
             "tendon_stress" | "tendon_loss" | "tendon_loss_elastic" | "tendon_loss_creep"
             | "tendon_loss_relaxation" => {
@@ -533,13 +547,13 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 )?;
                 let part = match m.kind.as_str() {
                     "tendon_stress" => None,
-                    "tendon_loss" => Some(LossPart::Total),
-                    "tendon_loss_elastic" => Some(LossPart::Elastic),
-                    "tendon_loss_creep" => Some(LossPart::CreepShrinkage),
-                    _ => Some(LossPart::Relaxation),
+                    kind => Some(loss_part(kind)),
                 };
                 match part {
-                    None => MonitorKind::TendonStress { tendon },
+                    None => MonitorKind::TendonStress {
+                        tendon,
+                        span: span_of(ctx, &key, m, &model.tendons[tendon])?,
+                    },
                     Some(part) => MonitorKind::TendonLoss { tendon, part },
                 }
             }
@@ -730,6 +744,9 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .unwrap_or(DEFAULT_START_DAY);
     check_ages(ctx, &model, start, &mut warnings)?;
     for (i, t) in file.tendons.iter().enumerate() {
+        if t.kind == "pretensioned" {
+            continue;
+        }
         let step_of = |key: &str, name: &str| {
             index_by_name(
                 ctx,
@@ -1514,7 +1531,13 @@ fn build_tendon(
 ) -> R<TendonEl> {
     let k = |f: &str| format!("tendons[{i}].{f}");
     if t.kind != "external" {
-        return Err(ctx.err(k("kind"), format!("unknown tendon kind '{}' (expected external or bonded; pre-tensioned tendons are [[bars]] with an initial stress)", t.kind)));
+        return Err(ctx.err(
+            k("kind"),
+            format!(
+                "unknown tendon kind '{}' (expected external, bonded or pretensioned)",
+                t.kind
+            ),
+        ));
     }
     for (key, given) in [
         ("parabola", t.parabola.is_some()),
@@ -1653,34 +1676,14 @@ fn build_tendon(
         mode,
     )
     .map_err(|e| ctx.err(k("points"), e.to_string()))?;
-    let relaxation = match t.relaxation_class {
-        None => None,
-        Some(c) => {
-            use crate::materials::mc90_time::RelaxationClass;
-            let class = match c {
-                1 => RelaxationClass::Class1,
-                2 => RelaxationClass::Class2,
-                3 => RelaxationClass::Class3,
-                o => {
-                    return Err(ctx.err(
-                        k("relaxation_class"),
-                        format!("unknown relaxation class {o} (expected 1 = normal strands/wires, 2 = low relaxation, 3 = bars)"),
-                    ))
-                }
-            };
-            for &s in &span_stress {
-                crate::materials::chain::SteelRelaxationChain::fit(class, s / fptk, ep).map_err(
-                    |e| {
-                        ctx.err(
-                            k("relaxation_class"),
-                            format!("relaxation at {s} Pa cannot be represented: {e}"),
-                        )
-                    },
-                )?;
-            }
-            Some(class)
-        }
-    };
+    let relaxation = relaxation_of(
+        ctx,
+        &k("relaxation_class"),
+        t.relaxation_class,
+        &span_stress,
+        fptk,
+        ep,
+    )?;
     Ok(TendonEl {
         relaxation,
         name: t.name.clone(),
@@ -1692,6 +1695,72 @@ fn build_tendon(
         mode,
         stressed_in_step: 0,
     })
+}
+
+/// The span (0-based) a `tendon_stress`/`tendon_force` monitor of an external tendon names
+/// with its 1-based `span` key (None: the largest over the spans).
+fn span_of(ctx: &Ctx, key: &str, m: &MonitorIn, tendon: &TendonEl) -> R<Option<usize>> {
+    let Some(k) = m.span else { return Ok(None) };
+    let n = tendon.nodes.len() - 1;
+    if k < 1 || k as usize > n {
+        return Err(ctx.err(
+            format!("{key}.span"),
+            format!(
+                "tendon '{}' has spans 1 to {n} (between its anchors and deviators), not {k}",
+                tendon.name
+            ),
+        ));
+    }
+    Ok(Some(k as usize - 1))
+}
+
+/// The loss part of a `tendon_loss*` monitor kind.
+fn loss_part(kind: &str) -> LossPart {
+    match kind {
+        "tendon_loss" => LossPart::Total,
+        "tendon_loss_elastic" => LossPart::Elastic,
+        "tendon_loss_creep" => LossPart::CreepShrinkage,
+        _ => LossPart::Relaxation,
+    }
+}
+
+/// True for the tendon kinds that are embedded bars (bonded post-tensioned, pre-tensioned).
+fn is_bonded_kind(kind: &str) -> bool {
+    kind == "bonded" || kind == "pretensioned"
+}
+
+/// The relaxation class `class` of a tendon (key `key`), checked to be representable at each
+/// of the initial `stresses` [Pa] (None = no relaxation).
+fn relaxation_of(
+    ctx: &Ctx,
+    key: &str,
+    class: Option<i64>,
+    stresses: &[f64],
+    fptk: f64,
+    ep: f64,
+) -> R<Option<crate::materials::mc90_time::RelaxationClass>> {
+    use crate::materials::mc90_time::RelaxationClass;
+    let Some(c) = class else { return Ok(None) };
+    let class = match c {
+        1 => RelaxationClass::Class1,
+        2 => RelaxationClass::Class2,
+        3 => RelaxationClass::Class3,
+        o => {
+            return Err(ctx.err(
+                key,
+                format!("unknown relaxation class {o} (expected 1 = normal strands/wires, 2 = low relaxation, 3 = bars)"),
+            ))
+        }
+    };
+    for &s in stresses {
+        crate::materials::chain::SteelRelaxationChain::fit(class, s / fptk, ep).map_err(|e| {
+            ctx.err(
+                key,
+                format!("relaxation at {s} Pa cannot be represented: {e}"),
+            )
+        })?;
+    }
+    Ok(Some(class))
 }
 
 /// The stress at the jack from `jacking_stress` or `jacking_force` / area (None if neither),
@@ -2192,7 +2261,7 @@ fn build_bars(
     steels: &[(String, SteelParams)],
     model: &mut Model,
 ) -> R<()> {
-    if bars.is_empty() && !tendons.iter().any(|t| t.kind == "bonded") {
+    if bars.is_empty() && !tendons.iter().any(|t| is_bonded_kind(&t.kind)) {
         return Ok(());
     }
     unique_names(ctx, "bars", bars.iter().map(|b| b.name.as_str()))?;
@@ -2285,10 +2354,17 @@ fn build_bars(
             piece_ends: e.piece_ends,
             piece_points: e.piece_points,
             post_tension: None,
+            relaxation: None,
         });
     }
     for (i, t) in tendons.iter().enumerate() {
-        if t.kind != "bonded" {
+        if !is_bonded_kind(&t.kind) {
+            continue;
+        }
+        if t.kind == "pretensioned" {
+            out.push(pretensioned_tendon(
+                ctx, i, t, bars, &embedder, model, &coords,
+            )?);
             continue;
         }
         let key = format!("tendons[{i}]");
@@ -2304,12 +2380,11 @@ fn build_bars(
             ("initial_stress", t.initial_stress.is_some()),
             ("deviators", t.deviators.is_some()),
             ("deviator_friction", t.deviator_friction.is_some()),
-            ("relaxation_class", t.relaxation_class.is_some()),
         ] {
             if given {
                 return Err(ctx.err(
                     k(f),
-                    format!("{named}: not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is a [[bars]] entry with initial_stress)"),
+                    format!("{named}: not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is kind = \"pretensioned\" with initial_stress)"),
                 ));
             }
         }
@@ -2374,6 +2449,14 @@ fn build_bars(
             &samples,
         )
         .map_err(|err| ctx.err(k("anchorage_set"), format!("{named}: {err}")))?;
+        let relaxation = relaxation_of(
+            ctx,
+            &k("relaxation_class"),
+            t.relaxation_class,
+            &lock.stress,
+            fptk,
+            ep,
+        )?;
         out.push(Bar {
             name: t.name.clone(),
             area,
@@ -2390,10 +2473,117 @@ fn build_bars(
                 jacking_stress: sigma_pi,
                 set_length: lock.set_length,
             }),
+            relaxation: relaxation.map(|c| (c, fptk)),
         });
     }
     model.bars = out;
     Ok(())
+}
+
+/// A pre-tensioned tendon (`kind = "pretensioned"`): an embedded prestressing-steel bar
+/// bonded from the start that carries `initial_stress` at zero displacement (the stress in
+/// the bed before release); its elastic shortening at transfer follows from equilibrium.
+#[allow(clippy::too_many_arguments)]
+fn pretensioned_tendon(
+    ctx: &Ctx,
+    i: usize,
+    t: &TendonIn,
+    bars: &[BarIn],
+    embedder: &BarEmbedder,
+    model: &Model,
+    coords: &[Vec<[f64; 2]>],
+) -> R<Bar> {
+    let key = format!("tendons[{i}]");
+    let k = |f: &str| format!("{key}.{f}");
+    let named = format!("tendon '{}'", t.name);
+    if bars.iter().any(|b| b.name == t.name) {
+        return Err(ctx.err(
+            k("name"),
+            format!("{named}: a bar has the same name (bonded tendons are output as bars)"),
+        ));
+    }
+    for (f, given) in [
+        ("jacking_stress", t.jacking_stress.is_some()),
+        ("jacking_force", t.jacking_force.is_some()),
+        ("jacking", t.jacking.is_some()),
+        ("friction", t.friction.is_some()),
+        ("wobble", t.wobble.is_some()),
+        ("anchorage_set", t.anchorage_set.is_some()),
+        ("deviators", t.deviators.is_some()),
+        ("deviator_friction", t.deviator_friction.is_some()),
+        ("stressed_in_step", t.stressed_in_step.is_some()),
+        ("grouted_in_step", t.grouted_in_step.is_some()),
+    ] {
+        if given {
+            return Err(ctx.err(
+                k(f),
+                format!("{named}: not a key of a pre-tensioned tendon (bonded from the start with initial_stress, the stress before release)"),
+            ));
+        }
+    }
+    let area = positive(ctx, &k("area"), t.area)?;
+    if area > 0.1 {
+        return Err(ctx.err(
+            k("area"),
+            format!("{named}: {area} m² is not a tendon area (units are m²)"),
+        ));
+    }
+    let ep = positive(ctx, &k("Ep"), t.ep)?;
+    let fptk = positive(ctx, &k("fptk"), t.fptk)?;
+    if fptk >= ep {
+        return Err(ctx.err(
+            k("fptk"),
+            format!("{named}: must be far below Ep (units are Pa)"),
+        ));
+    }
+    let s0 = t.initial_stress.ok_or_else(|| {
+        ctx.err(
+            k("initial_stress"),
+            format!("{named}: missing: the stress before release [Pa]"),
+        )
+    })?;
+    if !(s0.is_finite() && s0 > 0.0 && s0 < 0.9 * fptk) {
+        return Err(ctx.err(
+            k("initial_stress"),
+            format!("{named}: must lie in (0, 0.9 fptk) (got {s0} Pa)"),
+        ));
+    }
+    let relaxation = relaxation_of(
+        ctx,
+        &k("relaxation_class"),
+        t.relaxation_class,
+        &[s0],
+        fptk,
+        ep,
+    )?;
+    let points = (!t.points.is_empty()).then_some(&t.points);
+    let path = path_of(
+        ctx,
+        &key,
+        &named,
+        "points",
+        points,
+        t.parabola.as_ref(),
+        t.arc.as_ref(),
+        t.segments.as_ref(),
+    )?;
+    let n_gauss = t.gauss_points.unwrap_or(4);
+    if !(1..=64).contains(&n_gauss) {
+        return Err(ctx.err(k("gauss_points"), format!("{named}: must lie in 1..=64")));
+    }
+    let e = embed_path(ctx, &key, &named, embedder, model, coords, &path, n_gauss)?;
+    Ok(Bar {
+        name: t.name.clone(),
+        area,
+        steel: SteelParams::prestressing(ep, fptk),
+        initial_stress: s0,
+        n_pieces: e.piece_points.len(),
+        points: e.points,
+        piece_ends: e.piece_ends,
+        piece_points: e.piece_points,
+        post_tension: None,
+        relaxation: relaxation.map(|c| (c, fptk)),
+    })
 }
 
 /// Optional region by name (None = all regions).

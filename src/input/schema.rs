@@ -252,6 +252,7 @@ pub struct MonitorIn {
     pub case: Option<String>,
     pub joint: Option<String>,
     pub tendon: Option<String>,
+    pub span: Option<i64>,
     pub since_step: Option<String>,
     pub bar: Option<String>,
     pub region: Option<String>,

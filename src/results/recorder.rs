@@ -177,13 +177,13 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
-                MonitorKind::TendonStress { tendon } => snap.system.tendon_committed[*tendon]
+                MonitorKind::TendonStress { tendon, span } => snap.system.tendon_committed[*tendon]
                     .as_ref()
-                    .map(|st| st.stresses().into_iter().fold(0.0, f64::max))
+                    .map(|st| pick_span(st.stresses(), *span))
                     .unwrap_or(0.0),
-                MonitorKind::TendonForce { tendon } => snap.system.tendon_committed[*tendon]
+                MonitorKind::TendonForce { tendon, span } => snap.system.tendon_committed[*tendon]
                     .as_ref()
-                    .map(|st| st.forces().into_iter().fold(0.0, f64::max))
+                    .map(|st| pick_span(st.forces(), *span))
                     .unwrap_or(0.0),
                 MonitorKind::TendonLoss { tendon, part } => snap.system.tendon_time[*tendon]
                     .as_ref()
@@ -199,6 +199,12 @@ impl<'m> Recorder<'m> {
                     .map(|j| summarise(snap.system, j).max_slip)
                     .fold(0.0, f64::max),
                 MonitorKind::BarStress { bar, point } => bar_stress(snap, *bar, *point),
+                MonitorKind::BarForce { bar, point } => {
+                    self.model.bars[*bar].area * bar_stress(snap, *bar, *point)
+                }
+                MonitorKind::BarLoss { bar, point, part } => {
+                    snap.system.bar_loss(*bar, *point, *part)
+                }
                 MonitorKind::MaxCrackStrain { region } => {
                     point_extreme(snap, *region, |p| p.crack_strain())
                 }
@@ -481,6 +487,14 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
             },
         ],
     ))
+}
+
+/// The value of span `span` of a tendon, or the largest over its spans.
+fn pick_span(values: Vec<f64>, span: Option<usize>) -> f64 {
+    match span {
+        Some(k) => values.get(k).copied().unwrap_or(0.0),
+        None => values.into_iter().fold(0.0, f64::max),
+    }
 }
 
 /// Stress of a bar [Pa] at one of its points, or the value of largest magnitude.
