@@ -1071,7 +1071,7 @@ pub fn bar_strain_vector(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> V
     g
 }
 
-/// Green strain along the bar for the total Lagrangian kinematics (docs/theory-bars.md,
+/// Green strain along the bar for the total Lagrangian kinematics (docs/theory.md,
 /// "Geometric nonlinearity"): with t the bar's unit direction on the undeformed geometry,
 /// d_a = t·∇N_a [1/m] and F t = t + Σ_a d_a u_a the stretched tangent,
 /// E_b = tᵀ E t = t·(H t) + ½ |H t|² [-], δE_b = g·δu_e with g_a = d_a (F t) [1/m] and
