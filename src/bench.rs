@@ -95,6 +95,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
             time: None,
         }],
         controls: SolverControls::default(),
+        geometry: Default::default(),
         bars: Vec::new(),
     };
     let wall: Vec<(usize, Dir, f64)> = model

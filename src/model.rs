@@ -321,6 +321,18 @@ pub struct Step {
     pub time: Option<TimeSpan>,
 }
 
+/// Kinematics of the concrete continuum and the embedded bars (`[analysis] geometry`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum Geometry {
+    /// Small displacements: linear strain ε = sym ∇u on the undeformed geometry.
+    #[default]
+    Linear,
+    /// Total Lagrangian: Green–Lagrange strain and second Piola–Kirchhoff stress on the
+    /// undeformed geometry (small strain, large rotation; docs/theory.md, "Geometric
+    /// nonlinearity").
+    Nonlinear,
+}
+
 /// Newton and step-cutting controls.
 #[derive(Debug, Clone, Serialize)]
 pub struct SolverControls {
@@ -442,6 +454,8 @@ pub struct Model {
     pub steps: Vec<Step>,
     /// Solver controls.
     pub controls: SolverControls,
+    /// Kinematics of the continuum and the embedded bars.
+    pub geometry: Geometry,
     /// Embedded bars and bonded tendons.
     pub bars: Vec<Bar>,
 }

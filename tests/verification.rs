@@ -83,6 +83,7 @@ fn model_from_mesh(
             time: None,
         }],
         controls: SolverControls::default(),
+        geometry: Default::default(),
         bars: Vec::new(),
     }
 }

@@ -1,15 +1,16 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
 
-use crate::elements::bar::bar_strain_vector;
+use crate::elements::bar::{bar_green_strain, bar_strain_vector};
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
+use crate::elements::total_lagrangian;
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
 use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext, UpdateError};
 use crate::materials::steel::{update_uniaxial, SteelState};
-use crate::model::Model;
+use crate::model::{Geometry, Model};
 use rayon::prelude::*;
 
 /// Elements per parallel chunk: large enough to amortise scheduling, small enough to keep the
@@ -44,7 +45,8 @@ pub struct System<'m> {
     pub gauss: Vec<GaussOutput>,
     /// Trial Gauss outputs.
     pub gauss_trial: Vec<GaussOutput>,
-    /// True if every material is linear and there are no joints (tangent constant).
+    /// True if every material is linear, the geometry is linear and there are no joints
+    /// (tangent constant).
     pub linear: bool,
     /// Joint contact elements (geometry from the contact search, done once).
     pub interfaces: Vec<InterfaceElement>,
@@ -123,6 +125,84 @@ pub struct BarOutput {
     pub plastic_strain: f64,
 }
 
+/// One embedded-bar point of a host element under the total Lagrangian kinematics.
+struct TlBar<'a> {
+    kind: crate::fem::shape::QuadKind,
+    coords: &'a [[f64; 2]],
+    bar: &'a crate::model::Bar,
+    /// Point index in the bar.
+    p: usize,
+    phase: BarPhase,
+    committed: &'a SteelState,
+    /// Green strain along the bar when it was bonded [-].
+    eps_ref: f64,
+    /// Relaxation strain of a tendon's steel (stress-free) [-].
+    relax: f64,
+}
+
+/// Add one bar point's force to `fe` [N] and, if given, its tangent to `ke` [N/m] with the
+/// total Lagrangian kinematics (see [`bar_green_strain`]): E_b = Green strain along the bar,
+/// σ_b from the steel law at E_b − ε_ref + σ_b,0/E_s, f += g σ A w,
+/// K += g E_t A w gᵀ + σ A w (d dᵀ ⊗ I₂). A locked-off, ungrouted tendon keeps its stress;
+/// its equivalent forces turn with the concrete (f += g σ_lock A w with the geometric term
+/// in K). The trial state and output go to `st` and `out`.
+fn tl_bar_point(
+    b: TlBar,
+    ue: &[f64],
+    fe: &mut [f64],
+    ke: Option<&mut [f64]>,
+    st: &mut SteelState,
+    out: &mut BarOutput,
+) {
+    let nd = ue.len();
+    let bp = &b.bar.points[b.p].point;
+    if b.phase == BarPhase::Inactive {
+        *st = *b.committed;
+        *out = BarOutput::default();
+        return;
+    }
+    let (e_b, g, d) = bar_green_strain(b.kind, b.coords, bp, ue);
+    let (sig, et) = if b.phase == BarPhase::Locked {
+        let sig = b.bar.bonding_stress(b.p) - b.bar.steel.es * b.relax;
+        *st = *b.committed;
+        *out = BarOutput {
+            strain: sig / b.bar.steel.es,
+            stress: sig,
+            plastic_strain: 0.0,
+        };
+        (sig, 0.0)
+    } else {
+        let eps = e_b - b.eps_ref + b.bar.bonding_stress(b.p) / b.bar.steel.es - b.relax;
+        let (s_new, sig, et) = update_uniaxial(&b.bar.steel, b.committed, eps);
+        *st = s_new;
+        *out = BarOutput {
+            strain: eps,
+            stress: sig,
+            plastic_strain: s_new.plastic_strain,
+        };
+        (sig, et)
+    };
+    let aw = b.bar.area * bp.weight_length;
+    let (fs, ks) = (sig * aw, et * aw);
+    for r in 0..nd {
+        fe[r] += g[r] * fs;
+    }
+    let Some(ke) = ke else {
+        return;
+    };
+    for r in 0..nd {
+        let gr = g[r] * ks;
+        let dr = d[r / 2] * fs;
+        for c in 0..nd {
+            let mut v = gr * g[c];
+            if r % 2 == c % 2 {
+                v += dr * d[c / 2];
+            }
+            ke[r * nd + c] += v;
+        }
+    }
+}
+
 /// Replace a square row-major matrix of order n by its symmetric part.
 fn symmetrise(k: &mut [f64], n: usize) {
     for i in 0..n {
@@ -198,7 +278,8 @@ impl<'m> System<'m> {
         }
         let linear = model.materials.iter().all(|m| m.law.is_linear())
             && model.interfaces.is_empty()
-            && model.bars.is_empty();
+            && model.bars.is_empty()
+            && model.geometry == Geometry::Linear;
         let n_gp = committed.len();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
@@ -356,6 +437,9 @@ impl<'m> System<'m> {
         let mut k_values = tangent.then(|| vec![0.0; self.asm.pattern.nnz()]);
         let n_el = model.elements.len();
         let time = self.time;
+        // Total Lagrangian continuum and bars (a separate code path: the linear one is
+        // untouched).
+        let tl = model.geometry == Geometry::Nonlinear;
         let mut start = 0;
         // Element vectors and matrices of one chunk, allocated once per assembly (the
         // element loop itself does not allocate).
@@ -438,20 +522,38 @@ impl<'m> System<'m> {
                             }
                             v
                         });
-                    continuum::response_at(
-                        el.kind,
-                        el.integration,
-                        coords,
-                        region.thickness,
-                        mat,
-                        owned.as_deref().unwrap_or(base),
-                        ue,
-                        fe,
-                        tangent.then_some(&mut *ke),
-                        t,
-                        o,
-                        &time,
-                    )
+                    let states = owned.as_deref().unwrap_or(base);
+                    if tl {
+                        total_lagrangian::response_tl(
+                            el.kind,
+                            el.integration,
+                            coords,
+                            region.thickness,
+                            mat,
+                            states,
+                            ue,
+                            fe,
+                            tangent.then_some(&mut *ke),
+                            t,
+                            o,
+                            &time,
+                        )
+                    } else {
+                        continuum::response_at(
+                            el.kind,
+                            el.integration,
+                            coords,
+                            region.thickness,
+                            mat,
+                            states,
+                            ue,
+                            fe,
+                            tangent.then_some(&mut *ke),
+                            t,
+                            o,
+                            &time,
+                        )
+                    }
                     .map_err(|err| (e, err))?;
                     // Embedded bars hosted by this element: uniaxial steel at each point,
                     // ε_b = T(φ) B u_e − ε_ref + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
@@ -470,6 +572,26 @@ impl<'m> System<'m> {
                         let relax = bar_time[bc0 + i]
                             .as_ref()
                             .map_or(0.0, |r| r.relax_strain_trial);
+                        if tl {
+                            tl_bar_point(
+                                TlBar {
+                                    kind: el.kind,
+                                    coords,
+                                    bar,
+                                    p,
+                                    phase: bar_phase[b],
+                                    committed: &bar_committed[bc0 + i],
+                                    eps_ref: bar_eps_ref[bc0 + i],
+                                    relax,
+                                },
+                                ue,
+                                fe,
+                                tangent.then_some(&mut *ke),
+                                st,
+                                out,
+                            );
+                            continue;
+                        }
                         match bar_phase[b] {
                             BarPhase::Inactive => {
                                 *st = bar_committed[bc0 + i];
@@ -658,13 +780,23 @@ impl<'m> System<'m> {
                     let gp = &bar.points[p];
                     let el = &model.elements[gp.element];
                     let coords = model.element_coords(el);
-                    let g = bar_strain_vector(el.kind, &coords, &gp.point);
-                    self.bar_eps_ref[i] = el
-                        .nodes
-                        .iter()
-                        .enumerate()
-                        .map(|(a, &n)| g[2 * a] * self.u[2 * n] + g[2 * a + 1] * self.u[2 * n + 1])
-                        .sum();
+                    self.bar_eps_ref[i] = if model.geometry == Geometry::Nonlinear {
+                        let ue: Vec<f64> = el
+                            .nodes
+                            .iter()
+                            .flat_map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+                            .collect();
+                        bar_green_strain(el.kind, &coords, &gp.point, &ue).0
+                    } else {
+                        let g = bar_strain_vector(el.kind, &coords, &gp.point);
+                        el.nodes
+                            .iter()
+                            .enumerate()
+                            .map(|(a, &n)| {
+                                g[2 * a] * self.u[2 * n] + g[2 * a + 1] * self.u[2 * n + 1]
+                            })
+                            .sum()
+                    };
                 }
                 self.bar_phase[b] = BarPhase::Bonded;
             }

@@ -44,7 +44,7 @@ pub struct GaussOutput {
 
 /// Strain–displacement matrix rows at one point: (∂N/∂x, ∂N/∂y) per node, and the
 /// integration factor w·det J [m²].
-fn point_derivatives(
+pub(crate) fn point_derivatives(
     kind: QuadKind,
     coords: &[[f64; 2]],
     p: &Point2,

@@ -4,3 +4,4 @@ pub mod bar;
 pub mod continuum;
 pub mod interface;
 pub mod tendon;
+pub mod total_lagrangian;

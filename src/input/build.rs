@@ -262,6 +262,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         monitors: Vec::new(),
         steps: Vec::new(),
         controls: SolverControls::default(),
+        geometry: Default::default(),
         bars: Vec::new(),
     };
     units::model_size(&mut warnings, ctx, locate::model_size(&model));
@@ -599,6 +600,18 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             kind,
         });
     }
+    if let Some(a) = &file.analysis {
+        model.geometry = match a.geometry.as_deref() {
+            None | Some("linear") => Geometry::Linear,
+            Some("nonlinear") => Geometry::Nonlinear,
+            Some(o) => {
+                return Err(ctx.err(
+                    "analysis.geometry",
+                    format!("unknown geometry '{o}' (expected linear or nonlinear)"),
+                ))
+            }
+        };
+    }
     // Steps.
     if file.steps.is_empty() {
         return Err(ctx.err("steps", "no steps given: add at least one [[steps]] table"));
@@ -616,6 +629,13 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                     return Err(ctx.err(
                         format!("{key}.kind"),
                         "a linear step needs linear materials; use kind = \"load\"",
+                    ));
+                }
+                // One solve with the initial stiffness cannot follow nonlinear geometry.
+                if model.geometry == Geometry::Nonlinear {
+                    return Err(ctx.err(
+                        format!("{key}.kind"),
+                        "a linear step needs analysis.geometry = \"linear\"; use kind = \"load\"",
                     ));
                 }
                 StepKind::Linear

@@ -30,6 +30,7 @@ pub struct File {
     pub solver: Option<SolverIn>,
     #[serde(default)]
     pub bars: Vec<BarIn>,
+    pub analysis: Option<AnalysisIn>,
 }
 
 /// `viscoplastic = { ... }` of a concrete material (Owen–Hinton option).
@@ -338,4 +339,10 @@ pub struct SolverIn {
     pub energy_tolerance: Option<f64>,
     pub max_iterations: Option<usize>,
     pub max_cuts: Option<usize>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisIn {
+    pub geometry: Option<String>,
 }
