@@ -521,3 +521,145 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         own_factor_nnz,
     })
 }
+
+/// Figures of the RC-beam benchmark (issue #4 item 8).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RcRow {
+    /// Case name.
+    pub case: String,
+    /// Free equations.
+    pub equations: usize,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations of the converged increments.
+    pub iterations: usize,
+    /// Whole run, including a failed last increment [s].
+    pub total_s: f64,
+    /// Largest load per load point reached [N].
+    pub p_max: f64,
+    /// Midspan deflection at the last converged increment [m].
+    pub deflection: f64,
+    /// How the run ended ("completed" or the first line of the error).
+    pub end: String,
+}
+
+/// Counts increments and iterations, follows the control force and the midspan deflection.
+#[derive(Default)]
+struct RcWatch {
+    increments: usize,
+    iterations: usize,
+    p_max: f64,
+    deflection: f64,
+}
+
+impl Observer for RcWatch {
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        self.increments += 1;
+        self.iterations += snap.iterations;
+        self.p_max = self.p_max.max(-snap.control_force.unwrap_or(0.0));
+        let m = snap.system.model;
+        if let Some(n) = m
+            .nodes
+            .iter()
+            .position(|p| (p[0] - 1.6).abs() < 1e-9 && p[1].abs() < 1e-9)
+        {
+            self.deflection = -snap.system.u[2 * n + 1];
+        }
+        Ok(())
+    }
+}
+
+/// The bundled RC beam (examples/rc-beam.toml) with its mesh refined `refine` times in both
+/// directions (1: 32 × 10 Q8; 5: 160 × 50 Q8, about 5e4 equations), taken to failure.
+pub fn rc_case(refine: usize) -> Result<RcRow, String> {
+    let r = refine.max(1);
+    let text = include_str!("../examples/rc-beam.toml")
+        .replace("nx = 32\n", &format!("nx = {}\n", 32 * r))
+        .replace("rows = 10 }", &format!("rows = {} }}", 10 * r));
+    if r > 1 && !text.contains(&format!("nx = {}\n", 32 * r)) {
+        return Err("rc-beam.toml changed: cannot refine its mesh".into());
+    }
+    let t0 = Instant::now();
+    let model = crate::input::parse(&text, "rc-beam.toml")
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = RcWatch::default();
+    let end = match steps::run(&model, &mut obs) {
+        Ok(_) => "completed".to_string(),
+        Err(e) => e.to_string().lines().next().unwrap_or("").to_string(),
+    };
+    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(RcRow {
+        case: format!("RC beam, {} rows", 10 * r),
+        equations,
+        increments: obs.increments,
+        iterations: obs.iterations,
+        total_s: t0.elapsed().as_secs_f64(),
+        p_max: obs.p_max,
+        deflection: obs.deflection,
+        end,
+    })
+}
+
+/// Concrete material-point updates per second (issue #4 item 8), single thread: a cracked
+/// point (one crack opened to 4 ε0, strains around it, implicit and IMPL-EX laws) and a
+/// plastic point (biaxial compression past initial yield). Returns (label, updates/s).
+pub fn material_point_rates(n: usize) -> Vec<(String, f64)> {
+    use crate::materials::concrete::{update, update_extrapolated, ConcreteParams, ConcreteState};
+    use std::hint::black_box;
+    let mut p = ConcreteParams::from_mc90(38e6, 0.2);
+    p.initial_yield_ratio = 0.3;
+    let e0 = p.eps0();
+    let virgin = ConcreteState::new();
+    let cracked = update(&p, &virgin, &[4.0 * e0, 0.0, 0.0], 0.1)
+        .expect("cracking update")
+        .0;
+    let ec = -0.6 * p.fcm / p.ec;
+    let plastic = update(&p, &virgin, &[ec, 0.3 * ec, 0.0], 0.1)
+        .expect("plastic update")
+        .0;
+    let mut implex = p.clone();
+    implex.implex = true;
+    let rate = |f: &dyn Fn(f64) -> f64| {
+        let t = Instant::now();
+        let mut acc = 0.0;
+        for i in 0..n {
+            acc += f((i % 1000) as f64 / 1000.0);
+        }
+        black_box(acc);
+        n as f64 / t.elapsed().as_secs_f64()
+    };
+    vec![
+        (
+            "cracked (implicit)".into(),
+            rate(&|s| {
+                let e = [(4.0 + s) * e0, -0.2 * e0, 0.5 * s * e0];
+                black_box(update(&p, &cracked, black_box(&e), 0.1).map_or(0.0, |r| r.1[0]))
+            }),
+        ),
+        (
+            "cracked (IMPL-EX)".into(),
+            rate(&|s| {
+                let e = [(4.0 + s) * e0, -0.2 * e0, 0.5 * s * e0];
+                black_box(
+                    update_extrapolated(&implex, &cracked, black_box(&e), 0.1, 1.0)
+                        .map_or(0.0, |r| r.1[0]),
+                )
+            }),
+        ),
+        (
+            "plastic (return mapping)".into(),
+            rate(&|s| {
+                let e = [ec * (1.0 + 0.1 * s), 0.3 * ec, 0.1 * s * ec];
+                black_box(update(&p, &plastic, black_box(&e), 0.1).map_or(0.0, |r| r.1[0]))
+            }),
+        ),
+        (
+            "elastic (uncracked)".into(),
+            rate(&|s| {
+                let e = [0.2 * e0 * s, -0.1 * e0, 0.0];
+                black_box(update(&p, &virgin, black_box(&e), 0.1).map_or(0.0, |r| r.1[0]))
+            }),
+        ),
+    ]
+}

@@ -120,7 +120,9 @@ enum Command {
         /// opening, refined by each factor of --refine), "long_term" (the seed beam with
         /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine),
         /// "seed-failure" (the seed beam on to failure by arc length, each --refine) or
-        /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete).
+        /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete), "rc" (the RC
+        /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations) or
+        /// "material-point" (concrete material-point updates per second).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -246,9 +248,11 @@ fn main() -> ExitCode {
             "seed" => bench_seed(refine, segfem::bench::seed_case),
             "long_term" => bench_seed(refine, segfem::bench::seed_long_term_case),
             "seed-failure" => bench_seed_failure(refine, false),
+            "rc" => bench_rc(refine),
+            "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure or seed-failure-concrete)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc or material-point)");
                 ExitCode::from(2)
             }
         },
@@ -595,6 +599,41 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
 }
 
 /// Print one row per refinement factor of a seed-beam benchmark `case`.
+fn bench_rc(refine: Vec<usize>) -> ExitCode {
+    println!(
+        "{:>18} {:>9} {:>5} {:>6} {:>8} {:>9} {:>9}  end",
+        "case", "equations", "incs", "iters", "total s", "P max kN", "w [mm]"
+    );
+    for r in refine {
+        match segfem::bench::rc_case(r) {
+            Ok(x) => println!(
+                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>9.1} {:>9.2}  {}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.total_s,
+                x.p_max / 1e3,
+                x.deflection * 1e3,
+                x.end
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+fn bench_material_point() -> ExitCode {
+    println!("{:>26} {:>14}", "concrete point", "updates/s");
+    for (label, rate) in segfem::bench::material_point_rates(2_000_000) {
+        println!("{label:>26} {rate:>14.3e}");
+    }
+    ExitCode::SUCCESS
+}
+
 fn bench_seed(
     refine: Vec<usize>,
     case: fn(usize) -> Result<segfem::bench::NonlinearRow, String>,
