@@ -408,16 +408,28 @@ impl Observer for Reach {
 /// refined `refine` times, then an arc-length step on Q until the midspan deflection reaches
 /// 0.12 m (L/60), Newton gives up (the furthest point the model reaches), or 400
 /// increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
-/// the same strength (fcm = 45 MPa, VALIDATION.md §1) with the solver settings of the RC
-/// beam example.
+/// the same strength (fcm = 45 MPa, VALIDATION.md §1, IMPL-EX cracking) with elastic end
+/// blocks of 0.3 m at the anchors and the solver settings of the RC beam example.
 pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, String> {
     let r = refine.max(1);
     let mut text = seed_text(r);
     if concrete {
-        text = text.replace(
-            "kind = \"elastic\"\nE = 35.5e9",
-            "kind = \"concrete\"\nfcm = 45e6\nE = 35.5e9",
-        );
+        // MC90 concrete with IMPL-EX cracking; elastic end blocks (0.3 m, like anchor
+        // diaphragms) so that the single-node anchor forces do not crush the concrete.
+        text = text
+            .replace(
+                "kind = \"elastic\"\nE = 35.5e9",
+                "kind = \"concrete\"\nfcm = 45e6\ncrack_integration = \"implex\"\nE = 35.5e9",
+            )
+            .replace(
+                "[[joint_materials]]",
+                "[[materials]]\nname = \"block\"\nkind = \"elastic\"\nE = 35.5e9\nnu = 0.2\ndensity = 2548.4\n\n\
+                 [[regions]]\nname = \"end_blocks\"\nmaterial = \"block\"\nthickness = 0.70\n\
+                 boxes = [[[0.0, 0.0], [0.3, 0.6]], [[6.9, 0.0], [7.2, 0.6]]]\n\n[[joint_materials]]",
+            );
+        if !text.contains("implex") || !text.contains("end_blocks") {
+            return Err("seed-beam.toml changed: cannot build the concrete case".into());
+        }
         text.push_str("\n[solver]\nforce_tolerance = 1e-4\nmax_iterations = 30\nmax_cuts = 8\n");
     }
     text.push_str(

@@ -740,3 +740,40 @@ fn external_tendon_with_a_parabola() {
     );
     rejects(&m, "tendons[0].parabola", &["bonded"]);
 }
+
+/// `regions[i].boxes`: elements whose centroid lies in a box move to that region; an empty
+/// or inverted box is refused with the key.
+#[test]
+fn region_boxes_move_elements_and_bad_boxes_are_refused() {
+    let base = edit(
+        EXPLICIT,
+        "[mesh]",
+        "[[regions]]\nname = \"block\"\nmaterial = \"concrete\"\nthickness = 0.5\nboxes = [[[1.2, 0.1], [1.8, 0.9]]]\n\n[mesh]",
+    );
+    let m = segfem::input::parse(&base, "m.toml").unwrap().model;
+    let names: Vec<&str> = m
+        .elements
+        .iter()
+        .map(|e| m.regions[e.region].name.as_str())
+        .collect();
+    // Centroids at x = 0.5 (outside) and 1.5 (inside the box).
+    assert_eq!(names, ["web", "block"]);
+    rejects(
+        &edit(
+            &base,
+            "[[1.2, 0.1], [1.8, 0.9]]",
+            "[[1.8, 0.1], [1.2, 0.9]]",
+        ),
+        "regions[1].boxes[0]",
+        &["x1 > x0"],
+    );
+    rejects(
+        &edit(
+            &base,
+            "[[1.2, 0.1], [1.8, 0.9]]",
+            "[[3.0, 0.1], [4.0, 0.9]]",
+        ),
+        "regions[1].boxes[0]",
+        &["no element centroid"],
+    );
+}

@@ -247,6 +247,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
             &mut cast_days,
         )?;
     }
+    region_boxes(ctx, &file.regions, &nodes, &mut elements)?;
     assign_cast_days(ctx, &cast_days, &mut regions, &mut materials, &mut warnings)?;
     let mut model = Model {
         title: file.title.clone().unwrap_or_default(),
@@ -845,6 +846,50 @@ type Mesh = (Vec<[f64; 2]>, Vec<Element>);
 
 /// Nodes, elements and joints of a segmental mesh.
 type SegMesh = (Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>);
+
+/// `regions[i].boxes`: elements whose centroid (mean of the corner nodes) lies inside one of
+/// the region's boxes [[x0, y0], [x1, y1]] (m) are moved to that region, whatever the mesh
+/// generator gave them (anchor blocks, loading plates). Later regions win where boxes overlap.
+fn region_boxes(
+    ctx: &Ctx,
+    regions: &[RegionIn],
+    nodes: &[[f64; 2]],
+    elements: &mut [crate::model::Element],
+) -> Result<(), InputError> {
+    for (i, r) in regions.iter().enumerate() {
+        let Some(boxes) = &r.boxes else { continue };
+        for (j, [[x0, y0], [x1, y1]]) in boxes.iter().enumerate() {
+            let key = format!("regions[{i}].boxes[{j}]");
+            if !(x0.is_finite()
+                && y0.is_finite()
+                && x1 > x0
+                && y1 > y0
+                && x1.is_finite()
+                && y1.is_finite())
+            {
+                return Err(ctx.err(
+                    key,
+                    format!("must be [[x0, y0], [x1, y1]] with x1 > x0 and y1 > y0 (got [[{x0}, {y0}], [{x1}, {y1}]])"),
+                ));
+            }
+            let mut hit = 0;
+            for e in elements.iter_mut() {
+                let k = e.nodes.len().min(4) as f64;
+                let (cx, cy) = e.nodes.iter().take(4).fold((0.0, 0.0), |(a, b), &n| {
+                    (a + nodes[n][0] / k, b + nodes[n][1] / k)
+                });
+                if (*x0..=*x1).contains(&cx) && (*y0..=*y1).contains(&cy) {
+                    e.region = i;
+                    hit += 1;
+                }
+            }
+            if hit == 0 {
+                return Err(ctx.err(key, "no element centroid lies inside the box"));
+            }
+        }
+    }
+    Ok(())
+}
 
 fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
     mesh: &MeshIn,

@@ -102,6 +102,7 @@ pub struct RegionIn {
     pub material: String,
     pub thickness: f64,
     pub cast_day: Option<f64>,
+    pub boxes: Option<Vec<[[f64; 2]; 2]>>,
 }
 
 #[derive(Debug, Deserialize)]
