@@ -100,3 +100,34 @@ fn seed_beam_behaves_as_the_seed_reports() {
         "largest opening at 140 kN: {open140:.2} mm vs 6 mm"
     );
 }
+
+/// The seed beam with MC90 concrete (IMPL-EX cracking, elastic 0.3 m end blocks at the
+/// anchors) continued by arc length to L/60: the tendon yields (0.9 f_ptk) and the ultimate
+/// load follows from statics of the opened midspan joint, M_u = T_y (d_p − a/2) with the
+/// tendon at d_p = 0.50 m below the top (held at the deviators, so no eccentricity loss
+/// between them), a = T_y/(0.85 f_cm b) in the 1.20 m top flange, less the self-weight
+/// moment (25 kN/m³ on the 0.27 m² section, span 7.2 m): Q_u = (M_u − M_sw)/2.4 m. Within
+/// 10 % (the stress block shape, the compressed depth at the open joint, the deflected
+/// joint faces).
+#[test]
+fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
+    let row = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let t_y = 0.9 * 1900e6 * 560e-6;
+    assert!(
+        row.tendon_stress >= 0.999 * 0.9 * 1900e6,
+        "tendon {:.0} MPa ({})",
+        row.tendon_stress / 1e6,
+        row.end
+    );
+    let a = t_y / (0.85 * 45e6 * 1.20);
+    let m_u = t_y * (0.50 - a / 2.0);
+    let m_sw = 25e3 * (0.70 * 0.10 + 0.20 * 0.40 + 1.20 * 0.10) * 7.2f64.powi(2) / 8.0;
+    let q_u = (m_u - m_sw) / 2.4;
+    let q = row.q_max * 1e3;
+    assert!(
+        (q - q_u).abs() < 0.10 * q_u,
+        "Q_max {:.1} kN vs statics {:.1} kN",
+        q / 1e3,
+        q_u / 1e3
+    );
+}
