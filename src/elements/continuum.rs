@@ -44,7 +44,7 @@ pub struct GaussOutput {
 
 /// Strain–displacement matrix rows at one point: (∂N/∂x, ∂N/∂y) per node, and the
 /// integration factor w·det J [m²].
-pub(crate) fn point_derivatives(
+fn point_derivatives(
     kind: QuadKind,
     coords: &[[f64; 2]],
     p: &Point2,
@@ -138,6 +138,25 @@ pub fn response_with_time(
     )
 }
 
+/// Cartesian shape derivatives and w·det J [m²] at every Gauss point of the rule (first
+/// `n` entries), and the characteristic length h = √(Σ w det J) [m] of the element, which
+/// the material update may need (crack band): computed for all points before any update.
+#[allow(clippy::type_complexity)]
+pub(crate) fn gauss_geometry(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+) -> (usize, [([[f64; 2]; MAX_NODES], f64); 9], f64) {
+    let pts = rule_points(kind, integration);
+    let mut geo = [([[0.0; 2]; MAX_NODES], 0.0); 9];
+    let mut area = 0.0;
+    for (g, p) in pts.iter().enumerate() {
+        geo[g] = point_derivatives(kind, coords, p);
+        area += geo[g].1;
+    }
+    (pts.len(), geo, area.sqrt())
+}
+
 /// As [`response_with_time`]; the tangent is formed only when `k` is given (a residual
 /// check or a stress recovery needs forces and stresses alone).
 #[allow(clippy::too_many_arguments)]
@@ -161,17 +180,8 @@ pub fn response_at(
     if let Some(k) = k.as_deref_mut() {
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
-    // Geometry of every Gauss point first: the element area (Σ w det J) gives the
-    // characteristic length the material update may need.
-    let pts = rule_points(kind, integration);
-    let mut geo = [([[0.0; 2]; MAX_NODES], 0.0); 9];
-    let mut area = 0.0;
-    for (g, p) in pts.iter().enumerate() {
-        geo[g] = point_derivatives(kind, coords, p);
-        area += geo[g].1;
-    }
-    let h = area.sqrt();
-    for g in 0..pts.len() {
+    let (n_pts, geo, h) = gauss_geometry(kind, integration, coords);
+    for g in 0..n_pts {
         let (dn, wdet) = geo[g];
         let mut eps = [0.0; 3];
         for a in 0..n {

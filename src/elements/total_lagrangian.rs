@@ -14,7 +14,7 @@
 //! - f = ∫ B_Lᵀ S t dA₀; K = ∫ B_Lᵀ D B_L t dA₀ + ∫ (∇N_aᵀ Ŝ ∇N_b) I₂ t dA₀ (the
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
-use super::continuum::{point_derivatives, rule_points, GaussOutput, Integration};
+use super::continuum::{GaussOutput, Integration};
 use crate::fem::shape::{QuadKind, MAX_NODES};
 use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
 
@@ -68,16 +68,9 @@ pub fn response_tl(
     if let Some(k) = k.as_deref_mut() {
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
-    let pts = rule_points(kind, integration);
-    let mut geo = [([[0.0; 2]; MAX_NODES], 0.0); 9];
-    let mut area = 0.0;
-    for (g, p) in pts.iter().enumerate() {
-        geo[g] = point_derivatives(kind, coords, p);
-        area += geo[g].1;
-    }
     // Characteristic length of the undeformed element (strains are referred to it).
-    let h_len = area.sqrt();
-    for g in 0..pts.len() {
+    let (n_pts, geo, h_len) = super::continuum::gauss_geometry(kind, integration, coords);
+    for g in 0..n_pts {
         let (dn, wdet) = geo[g];
         let h = displacement_gradient(&dn, u, n);
         let e = green_lagrange(&h);
@@ -138,7 +131,7 @@ pub fn response_tl(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elements::continuum::response_at;
+    use crate::elements::continuum::{response_at, rule_points};
     use crate::fem::shape::NODE_XI;
 
     const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];

@@ -847,6 +847,34 @@ type Mesh = (Vec<[f64; 2]>, Vec<Element>);
 /// Nodes, elements and joints of a segmental mesh.
 type SegMesh = (Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>);
 
+/// Area [m²], E_p [Pa] and f_ptk [Pa] of a bonded or pre-tensioned tendon (`key` =
+/// "tendons[i]", `named` = how messages name it): positive, an area that is one (≤ 0.1 m²),
+/// f_ptk below E_p (catches MPa given for Pa).
+fn tendon_steel(
+    ctx: &Ctx,
+    key: &str,
+    named: &str,
+    t: &TendonIn,
+) -> Result<(f64, f64, f64), InputError> {
+    let k = |f: &str| format!("{key}.{f}");
+    let area = positive(ctx, &k("area"), t.area)?;
+    if area > 0.1 {
+        return Err(ctx.err(
+            k("area"),
+            format!("{named}: {area} m² is not a tendon area (units are m²)"),
+        ));
+    }
+    let ep = positive(ctx, &k("Ep"), t.ep)?;
+    let fptk = positive(ctx, &k("fptk"), t.fptk)?;
+    if fptk >= ep {
+        return Err(ctx.err(
+            k("fptk"),
+            format!("{named}: must be far below Ep (units are Pa)"),
+        ));
+    }
+    Ok((area, ep, fptk))
+}
+
 /// `regions[i].boxes`: elements whose centroid (mean of the corner nodes) lies inside one of
 /// the region's boxes [[x0, y0], [x1, y1]] (m) are moved to that region, whatever the mesh
 /// generator gave them (anchor blocks, loading plates). Later regions win where boxes overlap.
@@ -2453,21 +2481,7 @@ fn build_bars(
                 ));
             }
         }
-        let area = positive(ctx, &k("area"), t.area)?;
-        if area > 0.1 {
-            return Err(ctx.err(
-                k("area"),
-                format!("{named}: {area} m² is not a tendon area (units are m²)"),
-            ));
-        }
-        let ep = positive(ctx, &k("Ep"), t.ep)?;
-        let fptk = positive(ctx, &k("fptk"), t.fptk)?;
-        if fptk >= ep {
-            return Err(ctx.err(
-                k("fptk"),
-                format!("{named}: must be far below Ep (units are Pa)"),
-            ));
-        }
+        let (area, ep, fptk) = tendon_steel(ctx, &key, &named, t)?;
         let steel = SteelParams::prestressing(ep, fptk);
         let sigma_pi = jacking_stress_of(ctx, i, t, area, fptk)?.ok_or_else(|| {
             ctx.err(
@@ -2586,21 +2600,7 @@ fn pretensioned_tendon(
             ));
         }
     }
-    let area = positive(ctx, &k("area"), t.area)?;
-    if area > 0.1 {
-        return Err(ctx.err(
-            k("area"),
-            format!("{named}: {area} m² is not a tendon area (units are m²)"),
-        ));
-    }
-    let ep = positive(ctx, &k("Ep"), t.ep)?;
-    let fptk = positive(ctx, &k("fptk"), t.fptk)?;
-    if fptk >= ep {
-        return Err(ctx.err(
-            k("fptk"),
-            format!("{named}: must be far below Ep (units are Pa)"),
-        ));
-    }
+    let (area, ep, fptk) = tendon_steel(ctx, &key, &named, t)?;
     let s0 = t.initial_stress.ok_or_else(|| {
         ctx.err(
             k("initial_stress"),

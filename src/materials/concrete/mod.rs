@@ -404,18 +404,6 @@ pub fn update(
     update_full(p, committed, strain, char_length, 0.0, 1.0)
 }
 
-/// As [`update`] for an increment lasting `dt` days (only the viscoplastic option of the
-/// compression plasticity depends on it; `dt` = 0 is a load increment).
-pub fn update_timed(
-    p: &ConcreteParams,
-    committed: &ConcreteState,
-    strain: &[f64; 3],
-    char_length: f64,
-    dt: f64,
-) -> UpdateResult {
-    update_full(p, committed, strain, char_length, dt, 1.0)
-}
-
 /// As [`update`] with the IMPL-EX extrapolation ratio `ratio` [-] = size of this increment /
 /// size of the previous one (0 = no extrapolation: the cracks keep their committed
 /// secant); used only when `p.implex`.
@@ -429,8 +417,9 @@ pub fn update_extrapolated(
     update_full(p, committed, strain, char_length, 0.0, ratio)
 }
 
-/// The general update: increment of `dt` days (viscoplastic option) and IMPL-EX
-/// extrapolation ratio `ratio` (see [`update_timed`], [`update_extrapolated`]).
+/// The general update: increment of `dt` days (only the viscoplastic option of the
+/// compression plasticity depends on it; 0 = a load increment) and IMPL-EX extrapolation
+/// ratio `ratio` (see [`update_extrapolated`]).
 pub fn update_full(
     p: &ConcreteParams,
     committed: &ConcreteState,
