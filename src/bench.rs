@@ -353,6 +353,8 @@ pub struct FailureRow {
     pub crushed: usize,
     /// How the run ended.
     pub end: String,
+    /// Solver and assembly figures (zero when the run ended without converging).
+    pub timings: steps::Timings,
 }
 
 /// Records what a failure run reaches.
@@ -436,9 +438,16 @@ increments = 400
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Reach::default();
+    let mut timings = steps::Timings::default();
     let end = match steps::run(&model, &mut obs) {
-        Ok(_) if obs.deflection <= -0.12 + 1e-9 => "deflection L/60 reached".to_string(),
-        Ok(_) => "increment limit".to_string(),
+        Ok(t) => {
+            timings = t;
+            if obs.deflection <= -0.12 + 1e-9 {
+                "deflection L/60 reached".to_string()
+            } else {
+                "increment limit".to_string()
+            }
+        }
         Err(steps::AnalysisError::NotConverged(rep)) => format!(
             "no convergence beyond this point (step '{}', increment {})",
             rep.step, rep.increment
@@ -462,6 +471,7 @@ increments = 400
         max_opening: obs.max_opening,
         crushed: obs.crushed,
         end,
+        timings,
     })
 }
 

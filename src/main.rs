@@ -575,20 +575,34 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
     );
     for r in refine {
         match segfem::bench::seed_failure_case(r, concrete) {
-            Ok(x) => println!(
-                "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
-                x.case,
-                x.equations,
-                x.increments,
-                x.iterations,
-                x.total_s,
-                x.q_max,
-                x.deflection,
-                x.tendon_stress / 1e6,
-                x.max_opening * 1e3,
-                x.crushed,
-                x.end
-            ),
+            Ok(x) => {
+                println!(
+                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
+                    x.case,
+                    x.equations,
+                    x.increments,
+                    x.iterations,
+                    x.total_s,
+                    x.q_max,
+                    x.deflection,
+                    x.tendon_stress / 1e6,
+                    x.max_opening * 1e3,
+                    x.crushed,
+                    x.end
+                );
+                let (t, s) = (&x.timings, &x.timings.solver);
+                println!(
+                    "{:>28} assembly {:.3} s, {} factorisations ({} LDLT) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
+                    "",
+                    t.assembly_s,
+                    s.factorisations,
+                    s.ldlt_factorisations,
+                    s.numeric_s,
+                    1e3 * s.numeric_s / s.factorisations.max(1) as f64,
+                    s.factor_nnz,
+                    s.solve_s
+                );
+            }
             Err(e) => {
                 eprintln!("error: {e}");
                 return ExitCode::from(3);

@@ -10,7 +10,7 @@ use faer::sparse::linalg::cholesky::{
     SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 /// Why a factorisation or solve failed.
@@ -98,9 +98,110 @@ enum Factor {
     Ldlt,
 }
 
+/// The matrix permuted once into the elimination order, so that faer factorises it as it
+/// stands (identity ordering) instead of permuting it at every numeric factorisation.
+struct Prepermuted {
+    /// Lower-triangle pattern of P A Pᵀ (checked once).
+    pattern: SymbolicSparseColMat<usize>,
+    /// For each stored entry of `pattern`, its position in the caller's value array.
+    source: Vec<usize>,
+    /// Values of P A Pᵀ (refilled at each factorisation).
+    values: Vec<f64>,
+    /// `order[k]`: the original equation eliminated k-th.
+    order: Vec<usize>,
+    /// Right-hand side in the elimination order (solve scratch).
+    rhs: Vec<f64>,
+}
+
+/// Largest matrix (stored lower-triangle entries) that is permuted once and kept permuted:
+/// three more arrays of this length (pattern, source map, values), ≤ 48 MB. Above it faer
+/// permutes per factorisation, which then costs little against the factorisation itself.
+const PREPERMUTE_MAX_NNZ: usize = 2_000_000;
+
+/// Compressed columns of an n × n pattern from (column, row, source) triples: column
+/// pointers, row indices sorted within each column, and the source of each entry.
+fn compress(n: usize, triples: &[(usize, usize, usize)]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let mut col_ptr = vec![0usize; n + 1];
+    for &(c, _, _) in triples {
+        col_ptr[c + 1] += 1;
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let mut next = col_ptr[..n].to_vec();
+    let mut entries = vec![(0usize, 0usize); triples.len()];
+    for &(c, r, p) in triples {
+        entries[next[c]] = (r, p);
+        next[c] += 1;
+    }
+    for j in 0..n {
+        entries[col_ptr[j]..col_ptr[j + 1]].sort_unstable();
+    }
+    let (row_idx, source) = entries.into_iter().unzip();
+    (col_ptr, row_idx, source)
+}
+
+impl Prepermuted {
+    /// P A Pᵀ of the lower-triangle `pattern` for the elimination order `order` (`inverse`:
+    /// its inverse, the position of each equation in the order), and the symbolic
+    /// factorisation of it as it stands (faer analyses the upper triangle when given no
+    /// ordering: it gets the transposed pattern for that).
+    fn new(
+        pattern: &LowerPattern,
+        order: &[usize],
+        inverse: &[usize],
+    ) -> Result<(Self, SymbolicCholesky<usize>), SolverError> {
+        let n = pattern.n;
+        let mut triples = Vec::with_capacity(pattern.nnz());
+        for j in 0..n {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let (a, b) = (inverse[pattern.row_idx[p]], inverse[j]);
+                triples.push((a.max(b), a.min(b), p));
+            }
+        }
+        let (up_ptr, up_idx, _) = compress(n, &triples);
+        let upper = SymbolicSparseColMatRef::new_checked(n, n, &up_ptr, None, &up_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            upper,
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
+        for t in triples.iter_mut() {
+            *t = (t.1, t.0, t.2);
+        }
+        let (col_ptr, row_idx, source) = compress(n, &triples);
+        let nnz = row_idx.len();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        Ok((
+            Self {
+                pattern,
+                source,
+                values: vec![0.0; nnz],
+                order: order.to_vec(),
+                rhs: vec![0.0; n],
+            },
+            symbolic,
+        ))
+    }
+
+    /// Gather the caller's values into the permuted matrix.
+    fn fill(&mut self, values: &[f64]) {
+        for (v, &p) in self.values.iter_mut().zip(&self.source) {
+            *v = values[p];
+        }
+    }
+}
+
 /// Sparse symmetric positive-definite solver with a reusable symbolic factorisation.
 pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
+    /// Set when the matrix is kept in the elimination order (then `symbolic` has none).
+    pre: Option<Prepermuted>,
     l_values: Vec<f64>,
     mem: MemBuffer,
     factor: Factor,
@@ -164,7 +265,12 @@ impl SparseCholesky {
             )),
             None => SymmetricOrdering::Amd,
         };
-        let symbolic = factorize_symbolic_cholesky(
+        let threshold = match std::env::var("SEGFEM_SN").ok().as_deref() {
+            Some("1") => SupernodalThreshold::FORCE_SUPERNODAL,
+            Some("0") => SupernodalThreshold::FORCE_SIMPLICIAL,
+            _ => threshold,
+        };
+        let mut symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
             ordering,
@@ -174,6 +280,19 @@ impl SparseCholesky {
             },
         )
         .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
+        // A supernodal factor reads the lower triangle of the permuted matrix: keep the matrix
+        // permuted (faer would permute it at every factorisation, ~5 % of a small nonlinear
+        // run) and analyse it again as it stands, forcing the same kind of factor.
+        let mut pre = None;
+        let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
+        if supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && std::env::var("SEGFEM_NOPRE").is_err() {
+            if let Some(perm) = symbolic.perm() {
+                let (fwd, inv) = perm.arrays();
+                let (p, sym) = Prepermuted::new(pattern, fwd, inv)?;
+                symbolic = sym;
+                pre = Some(p);
+            }
+        }
         let req = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()))
@@ -187,6 +306,7 @@ impl SparseCholesky {
         };
         Ok(Self {
             symbolic,
+            pre,
             l_values,
             mem,
             factor: Factor::None,
@@ -199,7 +319,13 @@ impl SparseCholesky {
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
         let t = std::time::Instant::now();
         self.factor = Factor::None;
-        let a = SparseColMatRef::new(pattern.symbolic(), values);
+        let a = match self.pre.as_mut() {
+            Some(p) => {
+                p.fill(values);
+                SparseColMatRef::new(p.pattern.as_ref(), &p.values)
+            }
+            None => SparseColMatRef::new(pattern.symbolic(), values),
+        };
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
@@ -226,9 +352,10 @@ impl SparseCholesky {
                     SymbolicCholeskyRaw::Supernodal(_) => index,
                 }
                 .min(pattern.n.saturating_sub(1));
-                let equation = match self.symbolic.perm() {
-                    Some(p) => p.arrays().0[index],
-                    None => index,
+                let equation = match (&self.pre, self.symbolic.perm()) {
+                    (Some(p), _) => p.order[index],
+                    (None, Some(p)) => p.arrays().0[index],
+                    (None, None) => index,
                 };
                 Err(SolverError::NotPositiveDefinite { equation })
             }
@@ -245,7 +372,17 @@ impl SparseCholesky {
         let t = std::time::Instant::now();
         let n = b.len();
         let stack = MemStack::new(&mut self.mem);
-        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        // A kept-permuted matrix: solve for P x from P b.
+        let pb = match self.pre.as_mut() {
+            Some(p) => {
+                for (r, &i) in p.rhs.iter_mut().zip(&p.order) {
+                    *r = b[i];
+                }
+                &mut p.rhs[..]
+            }
+            None => &mut b[..],
+        };
+        let rhs = MatMut::from_column_major_slice_mut(pb, n, 1);
         if self.factor == Factor::Llt {
             LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
                 Conj::No,
@@ -261,6 +398,11 @@ impl SparseCholesky {
                 stack,
             );
         }
+        if let Some(p) = self.pre.as_ref() {
+            for (&i, &r) in p.order.iter().zip(&p.rhs) {
+                b[i] = r;
+            }
+        }
         self.stats.solve_s += t.elapsed().as_secs_f64();
     }
 
@@ -269,18 +411,62 @@ impl SparseCholesky {
     /// the number of negative pivots of D (the inertia index: 0 for a positive-definite
     /// matrix; ≥ 1 past a limit point or bifurcation). A zero or non-finite pivot is
     /// [`SolverError::Singular`].
+    ///
+    /// After an indefinite factorisation LDLᵀ goes first (past a limit point LLᵀ fails on
+    /// every iteration, and the failed attempt cost a partial factorisation each time); if
+    /// the matrix turns out positive definite again it is refactorised by LLᵀ, so the
+    /// factor used is the same as with LLᵀ first.
     pub fn factorize_indefinite(
         &mut self,
         pattern: &LowerPattern,
         values: &[f64],
     ) -> Result<usize, SolverError> {
-        match self.factorize(pattern, values) {
-            Ok(()) => return Ok(0),
-            Err(SolverError::NotPositiveDefinite { .. }) => {}
-            Err(e) => return Err(e),
+        let ldlt_first = self.negative_pivots > 0;
+        if !ldlt_first {
+            match self.factorize(pattern, values) {
+                Ok(()) => return Ok(0),
+                Err(SolverError::NotPositiveDefinite { .. }) => {}
+                Err(e) => return Err(e),
+            }
+        } else if let Some(p) = self.pre.as_mut() {
+            p.fill(values);
         }
+        let negative = match self.factorize_ldlt(pattern, values) {
+            // A pivot too small for LDLᵀ may still pass LLᵀ, which would have gone first.
+            Err(SolverError::Singular) if ldlt_first => {
+                return match self.factorize(pattern, values) {
+                    Ok(()) => Ok(0),
+                    Err(_) => Err(SolverError::Singular),
+                };
+            }
+            r => r?,
+        };
+        if ldlt_first && negative == 0 {
+            // Positive definite again: the LLᵀ factor that LLᵀ first would have given.
+            match self.factorize(pattern, values) {
+                Ok(()) => return Ok(0),
+                Err(SolverError::NotPositiveDefinite { .. }) => {
+                    return self.factorize_ldlt(pattern, values)
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(negative)
+    }
+
+    /// LDLᵀ of the matrix (a kept-permuted matrix must already hold `values`); the number
+    /// of negative pivots.
+    fn factorize_ldlt(
+        &mut self,
+        pattern: &LowerPattern,
+        values: &[f64],
+    ) -> Result<usize, SolverError> {
         let t = std::time::Instant::now();
-        let a = SparseColMatRef::new(pattern.symbolic(), values);
+        self.factor = Factor::None;
+        let a = match self.pre.as_ref() {
+            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
+            None => SparseColMatRef::new(pattern.symbolic(), values),
+        };
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_ldlt(
             &mut self.l_values,

@@ -98,6 +98,10 @@ pub struct System<'m> {
     /// Relaxation and loss records of the bonded-tendon points (order of `bar_gps`; None
     /// for plain bars and tendons not yet stressed; see `analysis::bonded_time`).
     pub bar_time: Vec<Option<super::bonded_time::BarPointTime>>,
+    /// Element force vectors and matrices of one chunk, kept between assemblies (every
+    /// element writes its own before use: a run of many small assemblies zeroed and
+    /// reallocated them each time).
+    elem_buf: (Vec<f64>, Vec<f64>),
 }
 
 /// Stage of an embedded bar or bonded tendon.
@@ -354,6 +358,7 @@ impl<'m> System<'m> {
                 .collect(),
             bar_eps_ref: vec![0.0; n_bp],
             bar_time: vec![None; n_bp],
+            elem_buf: (Vec::new(), Vec::new()),
         }
     }
 
@@ -447,8 +452,9 @@ impl<'m> System<'m> {
         // Sized for the elements there are: a small model must not zero a 10 MB buffer on
         // every iteration (that was a quarter of a small contact run).
         let chunk = CHUNK.min(n_el).max(1);
-        let mut fbuf = vec![0.0; chunk * ND];
-        let mut kbuf = vec![0.0; chunk * ND * ND];
+        let (mut fbuf, mut kbuf) = std::mem::take(&mut self.elem_buf);
+        fbuf.resize(chunk * ND, 0.0);
+        kbuf.resize(chunk * ND * ND, 0.0);
         // Split the state arrays per element once per chunk so that chunks can be filled in
         // parallel without aliasing.
         while start < n_el {
@@ -661,6 +667,7 @@ impl<'m> System<'m> {
             }
             start = end;
         }
+        self.elem_buf = (fbuf, kbuf);
         // Joint contact elements.
         let n_cont = n_el;
         let results: Vec<_> = self

@@ -82,45 +82,62 @@ pub fn response_tl(
         };
         let w = wdet * thickness;
         let fm = [[1.0 + h[0][0], h[0][1]], [h[1][0], 1.0 + h[1][1]]];
-        // B_L,a (3 × 2) for every node.
-        let mut b = [[[0.0; 2]; 3]; MAX_NODES];
+        // f += w B_L,aᵀ S with B_L,a (3 × 2) of each node.
         for a in 0..n {
             let (ax, ay) = (dn[a][0], dn[a][1]);
-            b[a] = [
+            let b = [
                 [fm[0][0] * ax, fm[1][0] * ax],
                 [fm[0][1] * ay, fm[1][1] * ay],
                 [fm[0][0] * ay + fm[0][1] * ax, fm[1][0] * ay + fm[1][1] * ax],
             ];
             for i in 0..2 {
-                f[2 * a + i] += w * (b[a][0][i] * s[0] + b[a][1][i] * s[1] + b[a][2][i] * s[2]);
+                f[2 * a + i] += w * (b[0][i] * s[0] + b[1][i] * s[1] + b[2][i] * s[2]);
             }
         }
         let Some(k) = k.as_deref_mut() else {
             continue;
         };
-        for a in 0..n {
-            // Rows of B_aᵀ D (2 × 3).
-            let mut r = [[0.0; 3]; 2];
-            for (i, ri) in r.iter_mut().enumerate() {
-                for (c, rc) in ri.iter_mut().enumerate() {
-                    *rc = b[a][0][i] * d[0][c] + b[a][1][i] * d[1][c] + b[a][2][i] * d[2][c];
-                }
+        // With δE = S(F) δh, δh = (δH₁₁, δH₁₂, δH₂₁, δH₂₂) and δH_ik = N_a,k δu_a,i, both
+        // terms of K are ∇N_aᵀ C_ij ∇N_b with the 4 × 4 C = w (Sᵀ D S + I₂ ⊗ Ŝ): about half
+        // the operations of B_Lᵀ D B_L node pair by node pair. Column 2i + k of S is
+        // ∂E/∂H_ik: (F_i1, 0, F_i2) for k = 1, (0, F_i2, F_i1) for k = 2.
+        let mut sm = [[0.0; 3]; 4];
+        for i in 0..2 {
+            sm[2 * i] = [fm[i][0], 0.0, fm[i][1]];
+            sm[2 * i + 1] = [0.0, fm[i][1], fm[i][0]];
+        }
+        let mut ds = [[0.0; 3]; 4];
+        for q in 0..4 {
+            for r in 0..3 {
+                ds[q][r] = d[r][0] * sm[q][0] + d[r][1] * sm[q][1] + d[r][2] * sm[q][2];
             }
-            let (ax, ay) = (dn[a][0], dn[a][1]);
-            // Ŝ ∇N_a, for the initial-stress term ∇N_aᵀ Ŝ ∇N_b.
-            let sa = [ax * s[0] + ay * s[2], ax * s[2] + ay * s[1]];
-            for bn in 0..n {
-                let bb = &b[bn];
-                let geo = sa[0] * dn[bn][0] + sa[1] * dn[bn][1];
-                for i in 0..2 {
-                    let row = (2 * a + i) * nd;
-                    for j in 0..2 {
-                        let mut v = r[i][0] * bb[0][j] + r[i][1] * bb[1][j] + r[i][2] * bb[2][j];
-                        if i == j {
-                            v += geo;
-                        }
-                        k[row + 2 * bn + j] += w * v;
-                    }
+        }
+        let shat = [[s[0], s[2]], [s[2], s[1]]];
+        let mut c = [[0.0; 4]; 4];
+        for p in 0..4 {
+            for q in 0..4 {
+                let mut v = sm[p][0] * ds[q][0] + sm[p][1] * ds[q][1] + sm[p][2] * ds[q][2];
+                if p / 2 == q / 2 {
+                    v += shat[p % 2][q % 2];
+                }
+                c[p][q] = w * v;
+            }
+        }
+        let (mut dx, mut dy) = ([0.0; MAX_NODES], [0.0; MAX_NODES]);
+        for a in 0..n {
+            dx[a] = dn[a][0];
+            dy[a] = dn[a][1];
+        }
+        for a in 0..n {
+            for i in 0..2 {
+                // t_jl = Σ_k N_a,k C[2i + k][2j + l]; K[(a,i), (b,j)] += Σ_l t_jl N_b,l.
+                let (p0, p1) = (2 * i, 2 * i + 1);
+                let t = |q: usize| dx[a] * c[p0][q] + dy[a] * c[p1][q];
+                let (t00, t01, t10, t11) = (t(0), t(1), t(2), t(3));
+                let kr = &mut k[(2 * a + i) * nd..(2 * a + i + 1) * nd];
+                for bn in 0..n {
+                    kr[2 * bn] += t00 * dx[bn] + t01 * dy[bn];
+                    kr[2 * bn + 1] += t10 * dx[bn] + t11 * dy[bn];
                 }
             }
         }
