@@ -90,6 +90,21 @@ pub struct SolverStats {
     pub ldlt_factorisations: usize,
 }
 
+/// Supernodal factorisation at every size. faer's automatic rule (supernodal above 40 flops
+/// per factor entry) chose the simplicial up-looking factorisation for the seed beam's
+/// 1,859 equations (66,538 factor values), which took 4.6 ms per factorisation; the
+/// supernodal one, with dense blocks of the two dofs of each node and relaxed supernodes
+/// (87,435 values, explicit zeros included), takes 1.8 ms on the same matrices
+/// (docs/performance.md).
+const FACTOR_KIND: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
+
+/// Relative size of an LLᵀ pivot below which it counts as zero: l_jj² ≤ TINY_PIVOT a_jj.
+/// Round-off leaves ~1e-16 of a_jj on a mechanism (1.3e-16 on the hinge of tests/cli.rs,
+/// where simplicial LLᵀ happened to meet a pivot ≤ 0 and supernodal LLᵀ does not); the
+/// smallest ratios of the bundled examples are 1e-5–2e-2, 8e-9 for the seed beam next to
+/// its limit point (where LDLᵀ takes over anyway).
+const TINY_PIVOT: f64 = 1e-11;
+
 /// Which factor the solver holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Factor {
@@ -214,7 +229,7 @@ pub struct SparseCholesky {
 impl SparseCholesky {
     /// Ordering (AMD) and symbolic analysis of `pattern`; done once per pattern.
     pub fn new(pattern: &LowerPattern) -> Result<Self, SolverError> {
-        Self::with_threshold(pattern, SupernodalThreshold::AUTO)
+        Self::with_threshold(pattern, FACTOR_KIND)
     }
 
     /// Symbolic analysis of `pattern` with the elimination order `order` (`order[k]`: the
@@ -224,11 +239,11 @@ impl SparseCholesky {
         pattern: &LowerPattern,
         order: Option<&[usize]>,
     ) -> Result<Self, SolverError> {
-        Self::build(pattern, SupernodalThreshold::AUTO, order)
+        Self::build(pattern, FACTOR_KIND, order)
     }
 
     /// As [`SparseCholesky::new`], choosing simplicial or supernodal factorisation by
-    /// `threshold` (faer's flop-ratio rule; AUTO in production, forced in tests).
+    /// `threshold` (faer's flop-ratio rule; [`FACTOR_KIND`] in production, both kinds in tests).
     pub fn with_threshold(
         pattern: &LowerPattern,
         threshold: SupernodalThreshold,
@@ -265,11 +280,6 @@ impl SparseCholesky {
             )),
             None => SymmetricOrdering::Amd,
         };
-        let threshold = match std::env::var("SEGFEM_SN").ok().as_deref() {
-            Some("1") => SupernodalThreshold::FORCE_SUPERNODAL,
-            Some("0") => SupernodalThreshold::FORCE_SIMPLICIAL,
-            _ => threshold,
-        };
         let mut symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
@@ -285,7 +295,7 @@ impl SparseCholesky {
         // run) and analyse it again as it stands, forcing the same kind of factor.
         let mut pre = None;
         let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
-        if supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && std::env::var("SEGFEM_NOPRE").is_err() {
+        if supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ {
             if let Some(perm) = symbolic.perm() {
                 let (fwd, inv) = perm.arrays();
                 let (p, sym) = Prepermuted::new(pattern, fwd, inv)?;
@@ -340,6 +350,16 @@ impl SparseCholesky {
         self.stats.factorisations += 1;
         match res {
             Ok(_) => {
+                // A pivot that is round-off of its diagonal entry is a zero pivot (the
+                // supernodal kernels leave it a tiny positive number on a mechanism).
+                if let Some(k) = self.tiny_pivot(pattern, values) {
+                    let equation = match (&self.pre, self.symbolic.perm()) {
+                        (Some(p), _) => p.order[k],
+                        (None, Some(p)) => p.arrays().0[k],
+                        (None, None) => k,
+                    };
+                    return Err(SolverError::NotPositiveDefinite { equation });
+                }
                 self.factor = Factor::Llt;
                 self.negative_pivots = 0;
                 Ok(())
@@ -411,47 +431,17 @@ impl SparseCholesky {
     /// the number of negative pivots of D (the inertia index: 0 for a positive-definite
     /// matrix; ≥ 1 past a limit point or bifurcation). A zero or non-finite pivot is
     /// [`SolverError::Singular`].
-    ///
-    /// After an indefinite factorisation LDLᵀ goes first (past a limit point LLᵀ fails on
-    /// every iteration, and the failed attempt cost a partial factorisation each time); if
-    /// the matrix turns out positive definite again it is refactorised by LLᵀ, so the
-    /// factor used is the same as with LLᵀ first.
     pub fn factorize_indefinite(
         &mut self,
         pattern: &LowerPattern,
         values: &[f64],
     ) -> Result<usize, SolverError> {
-        let ldlt_first = self.negative_pivots > 0;
-        if !ldlt_first {
-            match self.factorize(pattern, values) {
-                Ok(()) => return Ok(0),
-                Err(SolverError::NotPositiveDefinite { .. }) => {}
-                Err(e) => return Err(e),
-            }
-        } else if let Some(p) = self.pre.as_mut() {
-            p.fill(values);
+        match self.factorize(pattern, values) {
+            Ok(()) => Ok(0),
+            // (A kept-permuted matrix was filled by the failed LLᵀ.)
+            Err(SolverError::NotPositiveDefinite { .. }) => self.factorize_ldlt(pattern, values),
+            Err(e) => Err(e),
         }
-        let negative = match self.factorize_ldlt(pattern, values) {
-            // A pivot too small for LDLᵀ may still pass LLᵀ, which would have gone first.
-            Err(SolverError::Singular) if ldlt_first => {
-                return match self.factorize(pattern, values) {
-                    Ok(()) => Ok(0),
-                    Err(_) => Err(SolverError::Singular),
-                };
-            }
-            r => r?,
-        };
-        if ldlt_first && negative == 0 {
-            // Positive definite again: the LLᵀ factor that LLᵀ first would have given.
-            match self.factorize(pattern, values) {
-                Ok(()) => return Ok(0),
-                Err(SolverError::NotPositiveDefinite { .. }) => {
-                    return self.factorize_ldlt(pattern, values)
-                }
-                Err(e) => return Err(e),
-            }
-        }
-        Ok(negative)
     }
 
     /// LDLᵀ of the matrix (a kept-permuted matrix must already hold `values`); the number
@@ -494,7 +484,26 @@ impl SparseCholesky {
         Ok(self.negative_pivots)
     }
 
-    /// Diagonal D of the last LDLᵀ factor (permuted order).
+    /// First equation (elimination order) of the last LLᵀ factor whose pivot l_jj² is at
+    /// most [`TINY_PIVOT`] times the matrix's diagonal entry a_jj: what is left of a_jj
+    /// after elimination is round-off, a zero pivot (a mechanism).
+    fn tiny_pivot(&self, pattern: &LowerPattern, values: &[f64]) -> Option<usize> {
+        let l = self.ldlt_diagonal();
+        let perm = self.symbolic.perm().map(|p| p.arrays().0);
+        (0..l.len()).find(|&k| {
+            let a = match (&self.pre, perm) {
+                (Some(p), _) => {
+                    let (cp, ri) = (p.pattern.col_ptr(), p.pattern.row_idx());
+                    (cp[k] < cp[k + 1] && ri[cp[k]] == k).then(|| p.values[cp[k]])
+                }
+                (None, Some(fwd)) => pattern.position(fwd[k], fwd[k]).map(|q| values[q]),
+                (None, None) => pattern.position(k, k).map(|q| values[q]),
+            };
+            a.is_some_and(|a| l[k] * l[k] <= TINY_PIVOT * a.abs())
+        })
+    }
+
+    /// Diagonal of the last factor (permuted order): D of LDLᵀ, or the diagonal of L of LLᵀ.
     fn ldlt_diagonal(&self) -> Vec<f64> {
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
