@@ -22,7 +22,7 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "seed-beam",
-        "the seed's 7.2 m dry-jointed box beam with an external tendon (VALIDATION.md §1)",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (VALIDATION.md §1)",
         include_str!("../examples/seed-beam.toml"),
     ),
     (
@@ -397,6 +397,9 @@ fn run(
                 for (n, v) in &s.final_monitors {
                     println!("  {n} = {v:.6e}");
                 }
+                if let Some(u) = &s.ultimate {
+                    println!("{u}");
+                }
                 println!("results in {}", out.display());
             }
             ExitCode::SUCCESS
@@ -561,7 +564,7 @@ fn bench_bare(path: &std::path::Path) -> ExitCode {
 
 fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
     println!(
-        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  end",
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
         "case",
         "equations",
         "incs",
@@ -576,7 +579,7 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
     for r in refine {
         match segfem::bench::seed_failure_case(r, concrete) {
             Ok(x) => println!(
-                "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
+                "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
                 x.case,
                 x.equations,
                 x.increments,
@@ -587,6 +590,7 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
                 x.tendon_stress / 1e6,
                 x.max_opening * 1e3,
                 x.crushed,
+                x.mode,
                 x.end
             ),
             Err(e) => {

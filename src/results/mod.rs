@@ -5,4 +5,5 @@ pub mod checkpoint;
 pub mod fields;
 pub mod joints;
 pub mod recorder;
+pub mod ultimate;
 pub mod vtu;
