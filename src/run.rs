@@ -419,12 +419,12 @@ pub fn run_file_opts(
             file: file.to_string(),
             message: m,
         }),
-        Some(e @ AnalysisError::NotConverged(_)) => Err(RunError::NotConverged(
-            match &summary.ultimate {
+        Some(e @ AnalysisError::NotConverged(_)) => {
+            Err(RunError::NotConverged(match &summary.ultimate {
                 Some(u) => format!("{file}: {e}\n{u}"),
                 None => format!("{file}: {e}"),
-            },
-        )),
+            }))
+        }
         Some(AnalysisError::Stopped {
             reason,
             step,

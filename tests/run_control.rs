@@ -35,10 +35,7 @@ fn with_steps(text: &str, steps: &str) -> String {
 /// fewer increments and a shorter ultimate step that still opens the joints.
 fn seed_beam_short() -> String {
     let full = example("seed-beam");
-    let to_140 = full
-        .split("[[steps]]\nname = \"failure\"")
-        .next()
-        .unwrap();
+    let to_140 = full.split("[[steps]]\nname = \"failure\"").next().unwrap();
     let t = edit(
         to_140,
         "Q = 140.0 }\nincrements = 42",

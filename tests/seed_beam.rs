@@ -120,7 +120,6 @@ fn seed_beam_behaves_as_the_seed_reports() {
 fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
     let row = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(row.mode, "tendon yield", "{}", row.end);
-    let t_y = 0.9 * 1900e6 * 560e-6;
     assert!(
         row.tendon_stress >= 0.999 * 0.9 * 1900e6,
         "tendon {:.0} MPa ({})",
@@ -161,7 +160,10 @@ fn statics_ultimate_load() -> f64 {
 fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
     use common::{code, segfem, stdout, TempDir};
     let tmp = TempDir::new("seed-failure");
-    let o = segfem(tmp.path(), &["example", "seed-beam", "-o", "seed-beam.toml"]);
+    let o = segfem(
+        tmp.path(),
+        &["example", "seed-beam", "-o", "seed-beam.toml"],
+    );
     assert_eq!(code(&o), 0);
     let o = segfem(tmp.path(), &["run", "seed-beam.toml", "-o", "seed"]);
     assert_eq!(code(&o), 0, "{}", common::stderr(&o));
@@ -178,7 +180,10 @@ fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
     assert_eq!(u["mode"], "tendon yield", "{u}");
     assert_eq!(u["load_case"], "Q", "{u}");
     assert_eq!(u["ended"], "completed", "{u}");
-    let (at, peak) = (u["at_factor"].as_f64().unwrap(), u["peak_factor"].as_f64().unwrap());
+    let (at, peak) = (
+        u["at_factor"].as_f64().unwrap(),
+        u["peak_factor"].as_f64().unwrap(),
+    );
     // Q is in kN (the load case's unit force is 1 kN).
     let q_u = statics_ultimate_load() / 1e3;
     assert!(
@@ -186,7 +191,10 @@ fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
         "peak Q {peak:.1} kN vs statics {q_u:.1} kN"
     );
     // The tendon yields at the peak (within one increment of 4 kN), well past 140 kN.
-    assert!(at > 140.0 && at <= peak && peak - at < 4.0, "yield at {at}, peak {peak}");
+    assert!(
+        at > 140.0 && at <= peak && peak - at < 4.0,
+        "yield at {at}, peak {peak}"
+    );
     // history.csv: Q, midspan deflection, tendon stress and largest opening; the tendon
     // reaches 0.9 f_ptk and the last row is at L/60.
     let h = std::fs::read_to_string(tmp.join("seed/history.csv")).unwrap();

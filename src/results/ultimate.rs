@@ -126,7 +126,9 @@ impl UltimateWatch {
             // back from its peak.
             let lam = snap.arc_length_factor;
             let fell = match (lam, self.lambda_peak) {
-                (Some(l), Some((s, p))) if s == snap.step => l < p - LIMIT_DROP * p.abs().max(1e-12),
+                (Some(l), Some((s, p))) if s == snap.step => {
+                    l < p - LIMIT_DROP * p.abs().max(1e-12)
+                }
                 _ => false,
             };
             if let Some(l) = lam {
@@ -213,9 +215,11 @@ impl UltimateWatch {
 fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Option<Event> {
     let sys = snap.system;
     let crushed: Vec<usize> = (0..model.elements.len())
-        .filter(|&e| sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
-            .iter()
-            .any(|p| p.is_crushed()))
+        .filter(|&e| {
+            sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
+                .iter()
+                .any(|p| p.is_crushed())
+        })
         .collect();
     if crushed.is_empty() {
         return None;
