@@ -170,6 +170,9 @@ struct PlotArgs {
     /// Output directory (default: DIR/figures).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Further y columns, comma separated, each against --x in its own figure curves_COL.
+    #[arg(long, value_delimiter = ',')]
+    also: Vec<String>,
 }
 
 #[derive(clap::Args)]
@@ -284,8 +287,13 @@ fn view_plot(a: PlotArgs) -> ExitCode {
         scale: a.scale,
         out: a.output,
     };
+    let extra = match view::extra_curves(&opts, &a.also) {
+        Ok(f) => f,
+        Err(e) => return view_error(e),
+    };
     match view::plot(&opts) {
         Ok(o) => {
+            extra.iter().for_each(|f| println!("{}", f.display()));
             o.notes.iter().for_each(|n| eprintln!("note: {n}"));
             o.files.iter().for_each(|f| println!("{}", f.display()));
             ExitCode::SUCCESS

@@ -215,4 +215,38 @@ fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
     assert!(last[col("midspan_uy")] <= -0.12, "{last:?}");
     assert!(last[col("deflection_Q")] < last[col("midspan_uy")]);
     assert!(last[col("max_opening")] > 0.006);
+    // The README's plot command: deflection with the seed's points, tendon stress and
+    // opening in their own figures, the deformed shape at Q = 140 kN (output 3) × 20.
+    let refs = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/validation/seed-beam-reference.csv"
+    );
+    let o = segfem(
+        tmp.path(),
+        &[
+            "plot",
+            "seed",
+            "--x",
+            "Q",
+            "--y",
+            "deflection_Q",
+            "--ref",
+            refs,
+            "--also",
+            "tendon_stress,max_opening",
+            "--step",
+            "3",
+            "--scale",
+            "20",
+        ],
+    );
+    assert_eq!(code(&o), 0, "{}", common::stderr(&o));
+    for f in [
+        "curves",
+        "curves_tendon_stress",
+        "curves_max_opening",
+        "deformed",
+    ] {
+        assert!(tmp.join(&format!("seed/figures/{f}.png")).is_file(), "{f}");
+    }
 }
