@@ -405,6 +405,32 @@ fn check_prints_the_summary() {
 }
 
 #[test]
+fn closed_stdout_pipe_ends_quietly() {
+    // `segfem check m.toml | head -1`: the reader goes away before segfem writes. The read
+    // end is dropped right after spawning, long before the process has parsed the model,
+    // so its first write meets a closed pipe; `println!` would panic there (status 101).
+    let tmp = TempDir::new("pipe");
+    assert_eq!(
+        code(&segfem(
+            tmp.path(),
+            &["example", "box-beam", "-o", "f.toml"]
+        )),
+        0
+    );
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+        .args(["check", "f.toml"])
+        .current_dir(tmp.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn segfem");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("wait for segfem");
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+}
+
+#[test]
 fn box_beam_history_is_physically_right() {
     let tmp = TempDir::new("history");
     let (model_text, o) = run_box_beam(&tmp);
