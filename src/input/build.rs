@@ -444,6 +444,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     }
     // Embedded bars (needed by bar monitors).
     build_bars(ctx, &file.bars, &file.tendons, &steels, &mut model)?;
+    super::bar_layers::build(ctx, &file.bar_layers, &steels, &mut model)?;
     // Monitors.
     unique_names(
         ctx,
@@ -2448,6 +2449,7 @@ fn build_bars(
             piece_points: e.piece_points,
             post_tension: None,
             relaxation: None,
+            layer: false,
         });
     }
     for (i, t) in tendons.iter().enumerate() {
@@ -2553,6 +2555,7 @@ fn build_bars(
                 set_length: lock.set_length,
             }),
             relaxation: relaxation.map(|c| (c, fptk)),
+            layer: false,
         });
     }
     model.bars = out;
@@ -2648,6 +2651,7 @@ fn pretensioned_tendon(
         piece_points: e.piece_points,
         post_tension: None,
         relaxation: relaxation.map(|c| (c, fptk)),
+        layer: false,
     })
 }
 
