@@ -366,6 +366,16 @@ impl<'m> Recorder<'m> {
             write_atomic(&self.dir.join(&bname), bars_vtu(snap).as_bytes())?;
             self.pvd.push((t, 2, bname));
         }
+        if super::gauss_points::wanted(model) {
+            let gname = format!(
+                "gauss_step{:03}_inc{:04}.vtu",
+                snap.step + 1,
+                snap.increment
+            );
+            let doc = super::gauss_points::render_gauss_points(snap);
+            write_atomic(&self.dir.join(&gname), doc.as_bytes())?;
+            self.pvd.push((t, 3, gname));
+        }
         write_atomic(
             &self.dir.join("results.pvd"),
             render_pvd(&self.pvd).as_bytes(),
