@@ -241,6 +241,16 @@ impl Observer for Nothing {
 /// directions (1: the seed's coarse mesh, 6 rows through the depth).
 fn seed_text(refine: usize) -> String {
     let r = refine.max(1);
+    seed_text_to_failure(r)
+        .split("[[steps]]\nname = \"failure\"")
+        .next()
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// The bundled seed beam, refined as in [`seed_text`], with its last step on to failure.
+fn seed_text_to_failure(refine: usize) -> String {
+    let r = refine.max(1);
     include_str!("../examples/seed-beam.toml")
         .replace(
             "nx_per_segment = 6 ",
@@ -353,6 +363,8 @@ pub struct FailureRow {
     pub crushed: usize,
     /// How the run ended.
     pub end: String,
+    /// The first failure met (see [`crate::results::ultimate`]).
+    pub mode: String,
     /// Solver and assembly figures (zero when the run ended without converging).
     pub timings: steps::Timings,
 }
@@ -360,6 +372,7 @@ pub struct FailureRow {
 /// Records what a failure run reaches.
 #[derive(Default)]
 struct Reach {
+    watch: crate::results::ultimate::UltimateWatch,
     increments: usize,
     iterations: usize,
     q_max: f64,
@@ -373,6 +386,7 @@ impl Observer for Reach {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         let sys = snap.system;
         let m = sys.model;
+        self.watch.increment(snap);
         self.increments += 1;
         self.iterations += snap.iterations;
         self.q_max = self.q_max.max(snap.factors[1]);
@@ -394,10 +408,10 @@ impl Observer for Reach {
     }
 }
 
-/// The seed beam taken to failure: the bundled example (self weight, prestress, Q to 140 kN)
-/// refined `refine` times, then an arc-length step on Q until the midspan deflection reaches
-/// 0.12 m (L/60), Newton gives up (the furthest point the model reaches), or 400
-/// increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
+/// The seed beam taken to failure: the bundled example (self weight, prestress, Q to 140 kN,
+/// then its arc-length step on Q until the midspan deflection reaches 0.12 m, L/60) refined
+/// `refine` times; the run ends there, where Newton gives up (the furthest point the model
+/// reaches), or after 400 increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
 /// the same strength (fcm = 45 MPa, VALIDATION.md §1, IMPL-EX cracking) with elastic end
 /// blocks of 0.3 m at the anchors and the solver settings of the RC beam example.
 pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, String> {
@@ -422,24 +436,26 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         }
         text.push_str("\n[solver]\nforce_tolerance = 1e-4\nmax_iterations = 30\nmax_cuts = 8\n");
     }
-    text.push_str(
-        r#"
-[[steps]]
-name = "failure"
-kind = "arc_length"
-loads = { Q = 1.0 }
-initial_increment = 4.0
-stop_displacement = { point = [3.6, 0.0], component = "y", value = -0.12 }
-increments = 400
-"#,
-    );
+    // The example's own step on to failure (arc length to L/60); a TOML array of tables
+    // may go on after the [solver] table.
+    let failure = seed_text_to_failure(r);
+    let step = &failure[failure
+        .find("[[steps]]\nname = \"failure\"")
+        .ok_or("seed-beam.toml has no failure step")?..];
+    text.push('\n');
+    text.push_str(step);
     let t0 = Instant::now();
     let model = crate::input::parse(&text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Reach::default();
+    let result = steps::run(&model, &mut obs);
+    let mode = obs
+        .watch
+        .finish(&model, result.is_ok())
+        .map_or_else(String::new, |u| u.mode);
     let mut timings = steps::Timings::default();
-    let end = match steps::run(&model, &mut obs) {
+    let end = match result {
         Ok(t) => {
             timings = t;
             if obs.deflection <= -0.12 + 1e-9 {
@@ -471,6 +487,7 @@ increments = 400
         max_opening: obs.max_opening,
         crushed: obs.crushed,
         end,
+        mode,
         timings,
     })
 }

@@ -9,6 +9,39 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 use std::sync::Arc;
 
+/// `println!` for the command's report on stdout. When stdout is a pipe the reader closed
+/// (`segfem check m.toml | head -3`) the reader has what it wanted: end quietly with
+/// status 0 instead of the panic `println!` gives; any other write error is reported.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout().lock(), $($arg)*) {
+            stdout_failed(e)
+        }
+    }};
+}
+
+/// `print!` with the same closed-pipe handling as [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut o = std::io::stdout().lock();
+        if let Err(e) = write!(o, $($arg)*).and_then(|_| o.flush()) {
+            stdout_failed(e)
+        }
+    }};
+}
+
+/// End the process after a failed write to stdout: quietly for a closed pipe, with a
+/// message and status 1 otherwise.
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("error: writing to standard output: {e}");
+    std::process::exit(1);
+}
+
 /// Large blocks on transparent huge pages (segfem::hugepages: fewer page faults).
 #[global_allocator]
 static ALLOC: segfem::hugepages::HugePageAlloc = segfem::hugepages::HugePageAlloc;
@@ -22,7 +55,7 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "seed-beam",
-        "the seed's 7.2 m dry-jointed box beam with an external tendon (VALIDATION.md §1)",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (VALIDATION.md §1)",
         include_str!("../examples/seed-beam.toml"),
     ),
     (
@@ -170,6 +203,9 @@ struct PlotArgs {
     /// Output directory (default: DIR/figures).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Further y columns, comma separated, each against --x in its own figure curves_COL.
+    #[arg(long, value_delimiter = ',')]
+    also: Vec<String>,
 }
 
 #[derive(clap::Args)]
@@ -284,10 +320,15 @@ fn view_plot(a: PlotArgs) -> ExitCode {
         scale: a.scale,
         out: a.output,
     };
+    let extra = match view::extra_curves(&opts, &a.also) {
+        Ok(f) => f,
+        Err(e) => return view_error(e),
+    };
     match view::plot(&opts) {
         Ok(o) => {
+            extra.iter().for_each(|f| outln!("{}", f.display()));
             o.notes.iter().for_each(|n| eprintln!("note: {n}"));
-            o.files.iter().for_each(|f| println!("{}", f.display()));
+            o.files.iter().for_each(|f| outln!("{}", f.display()));
             ExitCode::SUCCESS
         }
         Err(e) => view_error(e),
@@ -307,7 +348,7 @@ fn view_report(a: ReportArgs) -> ExitCode {
     match report::report(&opts) {
         Ok((path, notes)) => {
             notes.iter().for_each(|n| eprintln!("note: {n}"));
-            println!("{}", path.display());
+            outln!("{}", path.display());
             ExitCode::SUCCESS
         }
         Err(e) => view_error(e),
@@ -384,7 +425,7 @@ fn run(
                 eprintln!("warning: {w}");
             }
             if !quiet {
-                println!(
+                outln!(
                     "{}: {} nodes, {} elements, {} equations; {} increments, {} iterations in {:.3} s",
                     shown.display(),
                     s.size.nodes,
@@ -395,9 +436,12 @@ fn run(
                     s.wall_s
                 );
                 for (n, v) in &s.final_monitors {
-                    println!("  {n} = {v:.6e}");
+                    outln!("  {n} = {v:.6e}");
                 }
-                println!("results in {}", out.display());
+                if let Some(u) = &s.ultimate {
+                    outln!("{u}");
+                }
+                outln!("results in {}", out.display());
             }
             ExitCode::SUCCESS
         }
@@ -421,12 +465,12 @@ fn check(model: PathBuf) -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let m = &b.model;
-            println!("{}: valid", model.display());
-            println!("  title:     {}", m.title);
-            println!("  nodes:     {}", m.nodes.len());
-            println!("  elements:  {}", m.elements.len());
-            println!("  dofs:      {}", m.n_dofs());
-            println!(
+            outln!("{}: valid", model.display());
+            outln!("  title:     {}", m.title);
+            outln!("  nodes:     {}", m.nodes.len());
+            outln!("  elements:  {}", m.elements.len());
+            outln!("  dofs:      {}", m.n_dofs());
+            outln!(
                 "  regions:   {}",
                 m.regions
                     .iter()
@@ -434,7 +478,7 @@ fn check(model: PathBuf) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!(
+            outln!(
                 "  supports:  {}",
                 m.supports
                     .iter()
@@ -442,7 +486,7 @@ fn check(model: PathBuf) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!(
+            outln!(
                 "  loads:     {}",
                 m.load_cases
                     .iter()
@@ -450,7 +494,7 @@ fn check(model: PathBuf) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!(
+            outln!(
                 "  monitors:  {}",
                 m.monitors
                     .iter()
@@ -458,7 +502,7 @@ fn check(model: PathBuf) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!(
+            outln!(
                 "  steps:     {}",
                 m.steps
                     .iter()
@@ -478,7 +522,7 @@ fn check(model: PathBuf) -> ExitCode {
 fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
     let Some(name) = name else {
         for (n, d, _) in EXAMPLES {
-            println!("{n:12} {d}");
+            outln!("{n:12} {d}");
         }
         return ExitCode::SUCCESS;
     };
@@ -498,14 +542,14 @@ fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
             }
         },
         None => {
-            print!("{text}");
+            out!("{text}");
             ExitCode::SUCCESS
         }
     }
 }
 
 fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
-    println!(
+    outln!(
         "{:>4} {:>9} {:>7} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>12}",
         "elem",
         "dofs",
@@ -531,7 +575,7 @@ fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
         };
         for &n in &dofs {
             match segfem::bench::run_case(kind, n as usize) {
-                Ok(r) => println!(
+                Ok(r) => outln!(
                     "{:>4} {:>9} {:>7.3} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>7.3} {:>8.3} {:>9.0} {:>12.5e}",
                     r.kind, r.dofs, r.mesh_s, r.setup_s, r.assembly_s, r.ordering_s, r.factor_s, r.solve_s, r.total_s,
                     r.peak_bytes as f64 / 1048576.0, r.tip_uy
@@ -549,7 +593,7 @@ fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
 fn bench_bare(path: &std::path::Path) -> ExitCode {
     match segfem::bench::bare_factorisation(path) {
         Ok(r) => {
-            println!("{}", serde_json::to_string(&r).expect("row serialises"));
+            outln!("{}", serde_json::to_string(&r).expect("row serialises"));
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -560,8 +604,8 @@ fn bench_bare(path: &std::path::Path) -> ExitCode {
 }
 
 fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
-    println!(
-        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  end",
+    outln!(
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
         "case",
         "equations",
         "incs",
@@ -576,8 +620,8 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
     for r in refine {
         match segfem::bench::seed_failure_case(r, concrete) {
             Ok(x) => {
-                println!(
-                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}",
+                outln!(
+                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
                     x.case,
                     x.equations,
                     x.increments,
@@ -588,10 +632,11 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
                     x.tendon_stress / 1e6,
                     x.max_opening * 1e3,
                     x.crushed,
+                    x.mode,
                     x.end
                 );
                 let (t, s) = (&x.timings, &x.timings.solver);
-                println!(
+                outln!(
                     "{:>28} assembly {:.3} s, {} factorisations ({} LDLT) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
                     "",
                     t.assembly_s,
@@ -614,13 +659,19 @@ fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
 
 /// Print one row per refinement factor of a seed-beam benchmark `case`.
 fn bench_rc(refine: Vec<usize>) -> ExitCode {
-    println!(
+    outln!(
         "{:>18} {:>9} {:>5} {:>6} {:>8} {:>9} {:>9}  end",
-        "case", "equations", "incs", "iters", "total s", "P max kN", "w [mm]"
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "total s",
+        "P max kN",
+        "w [mm]"
     );
     for r in refine {
         match segfem::bench::rc_case(r) {
-            Ok(x) => println!(
+            Ok(x) => outln!(
                 "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>9.1} {:>9.2}  {}",
                 x.case,
                 x.equations,
@@ -641,9 +692,9 @@ fn bench_rc(refine: Vec<usize>) -> ExitCode {
 }
 
 fn bench_material_point() -> ExitCode {
-    println!("{:>26} {:>14}", "concrete point", "updates/s");
+    outln!("{:>26} {:>14}", "concrete point", "updates/s");
     for (label, rate) in segfem::bench::material_point_rates(2_000_000) {
-        println!("{label:>26} {rate:>14.3e}");
+        outln!("{label:>26} {rate:>14.3e}");
     }
     ExitCode::SUCCESS
 }
@@ -652,7 +703,7 @@ fn bench_seed(
     refine: Vec<usize>,
     case: fn(usize) -> Result<segfem::bench::NonlinearRow, String>,
 ) -> ExitCode {
-    println!(
+    outln!(
         "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10} {:>9} {:>8} {:>13}",
         "case",
         "equations",
@@ -666,7 +717,7 @@ fn bench_seed(
     );
     for r in refine {
         match case(r) {
-            Ok(x) => println!(
+            Ok(x) => outln!(
                 "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10.2} {:>9.3} {:>8.3} {:>13.5e}",
                 x.case,
                 x.equations,

@@ -506,6 +506,10 @@ pub struct Bar {
     /// Relaxation of a tendon's steel during time steps: MC90 class and f_ptk [Pa] (None =
     /// no relaxation).
     pub relaxation: Option<(RelaxationClass, f64)>,
+    /// A smeared layer (`[[bar_layers]]`): the points are the Gauss points of the host
+    /// elements, `area` is the steel area per unit width ρ·t [m²/m] and each point's
+    /// `weight_length` its share of the element's area w·det J [m²]; one piece per element.
+    pub layer: bool,
 }
 
 /// Post-tensioning of a bonded tendon (docs/theory-prestress.md): not present before

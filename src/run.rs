@@ -9,6 +9,7 @@ use crate::model::Model;
 use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
 use crate::results::recorder::Recorder;
+use crate::results::ultimate::{Ultimate, UltimateWatch};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -123,6 +124,9 @@ pub struct Summary {
     pub peak_memory_bytes: Option<u64>,
     /// Final monitor values (name → value).
     pub final_monitors: Vec<(String, f64)>,
+    /// Runs to failure (a displacement or arc-length step, or a failure met): which
+    /// failure was reached first and at what load, and the peak load.
+    pub ultimate: Option<Ultimate>,
     /// Warnings met in the input.
     pub warnings: Vec<String>,
 }
@@ -147,6 +151,7 @@ pub fn size_of(model: &Model, equations: usize) -> Size {
 
 struct Progress<'a, 'm> {
     rec: Recorder<'m>,
+    watch: UltimateWatch,
     on_increment: &'a mut dyn FnMut(&Snapshot),
     dir: PathBuf,
     origin: Origin,
@@ -159,6 +164,7 @@ struct Progress<'a, 'm> {
 impl Observer for Progress<'_, '_> {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         self.rec.increment(snap)?;
+        self.watch.increment(snap);
         (self.on_increment)(snap);
         Ok(())
     }
@@ -292,6 +298,7 @@ pub fn run_file_opts(
         .to_string();
     let mut obs = Progress {
         rec,
+        watch: UltimateWatch::new(),
         on_increment,
         dir: PathBuf::from(out),
         origin: Origin {
@@ -312,6 +319,7 @@ pub fn run_file_opts(
         },
     );
     let rec = obs.rec;
+    let watch = obs.watch;
     let mut failures = obs.failures;
     let (timings, error) = match result {
         Ok(t) => (t, None),
@@ -377,6 +385,10 @@ pub fn run_file_opts(
                 .join("\n")
         )),
     };
+    let ultimate = watch.finish(
+        &model,
+        !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
+    );
     let summary = Summary {
         title: model.title.clone(),
         status: status.into(),
@@ -390,6 +402,7 @@ pub fn run_file_opts(
         timings,
         peak_memory_bytes: peak_memory(),
         final_monitors,
+        ultimate,
         warnings: built.warnings,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
@@ -407,7 +420,10 @@ pub fn run_file_opts(
             message: m,
         }),
         Some(e @ AnalysisError::NotConverged(_)) => {
-            Err(RunError::NotConverged(format!("{file}: {e}")))
+            Err(RunError::NotConverged(match &summary.ultimate {
+                Some(u) => format!("{file}: {e}\n{u}"),
+                None => format!("{file}: {e}"),
+            }))
         }
         Some(AnalysisError::Stopped {
             reason,

@@ -777,3 +777,26 @@ fn region_boxes_move_elements_and_bad_boxes_are_refused() {
         &["no element centroid"],
     );
 }
+
+#[test]
+fn incompatible_modes_are_for_q4_and_small_displacements() {
+    rejects(
+        &edit(
+            BANDED,
+            "element = \"Q8\"",
+            "element = \"Q8\"\nintegration = \"incompatible\"",
+        ),
+        "mesh.integration",
+        &["Q4 elements only", "Q8"],
+    );
+    let q4i = edit(
+        BANDED,
+        "element = \"Q8\"",
+        "element = \"Q4\"\nintegration = \"incompatible\"",
+    );
+    rejects(
+        &format!("{q4i}\n[analysis]\ngeometry = \"nonlinear\"\n"),
+        "analysis.geometry",
+        &["incompatible-mode Q4", "Q8 or Q9"],
+    );
+}

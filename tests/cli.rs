@@ -405,6 +405,32 @@ fn check_prints_the_summary() {
 }
 
 #[test]
+fn closed_stdout_pipe_ends_quietly() {
+    // `segfem check m.toml | head -1`: the reader goes away before segfem writes. The read
+    // end is dropped right after spawning, long before the process has parsed the model,
+    // so its first write meets a closed pipe; `println!` would panic there (status 101).
+    let tmp = TempDir::new("pipe");
+    assert_eq!(
+        code(&segfem(
+            tmp.path(),
+            &["example", "box-beam", "-o", "f.toml"]
+        )),
+        0
+    );
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+        .args(["check", "f.toml"])
+        .current_dir(tmp.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn segfem");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("wait for segfem");
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+}
+
+#[test]
 fn box_beam_history_is_physically_right() {
     let tmp = TempDir::new("history");
     let (model_text, o) = run_box_beam(&tmp);
@@ -924,4 +950,129 @@ fn unit_warning_reaches_stderr_and_summary() {
     let w = s["warnings"].as_array().unwrap();
     assert_eq!(w.len(), 1);
     assert_eq!(format!("warning: {}", w[0].as_str().unwrap()), want);
+}
+
+/// Float64 tuples of a DataArray `section/name` in a .vtu written by segfem (binary,
+/// UInt32 header).
+fn vtu_f64(doc: &str, section: &str, name: &str) -> Vec<f64> {
+    let els = parse_xml(doc).expect("well-formed .vtu");
+    let mut current = "";
+    for e in &els {
+        match e.name.as_str() {
+            "Points" | "Cells" | "PointData" | "CellData" => current = &e.name,
+            "DataArray" if current == section && e.attrs["Name"] == name => {
+                let raw = base64_decode(e.text.trim()).expect("base64");
+                return match e.attrs["type"].as_str() {
+                    "Float64" => raw[4..]
+                        .chunks(8)
+                        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                        .collect(),
+                    "Int32" => raw[4..]
+                        .chunks(4)
+                        .map(|b| i32::from_le_bytes(b.try_into().unwrap()) as f64)
+                        .collect(),
+                    t => panic!("{section}/{name}: type {t}"),
+                };
+            }
+            _ => {}
+        }
+    }
+    panic!("no DataArray {section}/{name}")
+}
+
+/// One 0.1 m Q4 of C30 pulled in x to ε = 1e-3, ten times its cracking strain: the
+/// Gauss-point file has the four points at (1 ± 1/√3)·0.05 m, each with one crack whose
+/// normal is x, a crack strain between ε − f_tm/E_ci and ε (the concrete between cracks
+/// unloads elastically), and σx equal to the control force over the section.
+#[test]
+fn gauss_point_file_shows_each_crack() {
+    let tmp = TempDir::new("gauss");
+    let model = r#"
+[[materials]]
+name = "c30"
+kind = "concrete"
+fcm = 38e6
+nu = 0.2
+
+[[regions]]
+name = "r"
+material = "c30"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]
+blocks = [{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+
+[[steps]]
+name = "pull"
+kind = "displacement"
+control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = 1e-4 }
+increments = 20
+"#;
+    std::fs::write(tmp.join("m.toml"), model).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = tmp.join("out");
+    let pvd = read(&out.join("results.pvd"));
+    assert!(
+        pvd.contains(r#"part="3" file="gauss_step001_inc0020.vtu""#),
+        "{pvd}"
+    );
+    let doc = read(&out.join("gauss_step001_inc0020.vtu"));
+    let pts = vtu_f64(&doc, "Points", "Points");
+    assert_eq!(pts.len(), 12, "four points");
+    let a = 0.05 * (1.0 - 1.0 / 3f64.sqrt());
+    let b = 0.05 * (1.0 + 1.0 / 3f64.sqrt());
+    for p in pts.chunks(3) {
+        for c in &p[..2] {
+            assert!(
+                (c - a).abs() < 1e-12 || (c - b).abs() < 1e-12,
+                "Gauss point {p:?}"
+            );
+        }
+    }
+    let eps = 1e-3;
+    // MC90 for fcm = 38 MPa: E_ci = 21.5e3 (fcm/10)^(1/3) MPa, f_tm = 1.4 ((fcm − 8)/10)^(2/3) MPa.
+    let e_ci = 21.5e9 * (3.8f64).cbrt();
+    let f_tm = 1.4e6 * (3.0f64).powf(2.0 / 3.0);
+    let cracks = vtu_f64(&doc, "PointData", "cracks");
+    let normal = vtu_f64(&doc, "PointData", "crack_normal");
+    let opening = vtu_f64(&doc, "PointData", "crack_strains");
+    let stress = vtu_f64(&doc, "PointData", "stress");
+    let h = History::parse(&read(&out.join("history.csv")));
+    let force = *h.column("control_force").last().unwrap();
+    for g in 0..4 {
+        assert_eq!(cracks[g], 1.0, "point {g}: one crack");
+        assert!(
+            (normal[3 * g].abs() - 1.0).abs() < 1e-9,
+            "normal {:?}",
+            &normal[3 * g..3 * g + 3]
+        );
+        let w = opening[2 * g];
+        assert!(
+            w <= eps && w >= eps - f_tm / e_ci,
+            "point {g}: crack strain {w:e} outside [{:e}, {eps:e}]",
+            eps - f_tm / e_ci
+        );
+        assert_eq!(opening[2 * g + 1], 0.0, "no second crack");
+        // Uniform field: every point carries the section's mean stress (1e-6: equilibrium
+        // tolerance of the iterations).
+        let sx = force / (0.1 * 0.1);
+        assert!(
+            (stress[3 * g] - sx).abs() <= 1e-6 * f_tm,
+            "σx {} vs F/A {sx}",
+            stress[3 * g]
+        );
+    }
 }

@@ -1,7 +1,7 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
 
-use crate::elements::bar::{bar_green_strain, bar_strain_vector};
+use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
 use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
@@ -612,7 +612,7 @@ impl<'m> System<'m> {
                                     stress: sig,
                                     plastic_strain: 0.0,
                                 };
-                                let g = bar_strain_vector(el.kind, coords, bp);
+                                let g = bar_strain_row(el.kind, coords, bp);
                                 let fs = sig * bar.area * bp.weight_length;
                                 for r in 0..nd {
                                     fe[r] += g[r] * fs;
@@ -621,7 +621,7 @@ impl<'m> System<'m> {
                             }
                             BarPhase::Bonded => {}
                         }
-                        let g = bar_strain_vector(el.kind, coords, bp);
+                        let g = bar_strain_row(el.kind, coords, bp);
                         let eps = g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>()
                             - bar_eps_ref[bc0 + i]
                             + bar.bonding_stress(p) / bar.steel.es
@@ -795,7 +795,7 @@ impl<'m> System<'m> {
                             .collect();
                         bar_green_strain(el.kind, &coords, &gp.point, &ue).0
                     } else {
-                        let g = bar_strain_vector(el.kind, &coords, &gp.point);
+                        let g = bar_strain_row(el.kind, &coords, &gp.point);
                         el.nodes
                             .iter()
                             .enumerate()

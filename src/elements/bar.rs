@@ -1057,12 +1057,18 @@ pub fn strain_along(dir: [f64; 2], eps: [f64; 3]) -> f64 {
 /// The row vector g = T(φ) B of a bar point (length 2n, interleaved dofs): ε_b = g · a_e.
 /// Entries: g_{2i} = cosφ (t·∇N_i), g_{2i+1} = sinφ (t·∇N_i) [1/m].
 pub fn bar_strain_vector(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> Vec<f64> {
+    bar_strain_row(kind, coords, p)[..2 * kind.n_nodes()].to_vec()
+}
+
+/// As [`bar_strain_vector`] without allocating (the assembly loop calls it for every bar
+/// point): the first 2n entries are g, the rest zero.
+pub fn bar_strain_row(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> [f64; 2 * MAX_NODES] {
     let n = kind.n_nodes();
     assert_eq!(coords.len(), n, "coords must have {n} entries for {kind:?}");
     let s = kind.eval(p.xi, p.eta);
     let (_, _, inv) = jacobian(&s, coords);
     let d: [[f64; 2]; MAX_NODES] = cartesian_derivatives(&s, &inv);
-    let mut g = vec![0.0; 2 * n];
+    let mut g = [0.0; 2 * MAX_NODES];
     for i in 0..n {
         let dn = p.dir[0] * d[i][0] + p.dir[1] * d[i][1];
         g[2 * i] = p.dir[0] * dn;

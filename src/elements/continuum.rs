@@ -15,6 +15,9 @@ pub enum Integration {
     Full,
     /// 2×2 Gauss for Q8 and Q9 (Q4 stays 2×2).
     Reduced,
+    /// Q4 only: 2×2 Gauss with Wilson–Taylor incompatible bending modes (QM6), condensed
+    /// in the element ([`super::incompatible`]).
+    Incompatible,
 }
 
 /// The Gauss points of an element kind under a rule.
@@ -174,6 +177,12 @@ pub fn response_at(
     out: &mut [GaussOutput],
     time: &TimeContext,
 ) -> Result<(), UpdateError> {
+    if integration == Integration::Incompatible {
+        debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
+        return super::incompatible::response_at(
+            coords, thickness, mat, committed, u, f, k, trial, out, time,
+        );
+    }
     let n = kind.n_nodes();
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);

@@ -2,6 +2,7 @@
 
 pub mod bar;
 pub mod continuum;
+pub mod incompatible;
 pub mod interface;
 pub mod tendon;
 pub mod total_lagrangian;

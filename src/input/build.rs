@@ -100,13 +100,20 @@ fn quad_kind(ctx: &Ctx, key: &str, s: &str) -> R<QuadKind> {
     }
 }
 
-fn integration(ctx: &Ctx, key: &str, s: Option<&str>) -> R<Integration> {
+/// The `integration` of elements of `kind`: `incompatible` (incompatible bending modes) is
+/// a Q4 formulation.
+pub(super) fn integration(ctx: &Ctx, key: &str, s: Option<&str>, kind: QuadKind) -> R<Integration> {
     match s {
         None | Some("full") => Ok(Integration::Full),
         Some("reduced") => Ok(Integration::Reduced),
+        Some("incompatible") if kind == QuadKind::Q4 => Ok(Integration::Incompatible),
+        Some("incompatible") => Err(ctx.err(
+            key,
+            format!("'incompatible' (bending modes) is for Q4 elements only, not {kind:?}: Q8 and Q9 bend well with full or reduced integration"),
+        )),
         Some(o) => Err(ctx.err(
             key,
-            format!("unknown integration '{o}' (expected full or reduced)"),
+            format!("unknown integration '{o}' (expected full, reduced or incompatible)"),
         )),
     }
 }
@@ -444,6 +451,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     }
     // Embedded bars (needed by bar monitors).
     build_bars(ctx, &file.bars, &file.tendons, &steels, &mut model)?;
+    super::bar_layers::build(ctx, &file.bar_layers, &steels, &mut model)?;
     // Monitors.
     unique_names(
         ctx,
@@ -612,6 +620,17 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
                 ))
             }
         };
+        if model.geometry == Geometry::Nonlinear
+            && model
+                .elements
+                .iter()
+                .any(|e| e.integration == Integration::Incompatible)
+        {
+            return Err(ctx.err(
+                "analysis.geometry",
+                "'nonlinear' is not available with incompatible-mode Q4 elements (mesh integration = \"incompatible\"): use Q8 or Q9",
+            ));
+        }
     }
     // Steps.
     if file.steps.is_empty() {
@@ -937,7 +956,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                 return Err(ctx.err("mesh.nx", "must be at least 1"));
             }
             let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q4"))?;
-            let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
+            let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
             if mesh.bands.is_empty() {
                 return Err(ctx.err(
                     "mesh.bands",
@@ -1029,6 +1048,7 @@ fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                     ctx,
                     &format!("mesh.blocks[{b}].integration"),
                     blk.integration.as_deref(),
+                    kind,
                 )?;
                 for (j, conn) in blk.elements.iter().enumerate() {
                     let key = format!("mesh.blocks[{b}].elements[{j}]");
@@ -1353,7 +1373,7 @@ fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         ));
     }
     let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
-    let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref())?;
+    let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
     let bands = bands_of(mesh, ctx, region_names)?;
     let origin = origin_of(mesh, ctx)?;
     let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
@@ -2448,6 +2468,7 @@ fn build_bars(
             piece_points: e.piece_points,
             post_tension: None,
             relaxation: None,
+            layer: false,
         });
     }
     for (i, t) in tendons.iter().enumerate() {
@@ -2553,6 +2574,7 @@ fn build_bars(
                 set_length: lock.set_length,
             }),
             relaxation: relaxation.map(|c| (c, fptk)),
+            layer: false,
         });
     }
     model.bars = out;
@@ -2648,6 +2670,7 @@ fn pretensioned_tendon(
         piece_points: e.piece_points,
         post_tension: None,
         relaxation: relaxation.map(|c| (c, fptk)),
+        layer: false,
     })
 }
 

@@ -48,16 +48,13 @@ pub fn build_gmsh(mesh: &MeshIn, ctx: &Ctx, region_names: &[&str]) -> R<GmshBuil
         .map_err(|e| ctx.err("mesh.file", format!("cannot read {}: {e}", path.display())))?;
     let g = parse_msh(&bytes, &path.display().to_string())
         .map_err(|e| ctx.err("mesh.file", e.to_string()))?;
-    let integ = match mesh.integration.as_deref() {
-        None | Some("full") => Integration::Full,
-        Some("reduced") => Integration::Reduced,
-        Some(o) => {
-            return Err(ctx.err(
-                "mesh.integration",
-                format!("unknown integration '{o}' (expected full or reduced)"),
-            ))
-        }
-    };
+    // Checked for Q4 here; each element's kind is checked again where it is built.
+    let integ = super::build::integration(
+        ctx,
+        "mesh.integration",
+        mesh.integration.as_deref(),
+        crate::fem::shape::QuadKind::Q4,
+    )?;
     for k in [
         "length",
         "nx",
@@ -158,6 +155,9 @@ fn map(
             let coords: Vec<[f64; 2]> = ids.iter().map(|&i| nodes[i]).collect();
             if let Some(m) = degenerate(&coords, &el.nodes, size) {
                 return Err(ctx.err("mesh.file", format!("{file}: element {}: {m}", el.tag)));
+            }
+            if integ == Integration::Incompatible && kind != crate::fem::shape::QuadKind::Q4 {
+                return Err(ctx.err("mesh.integration", format!("{file}: element {} is a {kind:?}: 'incompatible' (bending modes) is for Q4 elements only", el.tag)));
             }
             let detj = min_jacobian(kind, &coords, integ);
             if detj.is_nan() || detj <= 0.0 {

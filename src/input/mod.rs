@@ -1,5 +1,6 @@
 //! Model-file input: TOML schema, parsing with line numbers, validation into a [`Model`].
 
+pub mod bar_layers;
 pub mod build;
 pub mod error;
 pub mod limits;

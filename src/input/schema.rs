@@ -30,6 +30,8 @@ pub struct File {
     pub solver: Option<SolverIn>,
     #[serde(default)]
     pub bars: Vec<BarIn>,
+    #[serde(default)]
+    pub bar_layers: Vec<BarLayerIn>,
     pub analysis: Option<AnalysisIn>,
 }
 
@@ -305,6 +307,18 @@ pub struct BarIn {
     pub material: String,
     pub initial_stress: Option<f64>,
     pub gauss_points: Option<usize>,
+}
+
+/// A smeared layer of parallel bars (`[[bar_layers]]`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BarLayerIn {
+    pub name: String,
+    pub material: String,
+    pub region: String,
+    pub boxes: Option<Vec<[[f64; 2]; 2]>>,
+    pub direction: [f64; 2],
+    pub ratio: f64,
 }
 
 /// One part of a composite path: exactly one of a polyline, a parabola or an arc.

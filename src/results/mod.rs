@@ -3,6 +3,8 @@
 pub mod atomic;
 pub mod checkpoint;
 pub mod fields;
+pub mod gauss_points;
 pub mod joints;
 pub mod recorder;
+pub mod ultimate;
 pub mod vtu;

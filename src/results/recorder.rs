@@ -366,6 +366,16 @@ impl<'m> Recorder<'m> {
             write_atomic(&self.dir.join(&bname), bars_vtu(snap).as_bytes())?;
             self.pvd.push((t, 2, bname));
         }
+        if super::gauss_points::wanted(model) {
+            let gname = format!(
+                "gauss_step{:03}_inc{:04}.vtu",
+                snap.step + 1,
+                snap.increment
+            );
+            let doc = super::gauss_points::render_gauss_points(snap);
+            write_atomic(&self.dir.join(&gname), doc.as_bytes())?;
+            self.pvd.push((t, 3, gname));
+        }
         write_atomic(
             &self.dir.join("results.pvd"),
             render_pvd(&self.pvd).as_bytes(),
@@ -612,7 +622,8 @@ fn cell_states(snap: &Snapshot) -> CellStates {
     c
 }
 
-/// The bars as a .vtu of poly-lines: one cell per piece (entry, its Gauss points, exit);
+/// The bars as a .vtu of poly-lines: one cell per piece (entry, its Gauss points, exit),
+/// and one vertex per Gauss point of a smeared layer;
 /// point data = stress, strain and plastic strain (the entry/exit points take the values of
 /// the nearest Gauss point); cell data = bar index.
 fn bars_vtu(snap: &Snapshot) -> String {
@@ -631,7 +642,21 @@ fn bars_vtu(snap: &Snapshot) -> String {
     let mut cells: Vec<Vec<usize>> = Vec::new();
     let mut bar_id: Vec<i32> = Vec::new();
     let (mut stress, mut strain, mut plastic) = (Vec::new(), Vec::new(), Vec::new());
+    let mut types: Vec<u8> = Vec::new();
     for (b, bar) in model.bars.iter().enumerate() {
+        if bar.layer {
+            // A smeared layer has no line: one vertex per Gauss point.
+            for (p, gp) in bar.points.iter().enumerate() {
+                cells.push(vec![points.len()]);
+                points.push(gp.point.x);
+                stress.push(vals[b][p].stress);
+                strain.push(vals[b][p].strain);
+                plastic.push(vals[b][p].plastic_strain);
+                bar_id.push(b as i32);
+                types.push(1); // VTK_VERTEX
+            }
+            continue;
+        }
         for (k, &(p0, p1)) in bar.piece_points.iter().enumerate() {
             if p1 == p0 {
                 continue;
@@ -651,9 +676,9 @@ fn bars_vtu(snap: &Snapshot) -> String {
             push(bar.piece_ends[k][1], &vals[b][p1 - 1]);
             cells.push(cell);
             bar_id.push(b as i32);
+            types.push(4); // VTK_POLY_LINE
         }
     }
-    let types = vec![4u8; cells.len()]; // VTK_POLY_LINE
     render(
         &Grid {
             points: &points,

@@ -451,6 +451,42 @@ pub fn joint_profiles(g: &Grid) -> Vec<JointProfile> {
 /// Most joints drawn in one joint figure.
 pub const MAX_JOINTS: usize = 8;
 
+/// Further history curves for `segfem plot --also COL[,COL]`: each column against the x
+/// column of `opts`, in its own figure `curves_<COL>` (other units than the main curve's,
+/// e.g. the tendon stress beside the deflection), with the `opts.runs`; no reference
+/// markers. Returns the files written.
+pub fn extra_curves(opts: &PlotOptions, cols: &[String]) -> Result<Vec<PathBuf>, ViewError> {
+    let out_dir = opts.out.clone().unwrap_or_else(|| opts.dir.join("figures"));
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| ViewError::Io(format!("{}: {e}", out_dir.display())))?;
+    let mut files = Vec::new();
+    for c in cols {
+        let fig = curve_figure(
+            &opts.dir,
+            opts.x.as_deref(),
+            std::slice::from_ref(c),
+            &opts.runs,
+            None,
+        )?;
+        // File names from the column name only (a header such as "σ [Pa]" is not a name).
+        let stem: String = c
+            .split(' ')
+            .next()
+            .unwrap_or("")
+            .chars()
+            .map(|ch| {
+                if ch.is_ascii_alphanumeric() || ch == '_' {
+                    ch
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        files.extend(save(&fig, &out_dir, &format!("curves_{stem}"))?);
+    }
+    Ok(files)
+}
+
 /// `segfem plot`: write the figures of a run into the output directory.
 pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
     if let Some(s) = opts.scale {
