@@ -217,6 +217,8 @@ pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
     /// Set when the matrix is kept in the elimination order (then `symbolic` has none).
     pre: Option<Prepermuted>,
+    /// The matrix is to be kept permuted from the next factorisation on.
+    prepermute_due: bool,
     l_values: Vec<f64>,
     mem: MemBuffer,
     factor: Factor,
@@ -280,7 +282,7 @@ impl SparseCholesky {
             )),
             None => SymmetricOrdering::Amd,
         };
-        let mut symbolic = factorize_symbolic_cholesky(
+        let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
             ordering,
@@ -290,24 +292,10 @@ impl SparseCholesky {
             },
         )
         .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
-        // A supernodal factor reads the lower triangle of the permuted matrix: keep the matrix
-        // permuted (faer would permute it at every factorisation, ~5 % of a small nonlinear
-        // run) and analyse it again as it stands, forcing the same kind of factor.
-        let mut pre = None;
         let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
-        if supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ {
-            if let Some(perm) = symbolic.perm() {
-                let (fwd, inv) = perm.arrays();
-                let (p, sym) = Prepermuted::new(pattern, fwd, inv)?;
-                symbolic = sym;
-                pre = Some(p);
-            }
-        }
-        let req = symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()))
-            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let mem = MemBuffer::try_new(req).map_err(|e| SolverError::Internal(format!("{e:?}")))?;
+        let prepermute_due =
+            supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && symbolic.perm().is_some();
+        let mem = Self::scratch(&symbolic)?;
         let l_values = vec![0.0; symbolic.len_val()];
         let stats = SolverStats {
             symbolic_s: t.elapsed().as_secs_f64(),
@@ -316,7 +304,8 @@ impl SparseCholesky {
         };
         Ok(Self {
             symbolic,
-            pre,
+            pre: None,
+            prepermute_due,
             l_values,
             mem,
             factor: Factor::None,
@@ -325,8 +314,42 @@ impl SparseCholesky {
         })
     }
 
+    /// Scratch memory of the numeric factorisations and solves of `symbolic`.
+    fn scratch(symbolic: &SymbolicCholesky<usize>) -> Result<MemBuffer, SolverError> {
+        let req = symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()))
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        MemBuffer::try_new(req).map_err(|e| SolverError::Internal(format!("{e:?}")))
+    }
+
+    /// Keep the matrix permuted from the second factorisation on (a supernodal factor reads
+    /// the lower triangle of the permuted matrix, which faer would otherwise build at every
+    /// factorisation: ~5 % of a small nonlinear run). Not at the first: a run that
+    /// factorises once (a linear step) would pay the second symbolic analysis for nothing
+    /// (+0.1–0.2 s at 1e5 equations).
+    fn prepermute(&mut self, pattern: &LowerPattern) -> Result<(), SolverError> {
+        self.prepermute_due = false;
+        let t = std::time::Instant::now();
+        let Some(perm) = self.symbolic.perm() else {
+            return Ok(());
+        };
+        let (fwd, inv) = perm.arrays();
+        let (p, symbolic) = Prepermuted::new(pattern, fwd, inv)?;
+        self.mem = Self::scratch(&symbolic)?;
+        self.l_values = vec![0.0; symbolic.len_val()];
+        self.stats.factor_nnz = symbolic.len_val();
+        self.symbolic = symbolic;
+        self.pre = Some(p);
+        self.stats.symbolic_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
+        if self.prepermute_due && self.stats.factorisations > 0 {
+            self.prepermute(pattern)?;
+        }
         let t = std::time::Instant::now();
         self.factor = Factor::None;
         let a = match self.pre.as_mut() {
@@ -663,7 +686,12 @@ mod tests {
             let mut s = SparseCholesky::with_threshold(&p, th).unwrap();
             let supernodal = matches!(s.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
             assert_eq!(supernodal, th.0 == 0.0);
+            // The second factorisation of a supernodal solver runs on the kept-permuted
+            // matrix: the same inertia and solution.
             assert_eq!(s.factorize_indefinite(&p, &vals).unwrap(), expected);
+            assert!(s.pre.is_none());
+            assert_eq!(s.factorize_indefinite(&p, &vals).unwrap(), expected);
+            assert_eq!(s.pre.is_some(), supernodal);
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
             let mut x = b.clone();
             s.solve_in_place(&mut x);
