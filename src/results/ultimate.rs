@@ -1,10 +1,13 @@
 //! Which failure a run to failure reached, and at what load: the first of tendon yield,
-//! concrete crushing (at an opened joint or elsewhere) and loss of equilibrium met along the
-//! converged increments, with the peak load. Written to `summary.json` (`ultimate`) and
-//! printed by `segfem run` (docs/running.md, "Runs to failure").
+//! concrete crushing (at an opened joint or elsewhere) and loss of equilibrium (a limit
+//! point) met along the converged increments, with the peak load. First yield of the
+//! reinforcement is listed among the events but is not a failure. Written to
+//! `summary.json` (`ultimate`) and printed by `segfem run` (docs/running.md, "Runs to
+//! failure").
 //!
-//! The events are read from the committed states at each converged increment, so the
-//! verdict costs one pass over the tendons, concrete points and joints per increment.
+//! Yield and crushing are read from the committed states at each converged increment (one
+//! pass over the tendons, bars, concrete points and joints per increment); the limit point
+//! is found at the end, from the whole load history.
 
 use crate::analysis::steps::Snapshot;
 use crate::model::Model;
@@ -20,6 +23,9 @@ struct Event {
     at: usize,
 }
 
+/// Name of the load measure when it is the force of a displacement control.
+pub const CONTROL_FORCE: &str = "control force";
+
 /// How a run to failure ended (summary.json `ultimate`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Ultimate {
@@ -28,17 +34,21 @@ pub struct Ultimate {
     pub mode: String,
     /// What and where (tendon and its stress, crushed points and joint, …).
     pub detail: String,
-    /// The load measure: the load case whose factor grew most over the run.
+    /// The load measure: the load case whose factor varied most in the displacement and
+    /// arc-length steps (over the whole run if there are none), or [`CONTROL_FORCE`] when
+    /// only displacement controls move the structure there.
     pub load_case: String,
-    /// Factor of that load case when the failure was first met (the peak if none) [-].
+    /// The load measure when the failure was first met (the peak if none): a load factor
+    /// [-], or the magnitude of the control force [N].
     pub at_factor: f64,
-    /// Largest factor of that load case reached [-].
+    /// Largest value of the load measure reached (factor [-] or force [N]).
     pub peak_factor: f64,
     /// Step and increment (1-based) of the peak.
     pub peak_step: String,
     /// Increment of the peak within its step (1-based).
     pub peak_increment: usize,
-    /// Every failure event met, in order: (mode, factor of the load case when first met).
+    /// Every event met, in order: (mode, load measure when first met). Besides the failure
+    /// modes it lists "reinforcement yield" (first yield of a bar that is not a tendon).
     pub events: Vec<(String, f64)>,
     /// How the run ended: "completed" or "no convergence beyond the last increment".
     pub ended: String,
@@ -46,22 +56,33 @@ pub struct Ultimate {
 
 impl fmt::Display for Ultimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let value = |v: f64| {
+            if self.load_case == CONTROL_FORCE {
+                format!("{:.4} kN", v / 1e3)
+            } else {
+                format!("{v:.4}")
+            }
+        };
         if self.mode == "none reached" {
             write!(
                 f,
-                "ultimate: no failure reached; peak {} = {:.4} (step '{}', increment {}); run {}",
-                self.load_case, self.peak_factor, self.peak_step, self.peak_increment, self.ended
+                "ultimate: no failure reached; peak {} = {} (step '{}', increment {}); run {}",
+                self.load_case,
+                value(self.peak_factor),
+                self.peak_step,
+                self.peak_increment,
+                self.ended
             )
         } else {
             write!(
                 f,
-                "ultimate: {} at {} = {:.4} ({}); peak {} = {:.4} (step '{}', increment {}); run {}",
+                "ultimate: {} at {} = {} ({}); peak {} = {} (step '{}', increment {}); run {}",
                 self.mode,
                 self.load_case,
-                self.at_factor,
+                value(self.at_factor),
                 self.detail,
                 self.load_case,
-                self.peak_factor,
+                value(self.peak_factor),
                 self.peak_step,
                 self.peak_increment,
                 self.ended
@@ -70,20 +91,33 @@ impl fmt::Display for Ultimate {
     }
 }
 
+/// One converged increment as the watch keeps it.
+#[derive(Debug, Clone)]
+struct Row {
+    step: usize,
+    increment: usize,
+    factors: Vec<f64>,
+    /// Force of the displacement control [N] (displacement steps).
+    control_force: Option<f64>,
+    /// The increment belongs to a displacement or arc-length step.
+    path: bool,
+    negative_pivots: usize,
+}
+
 /// Follows the converged increments of a run and tells which failure it reached.
 #[derive(Debug, Default)]
 pub struct UltimateWatch {
-    /// (step, increment within it, load factors) of every converged increment.
-    rows: Vec<(usize, usize, Vec<f64>)>,
+    rows: Vec<Row>,
     tendon_yield: Option<Event>,
+    bar_yield: Option<Event>,
+    /// First crushing in an element touching an opened joint.
+    joint_crushing: Option<Event>,
+    /// First crushing elsewhere (or before the joint it touches opened).
     crushing: Option<Event>,
-    equilibrium: Option<Event>,
-    /// Largest arc-length factor so far in the current path step, and its step.
-    lambda_peak: Option<(usize, f64)>,
 }
 
-/// Relative drop of the arc-length factor below its peak taken as a limit point (well
-/// above the Newton tolerance, so that convergence noise on a plateau is not one) [-].
+/// Relative drop of the load below its peak, later in the same step, taken as a limit point
+/// (well above the Newton tolerance, so that convergence noise on a plateau is not one) [-].
 const LIMIT_DROP: f64 = 1e-3;
 
 impl UltimateWatch {
@@ -97,8 +131,14 @@ impl UltimateWatch {
         let sys = snap.system;
         let model = sys.model;
         let k = self.rows.len();
-        self.rows
-            .push((snap.step, snap.increment, snap.factors.to_vec()));
+        self.rows.push(Row {
+            step: snap.step,
+            increment: snap.increment,
+            factors: snap.factors.to_vec(),
+            control_force: snap.control_force,
+            path: model.steps[snap.step].path.is_some(),
+            negative_pivots: snap.negative_pivots,
+        });
         if self.tendon_yield.is_none() {
             for (t, st) in model.tendons.iter().zip(&sys.tendon_committed) {
                 let Some(st) = st else { continue };
@@ -118,88 +158,173 @@ impl UltimateWatch {
                 }
             }
         }
-        if self.crushing.is_none() {
-            self.crushing = crushing(model, snap, k);
+        if self.tendon_yield.is_none() || self.bar_yield.is_none() {
+            self.bar_events(snap, k);
         }
-        if self.equilibrium.is_none() && model.steps[snap.step].path.is_some() {
-            // A limit point: negative pivots in the tangent, or the arc-length factor falling
-            // back from its peak.
-            let lam = snap.arc_length_factor;
-            let fell = match (lam, self.lambda_peak) {
-                (Some(l), Some((s, p))) if s == snap.step => {
-                    l < p - LIMIT_DROP * p.abs().max(1e-12)
-                }
-                _ => false,
-            };
-            if let Some(l) = lam {
-                match self.lambda_peak {
-                    Some((s, p)) if s == snap.step && p >= l => {}
-                    _ => self.lambda_peak = Some((snap.step, l)),
+        if self.crushing.is_none() || self.joint_crushing.is_none() {
+            for e in crushing(model, snap, k) {
+                let slot = if e.mode == "concrete crushing" {
+                    &mut self.crushing
+                } else {
+                    &mut self.joint_crushing
+                };
+                if slot.is_none() {
+                    *slot = Some(e);
                 }
             }
-            if fell || snap.negative_pivots > 0 {
-                self.equilibrium = Some(Event {
-                    mode: "loss of equilibrium",
-                    detail: if fell {
-                        "the load falls past its peak".into()
-                    } else {
-                        format!(
-                            "{} negative pivots in the tangent (limit point)",
-                            snap.negative_pivots
-                        )
-                    },
+        }
+    }
+
+    /// First yield of a bonded or pre-tensioned tendon ("tendon yield") and of a plain bar
+    /// ("reinforcement yield") at increment `k`.
+    fn bar_events(&mut self, snap: &Snapshot, k: usize) {
+        let sys = snap.system;
+        let model = sys.model;
+        for (&(b, _), out) in sys.bar_gps.iter().zip(&sys.bar_out) {
+            if out.plastic_strain == 0.0 {
+                continue;
+            }
+            let bar = &model.bars[b];
+            let tendon =
+                bar.post_tension.is_some() || bar.initial_stress != 0.0 || bar.relaxation.is_some();
+            let (slot, mode, what) = if tendon {
+                (&mut self.tendon_yield, "tendon yield", "tendon")
+            } else {
+                (&mut self.bar_yield, "reinforcement yield", "bar")
+            };
+            if slot.is_none() {
+                *slot = Some(Event {
+                    mode,
+                    detail: format!("{what} {} at {:.0} MPa", bar.name, out.stress.abs() / 1e6),
                     at: k,
                 });
             }
         }
     }
 
+    /// The load measure at each watched increment, and its name: the load case whose factor
+    /// varied most over the path steps (the whole run if none), or the magnitude of the
+    /// displacement control's force when no load factor moves in the path steps.
+    fn measure(&self, model: &Model) -> (String, Vec<f64>) {
+        let n_cases = self.rows.iter().map(|r| r.factors.len()).max().unwrap_or(0);
+        let path: Vec<&Row> = self.rows.iter().filter(|r| r.path).collect();
+        let factor = |r: &Row, c: usize| r.factors.get(c).copied().unwrap_or(0.0);
+        let variation = |rows: &[&Row], c: usize| {
+            let (lo, hi) = rows
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+                    (a.min(factor(r, c)), b.max(factor(r, c)))
+                });
+            hi - lo
+        };
+        let name = |c: usize| {
+            model
+                .load_cases
+                .get(c)
+                .map(|lc| lc.name.clone())
+                .unwrap_or_default()
+        };
+        if !path.is_empty() {
+            let best =
+                (0..n_cases).max_by(|&a, &b| variation(&path, a).total_cmp(&variation(&path, b)));
+            let moves = best.is_some_and(|c| variation(&path, c) > 0.0);
+            if !moves && path.iter().any(|r| r.control_force.is_some()) {
+                let v = self
+                    .rows
+                    .iter()
+                    .map(|r| r.control_force.map_or(0.0, f64::abs))
+                    .collect();
+                return (CONTROL_FORCE.into(), v);
+            }
+            if let (Some(c), true) = (best, moves) {
+                return (name(c), self.rows.iter().map(|r| factor(r, c)).collect());
+            }
+        }
+        // No path step (or nothing moves in it): the case whose factor grew most from the
+        // first increment.
+        let (first, last) = (&self.rows[0], &self.rows[self.rows.len() - 1]);
+        let c = (0..n_cases)
+            .max_by(|&a, &b| {
+                (factor(last, a) - factor(first, a))
+                    .abs()
+                    .total_cmp(&(factor(last, b) - factor(first, b)).abs())
+            })
+            .unwrap_or(0);
+        (name(c), self.rows.iter().map(|r| factor(r, c)).collect())
+    }
+
+    /// The limit point: the peak `p` of the load measure `v` in a path step, if later in
+    /// that step the load falls LIMIT_DROP below it or the tangent shows negative pivots.
+    fn limit_point(&self, v: &[f64], p: usize) -> Option<Event> {
+        let row = &self.rows[p];
+        if !row.path {
+            return None;
+        }
+        let later = || (p..self.rows.len()).filter(|&j| self.rows[j].step == row.step);
+        let drop = v[p] - LIMIT_DROP * v[p].abs().max(1e-300);
+        let detail = if later().any(|j| v[j] < drop) {
+            "the load falls past its peak".to_string()
+        } else if let Some(j) = later().find(|&j| self.rows[j].negative_pivots > 0) {
+            format!(
+                "{} negative pivots in the tangent at the peak or after it (limit point)",
+                self.rows[j].negative_pivots
+            )
+        } else {
+            return None;
+        };
+        Some(Event {
+            mode: "loss of equilibrium",
+            detail,
+            at: p,
+        })
+    }
+
     /// The verdict, for runs that go to failure: those with a displacement or arc-length
     /// step, or any run in which a failure event was met. `converged`: the run ended
     /// without a failed increment.
     pub fn finish(&self, model: &Model, converged: bool) -> Option<Ultimate> {
-        let mut events: Vec<&Event> = [&self.tendon_yield, &self.crushing, &self.equilibrium]
-            .into_iter()
-            .flatten()
-            .collect();
-        let path = model.steps.iter().any(|s| s.path.is_some());
-        if self.rows.is_empty() || (events.is_empty() && !path) {
+        let path = self.rows.iter().any(|r| r.path);
+        let failures = [&self.tendon_yield, &self.joint_crushing, &self.crushing];
+        if self.rows.is_empty() || (failures.iter().all(|e| e.is_none()) && !path) {
             return None;
         }
+        let (load_case, v) = self.measure(model);
+        let peak = (0..v.len())
+            .max_by(|&a, &b| v[a].total_cmp(&v[b]).then(b.cmp(&a)))
+            .unwrap_or(0);
+        let equilibrium = self.limit_point(&v, peak);
+        // Failure modes in the order met (ties: yield, crushing, equilibrium).
+        let mut modes: Vec<&Event> = [
+            &self.tendon_yield,
+            &self.joint_crushing,
+            &self.crushing,
+            &equilibrium,
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        modes.sort_by_key(|e| e.at);
+        let mut events: Vec<&Event> = modes
+            .iter()
+            .copied()
+            .chain(self.bar_yield.as_ref())
+            .collect();
         events.sort_by_key(|e| e.at);
-        // The load measure: the load case whose factor grew most from the first increment.
-        let first = &self.rows[0].2;
-        let last = &self.rows[self.rows.len() - 1].2;
-        let case = (0..first.len())
-            .max_by(|&a, &b| {
-                (last[a] - first[a])
-                    .abs()
-                    .total_cmp(&(last[b] - first[b]).abs())
-            })
-            .unwrap_or(0);
-        let factor = |k: usize| self.rows[k].2.get(case).copied().unwrap_or(0.0);
-        let peak = (0..self.rows.len())
-            .max_by(|&a, &b| factor(a).total_cmp(&factor(b)))
-            .unwrap_or(0);
-        let (mode, detail, at) = match events.first() {
-            Some(e) => (e.mode.to_string(), e.detail.clone(), factor(e.at)),
-            None => ("none reached".into(), String::new(), factor(peak)),
+        let (mode, detail, at) = match modes.first() {
+            Some(e) => (e.mode.to_string(), e.detail.clone(), v[e.at]),
+            None => ("none reached".into(), String::new(), v[peak]),
         };
         Some(Ultimate {
             mode,
             detail,
-            load_case: model
-                .load_cases
-                .get(case)
-                .map(|c| c.name.clone())
-                .unwrap_or_default(),
+            load_case,
             at_factor: at,
-            peak_factor: factor(peak),
-            peak_step: model.steps[self.rows[peak].0].name.clone(),
-            peak_increment: self.rows[peak].1,
+            peak_factor: v[peak],
+            peak_step: model.steps[self.rows[peak].step].name.clone(),
+            peak_increment: self.rows[peak].increment,
             events: events
                 .iter()
-                .map(|e| (e.mode.to_string(), factor(e.at)))
+                .map(|e| (e.mode.to_string(), v[e.at]))
                 .collect(),
             ended: if converged {
                 "completed".into()
@@ -210,49 +335,71 @@ impl UltimateWatch {
     }
 }
 
-/// Crushed concrete points at increment `k`: "crushing at an opened joint" when a crushed
-/// element touches a joint that is open, else "concrete crushing".
-fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Option<Event> {
+/// Crushed concrete points at increment `k`: "crushing at an opened joint" for crushed
+/// elements touching a joint that is open, "concrete crushing" for the others (both events
+/// may be met at once).
+fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Vec<Event> {
     let sys = snap.system;
+    let crushed_points = |e: usize| {
+        sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
+            .iter()
+            .filter(|p| p.is_crushed())
+            .count()
+    };
     let crushed: Vec<usize> = (0..model.elements.len())
-        .filter(|&e| {
-            sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
-                .iter()
-                .any(|p| p.is_crushed())
-        })
+        .filter(|&e| crushed_points(e) > 0)
         .collect();
     if crushed.is_empty() {
-        return None;
+        return Vec::new();
     }
-    let points = sys.committed.iter().filter(|p| p.is_crushed()).count();
+    let mut at_joint = vec![false; crushed.len()];
+    let mut events = Vec::new();
     for (j, joint) in model.joints.iter().enumerate() {
-        let touches = crushed.iter().any(|&e| {
+        let touches = |e: usize| {
             joint.interfaces.iter().any(|&i| {
                 model.interfaces[i]
                     .nodes
                     .iter()
                     .any(|n| model.elements[e].nodes.contains(n))
             })
-        });
-        if touches && super::joints::summarise(sys, j).max_opening > 0.0 {
-            return Some(Event {
+        };
+        let here: Vec<usize> = (0..crushed.len())
+            .filter(|&c| touches(crushed[c]))
+            .collect();
+        if here.is_empty() || super::joints::summarise(sys, j).max_opening <= 0.0 {
+            continue;
+        }
+        let points: usize = here.iter().map(|&c| crushed_points(crushed[c])).sum();
+        if !here.iter().any(|&c| at_joint[c]) && events.is_empty() {
+            events.push(Event {
                 mode: "crushing at an opened joint",
                 detail: format!(
                     "joint {}, {points} crushed points in {} elements",
                     joint.name,
-                    crushed.len()
+                    here.len()
                 ),
                 at: k,
             });
         }
+        for c in here {
+            at_joint[c] = true;
+        }
     }
-    Some(Event {
-        mode: "concrete crushing",
-        detail: format!(
-            "{points} crushed points in {} elements (first element {})",
-            crushed.len(),
-            crushed[0] + 1
-        ),
-        at: k,
-    })
+    let elsewhere: Vec<usize> = (0..crushed.len())
+        .filter(|&c| !at_joint[c])
+        .map(|c| crushed[c])
+        .collect();
+    if let Some(&first) = elsewhere.first() {
+        let points: usize = elsewhere.iter().map(|&e| crushed_points(e)).sum();
+        events.push(Event {
+            mode: "concrete crushing",
+            detail: format!(
+                "{points} crushed points in {} elements (first element {})",
+                elsewhere.len(),
+                first + 1
+            ),
+            at: k,
+        });
+    }
+    events
 }
