@@ -412,6 +412,9 @@ pub struct TendonEl {
     pub ep: f64,
     /// Characteristic tensile strength f_ptk [Pa] (yield at 0.9 f_ptk).
     pub fptk: f64,
+    /// Uniaxial law of the steel: yield 0.9 f_ptk, perfectly plastic, or hardening to f_ptk
+    /// at ε_uk (`[[tendons]] eps_uk`).
+    pub steel: crate::materials::steel::SteelParams,
     /// Stress of each span as stressed, on the geometry at the start of its stressing step
     /// (friction and set losses included, its own elastic shortening not: the tendon loses
     /// that during the step) [Pa].

@@ -541,7 +541,7 @@ proptest! {
     ) {
         let pts = tendon_points(6.0, &sag);
         let law = if plastic {
-            TendonLaw::ElasticPlastic { yield_stress: 1.4e9, hardening: 5e9 }
+            TendonLaw::ElasticPlastic { yield_stress: 1.4e9, hardening: 5e9, cap: f64::INFINITY }
         } else {
             TendonLaw::Elastic
         };
@@ -707,7 +707,7 @@ proptest! {
     /// against central differences, as above.
     #[test]
     fn tendon_law_tangent_fd(path in prop::collection::vec(-0.01..0.03f64, 3), hard in 0.0..1e10f64) {
-        let law = TendonLaw::ElasticPlastic { yield_stress: 1.674e9, hardening: hard };
+        let law = TendonLaw::ElasticPlastic { yield_stress: 1.674e9, hardening: hard, cap: f64::INFINITY };
         let mut c = Default::default();
         for &eps in &path {
             let (s, et, st) = law.update(195e9, eps, &c);

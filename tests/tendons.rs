@@ -595,3 +595,58 @@ fn nonlinear_geometry_removes_the_spurious_second_order_moment() {
     // The deviator still helps.
     assert!(ud_n > 1.03 * un_n, "deviator {ud_n} vs none {un_n}");
 }
+
+/// `eps_uk` on an external tendon: prestressing steel hardening linearly from
+/// (0.9 f_ptk/E_p, 0.9 f_ptk) to (ε_uk, f_ptk), then perfectly plastic at f_ptk. The
+/// deviated tendon of the segmental beam above, pushed 80 mm: without `eps_uk` its stress
+/// stops at 0.9 f_ptk; with it the stress passes 0.9 f_ptk, never exceeds f_ptk, and where
+/// it lies between them it sits on the hardening line at the span's total strain
+/// σ/E_p + ε_p (checked to 1e-9: the return mapping is exact for a linear law); the beam
+/// carries more load past the yield of the plastic tendon.
+#[test]
+fn tendon_eps_uk_hardens_to_fptk() {
+    let points = "[[0.0, 0.1], [3.0, 0.1], [6.0, 0.1]]";
+    let (ep, fptk, eps_uk) = (195e9, 1860e6, 0.0105);
+    /// The push, and every span's (stress [Pa], plastic strain [-]) at every increment.
+    struct Spans(Push, Vec<(f64, f64)>);
+    impl Observer for Spans {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            for sp in &s.system.tendon_committed[0].as_ref().unwrap().spans {
+                self.1.push((sp.stress, sp.law.plastic_strain));
+            }
+            self.0.increment(s)
+        }
+    }
+    let run_push = |text: &str| {
+        let model = segfem::input::parse(text, "seg.toml").unwrap().model;
+        let mut obs = Spans(Push::default(), Vec::new());
+        steps::run(&model, &mut obs).unwrap_or_else(|e| panic!("{e}"));
+        (obs.0 .0, obs.1)
+    };
+    let plain = segmental(points, "linear");
+    let hard = plain.replace(
+        "fptk = 1860e6\n",
+        &format!("fptk = 1860e6\neps_uk = {eps_uk}\n"),
+    );
+    assert_ne!(plain, hard);
+    let (p0, _) = run_push(&plain);
+    let (p1, spans) = run_push(&hard);
+    let smax = |r: &[(f64, f64, f64, f64)]| r.iter().map(|x| x.2).fold(0.0, f64::max);
+    assert!((smax(&p0) - 0.9 * fptk).abs() < 1e-6 * fptk);
+    assert!(smax(&p1) > 0.9 * fptk + 0.02 * fptk, "{}", smax(&p1));
+    let (fy, eps_y) = (0.9 * fptk, 0.9 * fptk / ep);
+    let slope = (fptk - fy) / (eps_uk - eps_y);
+    let mut on_line = 0;
+    for &(s, ep_) in &spans {
+        assert!(s <= fptk * (1.0 + 1e-12), "σ = {s}");
+        if s > fy && s < fptk * (1.0 - 1e-9) {
+            let eps = s / ep + ep_;
+            let expect = fy + slope * (eps - eps_y);
+            assert!((s - expect).abs() < 1e-9 * fptk, "σ = {s}, line {expect}");
+            on_line += 1;
+        }
+    }
+    assert!(on_line > 0, "no span on the hardening branch");
+    let ult = |r: &[(f64, f64, f64, f64)]| r.iter().map(|x| x.1).fold(0.0, f64::max);
+    assert!(ult(&p1) > ult(&p0), "{} vs {}", ult(&p1), ult(&p0));
+}

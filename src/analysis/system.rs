@@ -824,7 +824,7 @@ impl<'m> System<'m> {
             data.area,
             data.ep,
             data.span_stress[0],
-            TendonLaw::prestressing_steel(data.fptk),
+            TendonLaw::from_steel(&data.steel),
             data.mode,
         )
         .and_then(|e| e.with_span_initial_stresses(data.span_stress.clone()))

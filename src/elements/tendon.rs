@@ -52,13 +52,16 @@ pub type StressFn = Arc<dyn Fn(f64) -> (f64, f64) + Send + Sync>;
 pub enum TendonLaw {
     /// Linear elastic, σ = E_p ε.
     Elastic,
-    /// Elastic–plastic with yield stress `yield_stress` \[Pa\] (e.g. 0.9 f_ptk) and linear
-    /// isotropic hardening modulus `hardening` \[Pa\] (0 = perfectly plastic).
+    /// Elastic–plastic with yield stress `yield_stress` \[Pa\] (e.g. 0.9 f_ptk), linear
+    /// isotropic hardening modulus `hardening` \[Pa\] (0 = perfectly plastic) and the stress
+    /// held at `cap` \[Pa\] once the hardening reaches it (f_ptk; infinity for no cap).
     ElasticPlastic {
         /// Yield stress f_y \[Pa\].
         yield_stress: f64,
         /// Plastic hardening modulus H \[Pa\] (dσ/dε_p).
         hardening: f64,
+        /// Largest stress \[Pa\]: perfectly plastic there (≥ `yield_stress`).
+        cap: f64,
     },
     /// User-supplied nonlinear-elastic (path-independent) law σ(ε), dσ/dε.
     Custom(StressFn),
@@ -71,9 +74,10 @@ impl fmt::Debug for TendonLaw {
             TendonLaw::ElasticPlastic {
                 yield_stress,
                 hardening,
+                cap,
             } => write!(
                 f,
-                "ElasticPlastic {{ yield_stress: {yield_stress}, hardening: {hardening} }}"
+                "ElasticPlastic {{ yield_stress: {yield_stress}, hardening: {hardening}, cap: {cap} }}"
             ),
             TendonLaw::Custom(_) => write!(f, "Custom(..)"),
         }
@@ -96,6 +100,20 @@ impl TendonLaw {
         TendonLaw::ElasticPlastic {
             yield_stress: 0.9 * fptk,
             hardening: 0.0,
+            cap: f64::INFINITY,
+        }
+    }
+
+    /// Prestressing steel of a uniaxial steel law `steel` (yield f_y, hardening H, cap
+    /// f_u: e.g. [`SteelParams::prestressing_hardening`], linear from 0.9 f_ptk to f_ptk at
+    /// ε_uk, then perfectly plastic).
+    ///
+    /// [`SteelParams::prestressing_hardening`]: crate::materials::steel::SteelParams::prestressing_hardening
+    pub fn from_steel(steel: &crate::materials::steel::SteelParams) -> Self {
+        TendonLaw::ElasticPlastic {
+            yield_stress: steel.fy,
+            hardening: steel.hardening,
+            cap: steel.fu,
         }
     }
 
@@ -107,19 +125,26 @@ impl TendonLaw {
             TendonLaw::ElasticPlastic {
                 yield_stress,
                 hardening,
+                cap,
             } => {
                 let trial = e * (eps - c.plastic_strain);
-                let f = trial.abs() - (yield_stress + hardening * c.hardening_var);
+                let f = trial.abs() - (yield_stress + hardening * c.hardening_var).min(*cap);
                 if f <= 0.0 {
                     (trial, e, *c)
                 } else {
-                    let dg = f / (e + hardening);
+                    // Return on the hardening line, or onto the cap if that line passes it.
+                    let mut dg = f / (e + hardening);
+                    let mut tangent = e * hardening / (e + hardening);
+                    if yield_stress + hardening * (c.hardening_var + dg) > *cap {
+                        dg = (trial.abs() - cap) / e;
+                        tangent = 0.0;
+                    }
                     let s = trial.signum();
                     let st = LawState {
                         plastic_strain: c.plastic_strain + s * dg,
                         hardening_var: c.hardening_var + dg,
                     };
-                    (trial - s * e * dg, e * hardening / (e + hardening), st)
+                    (trial - s * e * dg, tangent, st)
                 }
             }
             TendonLaw::Custom(fun) => {
@@ -981,6 +1006,7 @@ mod tests {
             TendonLaw::ElasticPlastic {
                 yield_stress: 1010e6,
                 hardening: 5e9,
+                cap: f64::INFINITY,
             },
         ];
         for law in laws {
@@ -1019,6 +1045,56 @@ mod tests {
         let r2 = t.response(&u, &r.state);
         let expect = 0.9 * fptk - EP * 0.001 / 5.0;
         assert!((r2.state.stresses()[0] - expect).abs() < 1e-9 * fptk);
+    }
+
+    /// Prestressing steel with ε_uk (SteelParams::prestressing_hardening): on the line from
+    /// (0.9 f_ptk/E_p, 0.9 f_ptk) to (ε_uk, f_ptk) in between, tangent its slope; at and beyond
+    /// ε_uk the stress stays f_ptk with zero tangent, and unloading from there is elastic.
+    /// Tolerance 1e-9 rel (round-off).
+    #[test]
+    fn prestressing_steel_hardens_to_fptk_at_eps_uk() {
+        let (fptk, eps_uk) = (1860e6, 0.035);
+        let steel = crate::materials::steel::SteelParams::prestressing_hardening(EP, fptk, eps_uk);
+        let law = TendonLaw::from_steel(&steel);
+        let (fy, eps_y) = (0.9 * fptk, 0.9 * fptk / EP);
+        let slope = (fptk - fy) / (eps_uk - eps_y);
+        let c = LawState::default();
+        for eps in [0.5 * eps_y, eps_y + 1e-4, 0.02, eps_uk - 1e-6] {
+            let (s, t, _) = law.update(EP, eps, &c);
+            let (es, et) = if eps <= eps_y {
+                (EP * eps, EP)
+            } else {
+                (fy + slope * (eps - eps_y), slope)
+            };
+            assert!(
+                (s - es).abs() < 1e-9 * fptk,
+                "ε = {eps}: σ = {s}, expected {es}"
+            );
+            assert!(
+                (t - et).abs() < 1e-9 * EP,
+                "ε = {eps}: tangent {t}, expected {et}"
+            );
+        }
+        // In steps (history carried) and beyond ε_uk: capped at f_ptk.
+        let mut st = c;
+        for k in 1..=60 {
+            let eps = 0.001 * k as f64;
+            let (s, t, n) = law.update(EP, eps, &st);
+            st = n;
+            if eps > eps_uk {
+                assert!(
+                    (s - fptk).abs() < 1e-9 * fptk && t == 0.0,
+                    "ε = {eps}: {s}, {t}"
+                );
+            } else if eps > eps_y {
+                assert!(
+                    (s - fy - slope * (eps - eps_y)).abs() < 1e-9 * fptk,
+                    "ε = {eps}: {s}"
+                );
+            }
+        }
+        let (s, t, _) = law.update(EP, 0.059, &st);
+        assert!((s - (fptk - EP * 0.001)).abs() < 1e-9 * fptk && t == EP);
     }
 
     /// Second-order effect: a lateral (vertical) deviator movement rotates the span forces

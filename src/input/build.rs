@@ -894,6 +894,31 @@ fn tendon_steel(
     Ok((area, ep, fptk))
 }
 
+/// The steel law of tendon `t` (`key` = "tendons[i]"): yield at 0.9 f_ptk, perfectly
+/// plastic, or with `eps_uk` linear hardening to f_ptk at ε_uk (> 0.9 f_ptk/E_p, < 0.1).
+fn tendon_law(
+    ctx: &Ctx,
+    key: &str,
+    named: &str,
+    t: &TendonIn,
+    ep: f64,
+    fptk: f64,
+) -> R<SteelParams> {
+    match t.eps_uk {
+        None => Ok(SteelParams::prestressing(ep, fptk)),
+        Some(e) if e.is_finite() && e > 0.9 * fptk / ep && e < 0.1 => {
+            Ok(SteelParams::prestressing_hardening(ep, fptk, e))
+        }
+        Some(e) => Err(ctx.err(
+            format!("{key}.eps_uk"),
+            format!(
+                "{named}: must lie between the yield strain 0.9 fptk/Ep = {:.5} and 0.1 (got {e})",
+                0.9 * fptk / ep
+            ),
+        )),
+    }
+}
+
 /// `regions[i].boxes`: elements whose centroid (mean of the corner nodes) lies inside one of
 /// the region's boxes [[x0, y0], [x1, y1]] (m) are moved to that region, whatever the mesh
 /// generator gave them (anchor blocks, loading plates). Later regions win where boxes overlap.
@@ -1674,6 +1699,14 @@ fn build_tendon(
     let fptk = positive(ctx, &k("fptk"), t.fptk)?;
     units::modulus(warnings, ctx, &k("Ep"), ep);
     units::strength(warnings, ctx, &k("fptk"), fptk);
+    let steel = tendon_law(
+        ctx,
+        &format!("tendons[{i}]"),
+        &format!("tendon '{}'", t.name),
+        t,
+        ep,
+        fptk,
+    )?;
     let size = locate::model_size(model);
     let mut nodes = Vec::new();
     for (j, p) in t.points.iter().enumerate() {
@@ -1785,7 +1818,7 @@ fn build_tendon(
         area,
         ep,
         span_stress[0],
-        TendonLaw::prestressing_steel(fptk),
+        TendonLaw::from_steel(&steel),
         mode,
     )
     .map_err(|e| ctx.err(k("points"), e.to_string()))?;
@@ -1804,6 +1837,7 @@ fn build_tendon(
         area,
         ep,
         fptk,
+        steel,
         span_stress,
         mode,
         stressed_in_step: 0,
@@ -2503,7 +2537,7 @@ fn build_bars(
             }
         }
         let (area, ep, fptk) = tendon_steel(ctx, &key, &named, t)?;
-        let steel = SteelParams::prestressing(ep, fptk);
+        let steel = tendon_law(ctx, &key, &named, t, ep, fptk)?;
         let sigma_pi = jacking_stress_of(ctx, i, t, area, fptk)?.ok_or_else(|| {
             ctx.err(
                 k("jacking_stress"),
@@ -2662,7 +2696,7 @@ fn pretensioned_tendon(
     Ok(Bar {
         name: t.name.clone(),
         area,
-        steel: SteelParams::prestressing(ep, fptk),
+        steel: tendon_law(ctx, &key, &named, t, ep, fptk)?,
         initial_stress: s0,
         n_pieces: e.piece_points.len(),
         points: e.points,

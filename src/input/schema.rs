@@ -173,6 +173,7 @@ pub struct TendonIn {
     #[serde(rename = "Ep")]
     pub ep: f64,
     pub fptk: f64,
+    pub eps_uk: Option<f64>,
     pub initial_stress: Option<f64>,
     pub jacking_stress: Option<f64>,
     pub jacking_force: Option<f64>,
