@@ -626,3 +626,185 @@ fn rc_beam_cracks_yields_and_holds_a_plateau() {
         );
     }
 }
+
+/// A 1 m square panel (one Q4, 70 mm thick, C30) with equal smeared layers in x and y
+/// (ρ = 1 %, f_y = 400 MPa), in pure shear v by edge tractions, by arc length past the
+/// cracking snap-back. Closed forms:
+/// - cracking at the pure-shear strength of the Ottosen surface τ_u (σ_e(0, 0, τ_u) = f_cm,
+///   found here by bisection on the surface): every point cracks at once at 45° — no
+///   point may flow plastically first (pure shear lies on the compression/tension routing
+///   border, I1 = 0). Required: τ_u lies within the increment in which the points crack;
+/// - after cracking (the crack band of a 1 m element leaves no tension across the crack)
+///   the 45° truss: v = ρ σ_s in both layers, the struts carry 2v, and the shear strain
+///   γ = 2v/(ρ E_s) + 4v/E_c, read as u_x of the top-right corner = ε_x + γ with
+///   ε_x = v/(ρ E_s) (2 %: Poisson coupling in the cracked concrete is neglected by the
+///   truss);
+/// - yield of both layers together: v_u = ρ f_y (0.5 %), where the run stops (a mechanism).
+#[test]
+fn reinforced_panel_in_pure_shear_cracks_on_the_surface_and_yields_at_rho_fy() {
+    use segfem::materials::concrete::ottosen;
+    let (rho, fy, es) = (0.01, 400e6, 200e9);
+    let text = format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 30e6
+nu = 0.2
+tension_softening = "crack_band"
+crack_integration = "implex"
+
+[[materials]]
+name = "s"
+kind = "rebar"
+E = {es}
+fy = {fy}
+
+[[regions]]
+name = "p"
+material = "c"
+thickness = 0.07
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+blocks = [{{ region = "p", element = "Q4", elements = [[1, 2, 3, 4]] }}]
+
+[[bar_layers]]
+name = "x"
+material = "s"
+region = "p"
+direction = [1.0, 0.0]
+ratio = {rho}
+
+[[bar_layers]]
+name = "y"
+material = "s"
+region = "p"
+direction = [0.0, 1.0]
+ratio = {rho}
+
+[[supports]]
+name = "pin"
+point = [0.0, 0.0]
+ux = 0.0
+uy = 0.0
+
+[[supports]]
+name = "roller"
+point = [1.0, 0.0]
+uy = 0.0
+
+# v = 1 MPa per unit factor: 7e4 N/m on a 0.07 m thick edge.
+[[load_cases]]
+name = "shear"
+line_loads = [
+  {{ line = [[0.0, 1.0], [1.0, 1.0]], q = [7e4, 0.0] }},
+  {{ line = [[0.0, 0.0], [1.0, 0.0]], q = [-7e4, 0.0] }},
+  {{ line = [[1.0, 0.0], [1.0, 1.0]], q = [0.0, 7e4] }},
+  {{ line = [[0.0, 0.0], [0.0, 1.0]], q = [0.0, -7e4] }},
+]
+
+[[steps]]
+name = "elastic"
+kind = "load"
+loads = {{ shear = 2.5 }}
+increments = 5
+
+[[steps]]
+name = "shear"
+kind = "arc_length"
+loads = {{ shear = 1.0 }}
+initial_increment = 0.05
+max_growth = 2.0
+stop_displacement = {{ point = [1.0, 1.0], component = "x", value = 0.012 }}
+increments = 3000
+"#
+    );
+    /// (v [Pa], u_x of the top-right corner [m], layer stresses [Pa], cracked points).
+    #[derive(Default)]
+    struct Panel(Vec<(f64, f64, Vec<f64>, usize)>);
+    impl Observer for Panel {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            let sys = s.system;
+            let v = 1e6 * s.factors[0];
+            let cracked = sys.committed.iter().filter(|p| p.n_cracks() > 0).count();
+            self.0.push((
+                v,
+                sys.u[2 * 2],
+                sys.bar_out.iter().map(|o| o.stress).collect(),
+                cracked,
+            ));
+            Ok(())
+        }
+    }
+    let m = model(&text);
+    let p = ConcreteParams::from_mc90(30e6, 0.2);
+    let mut obs = Panel::default();
+    // The run ends at the yield of both (perfectly plastic) layers: a mechanism.
+    match steps::run(&m, &mut obs) {
+        Ok(_) | Err(steps::AnalysisError::NotConverged(_)) => {}
+        Err(e) => panic!("{e}"),
+    }
+    let rows = obs.0;
+    // Pure-shear strength of the surface.
+    let (mut lo, mut hi) = (0.0, p.fcm);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if ottosen::equivalent_stress(&p.ottosen, &[0.0, 0.0, mid]) < p.fcm {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let tau_u = lo;
+    let first = rows
+        .iter()
+        .position(|r| r.3 > 0)
+        .expect("the panel must crack");
+    assert_eq!(rows[first].3, 4, "all four points crack together");
+    // The surface is passed within the increment in which the points crack (IMPL-EX: the
+    // crack forms at its end), and that increment is small.
+    let (v_before, v_crack) = (rows[first - 1].0, rows[first].0);
+    assert!(
+        v_before < tau_u && v_crack >= tau_u && v_crack - v_before <= 0.25e6,
+        "cracking between v = {v_before:.4e} and {v_crack:.4e}, surface τ_u = {tau_u:.4e}"
+    );
+    // The truss after cracking, once the concrete has let go (v below the cracking load
+    // again, on the rising branch).
+    let start = first
+        + rows[first..]
+            .iter()
+            .position(|r| r.0 < 0.5 * tau_u)
+            .expect("the load must drop after cracking (snap-back)");
+    let mut checked = 0;
+    for r in rows[start..]
+        .iter()
+        .filter(|r| r.0 > 1e6 && r.0 < 0.97 * rho * fy)
+    {
+        for &s in &r.2 {
+            assert!(
+                (s - r.0 / rho).abs() < 0.01 * r.0 / rho,
+                "v {:.3e}: σ_s {s:.4e}",
+                r.0
+            );
+        }
+        let ex = r.0 / (rho * es);
+        let gamma = 2.0 * r.0 / (rho * es) + 4.0 * r.0 / p.ec;
+        let u = ex + gamma;
+        assert!(
+            (r.1 - u).abs() < 0.02 * u,
+            "v {:.3e}: u_x {:.4e} vs truss {u:.4e}",
+            r.0,
+            r.1
+        );
+        checked += 1;
+    }
+    assert!(checked > 5, "too few truss rows: {checked}");
+    let v_max = rows.iter().map(|r| r.0).fold(0.0, f64::max);
+    assert!(
+        (v_max - rho * fy).abs() < 0.005 * rho * fy,
+        "peak v {v_max:.4e} vs ρ f_y {:.4e}",
+        rho * fy
+    );
+}

@@ -220,9 +220,12 @@ impl ConcreteParams {
     /// Compression-dominated stress state (routes to plasticity/crushing, MODEL.md §1.6):
     /// largest principal stress σ1 < r_d f_tm and I1 = σx + σy < 0. The I1 condition keeps
     /// small tensile states out of the hardening model, whose loading surfaces pass
-    /// through the origin when the initial yield stress is zero.
+    /// through the origin when the initial yield stress is zero. I1 must be below
+    /// −1e-9 f_tm: pure shear (I1 = 0) lies on the border, and round-off must not send some
+    /// points of a uniformly sheared body into plasticity and others not (a spurious
+    /// bifurcation: the points then take different stresses and crack early).
     pub fn compression_dominated(&self, s: &[f64; 3]) -> bool {
-        principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < 0.0
+        principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < -1e-9 * self.ftm
     }
 
     /// Cracking strain ε0 = f_tm/E [-].
