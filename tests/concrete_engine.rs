@@ -627,6 +627,42 @@ fn rc_beam_cracks_yields_and_holds_a_plateau() {
     }
 }
 
+/// Path independence of the RC beam example under the increment size (issue #4): with half
+/// (12 + 40) and twice (50 + 160) the example's increments the bottom steel first yields at
+/// the same moment within 3 % (IMPL-EX has a first-order error in the increment size), and
+/// both runs hold the plateau to the end of the step (16 mm at the plate).
+#[test]
+fn rc_beam_yield_moment_does_not_depend_on_the_increment_size() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/rc-beam.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("increments = 25\n") && text.contains("increments = 80\n"));
+    let yield_moment = |cracking: usize, failure: usize| {
+        let t = text
+            .replace("increments = 25\n", &format!("increments = {cracking}\n"))
+            .replace("increments = 80\n", &format!("increments = {failure}\n"));
+        let m = model(&t);
+        let mut tr = BeamTrace::default();
+        let end = steps::run(&m, &mut tr);
+        let r = tr
+            .rows
+            .iter()
+            .find(|r| r.1 >= 0.999 * 500e6)
+            .expect("the bottom steel never yields");
+        (r.0, end.is_ok(), tr.rows.last().unwrap().3)
+    };
+    let (half, half_ok, half_w) = yield_moment(12, 40);
+    let (double, double_ok, double_w) = yield_moment(50, 160);
+    assert!(
+        (half - double).abs() < 0.03 * double,
+        "M_y {half:.0} N·m (half the increments) vs {double:.0} N·m (twice)"
+    );
+    assert!(
+        half_ok && double_ok,
+        "both runs must reach the end of the step"
+    );
+    assert!(half_w > 0.016 && double_w > 0.016, "{half_w} {double_w}");
+}
+
 /// A 1 m square panel (one Q4, 70 mm thick, C30) with equal smeared layers in x and y
 /// (ρ = 1 %, f_y = 400 MPa), in pure shear v by edge tractions, by arc length past the
 /// cracking snap-back. Closed forms:

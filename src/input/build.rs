@@ -1609,6 +1609,7 @@ fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
         f(m.shear_beta_min.is_some(), "shear_beta_min"),
         f(m.residual_stiffness.is_some(), "residual_stiffness"),
         f(m.secant_crack_tangent.is_some(), "secant_crack_tangent"),
+        f(m.double_crack.is_some(), "double_crack"),
         f(m.crack_integration.is_some(), "crack_integration"),
         f(
             m.normalize_equivalent_stress.is_some(),
@@ -2079,6 +2080,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             "shear_beta_min",
             "residual_stiffness",
             "secant_crack_tangent",
+            "double_crack",
             "crack_integration",
             "normalize_equivalent_stress",
             "viscoplastic",
@@ -2155,6 +2157,18 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
     }
     if let Some(v) = m.secant_crack_tangent {
         p.secant_crack_tangent = v;
+    }
+    if let Some(v) = &m.double_crack {
+        p.zero_double_crack = match v.as_str() {
+            "softening" => false,
+            "zero" => true,
+            _ => {
+                return Err(ctx.err(
+                    k("double_crack"),
+                    format!("must be \"softening\" or \"zero\", got \"{v}\""),
+                ))
+            }
+        };
     }
     if let Some(v) = &m.crack_integration {
         p.implex = match v.as_str() {

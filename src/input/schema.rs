@@ -77,6 +77,7 @@ pub struct MaterialIn {
     pub shear_beta_min: Option<f64>,
     pub residual_stiffness: Option<f64>,
     pub secant_crack_tangent: Option<bool>,
+    pub double_crack: Option<String>,
     pub crack_integration: Option<String>,
     pub normalize_equivalent_stress: Option<bool>,
     pub viscoplastic: Option<ViscoplasticIn>,

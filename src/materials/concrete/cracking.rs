@@ -14,7 +14,8 @@
 //!     return), so struts parallel to cracks crush at f_cm;
 //! * shear: τ_nt = β G γ_nt, β from [`super::ShearRetention`] at the largest crack-normal
 //!   strain reached (so a closed crack keeps its shear reduction);
-//! * two cracks both open → no stress (seed: "concrete stresses are then zeroed").
+//! * two cracks both open: each keeps its own law and the shear retention (default), or
+//!   no stress at all (`zero_double_crack`, the seed: "concrete stresses are then zeroed").
 //!
 //! Stress σ = Tᵀ σ', tangent Tᵀ D' T. D' is the consistent tangent of the laws above: it
 //! has the off-diagonal term ∂τ/∂ε_n = β'(ε_n) G γ while crack 1 opens on its envelope
@@ -246,7 +247,7 @@ pub fn update_cracked(
     } else {
         n_cracks >= 2 && r0.open && r1.open
     };
-    if both_open {
+    if both_open && p.zero_double_crack {
         let rs = p.residual_stiffness;
         dl[0][0] = rs * p.ec;
         dl[1][1] = rs * p.ec;

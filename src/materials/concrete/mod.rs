@@ -122,6 +122,13 @@ pub struct ConcreteParams {
     /// Use secant (non-negative, symmetric) crack-direction stiffness instead of the
     /// consistent tangent for cracked points (robust for modified Newton; default false).
     pub secant_crack_tangent: bool,
+    /// The seed's rule for a point with two open cracks: no stress at all (true). Default
+    /// false: each crack keeps its own tension-softening law and the shear retention, so the
+    /// stress goes to zero only as the cracks open (docs/theory-concrete.md: a point — and
+    /// an element whose points all have two open cracks — otherwise loses all stiffness at
+    /// once, and refined RC meshes stop before yield).
+    #[serde(default)]
+    pub zero_double_crack: bool,
     /// IMPL-EX integration of the crack laws (Oliver, Huespe & Cante 2008): within an
     /// increment each crack follows the secant at its largest crack strain extrapolated from
     /// the two previous increments, and cracks form at the end of the increment in which the
@@ -166,6 +173,7 @@ impl ConcreteParams {
             shear: ShearRetention::default(),
             residual_stiffness: 1e-6,
             secant_crack_tangent: false,
+            zero_double_crack: false,
             implex: false,
             viscoplastic: None,
         }

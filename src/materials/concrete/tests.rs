@@ -282,7 +282,8 @@ fn compression_dominated_crushes_not_cracks() {
 /// compression in that direction only.
 #[test]
 fn second_crack_and_zero_stress() {
-    let p = params();
+    let mut p = params();
+    p.zero_double_crack = true; // the seed's rule
     let mut st = ConcreteState::new();
     let mut second_at = None;
     for k in 1..=100 {
@@ -314,6 +315,42 @@ fn second_crack_and_zero_stress() {
     // x is open: secant of crack 1 at its max strain (6e-4) times 3e-4
     let (env, _) = tension_envelope(&p, 5e-4, 6e-4);
     assert!(((out.1[0] - env * 0.5) / env).abs() < 1e-9);
+}
+
+/// Default double-crack rule: with both cracks open each direction stays on its own
+/// tension-softening envelope (equal biaxial stretching: σx = σy = envelope(ε), τ = 0), so
+/// the stress decays with the openings instead of vanishing when the second crack forms.
+/// Tolerance 1e-9 f_tm (closed-form laws); the step that forms a crack is skipped.
+#[test]
+fn double_crack_keeps_each_crack_softening_law() {
+    let p = params();
+    assert!(!p.zero_double_crack);
+    let alpha = p.softening_alpha(0.1);
+    let mut st = ConcreteState::new();
+    let mut checked = 0;
+    for k in 1..=100 {
+        let e = 6e-4 * k as f64 / 100.0;
+        let out = upd(&p, &st, [e, e, 0.0]);
+        let formed = out.0.n_cracks() != st.n_cracks();
+        st = out.0;
+        if st.n_cracks() == 2 && !formed {
+            let (env, _) = tension_envelope(&p, alpha, e);
+            for i in 0..2 {
+                assert!(
+                    (out.1[i] - env).abs() < 1e-9 * p.ftm,
+                    "ε = {e}: σ = {:?}, envelope {env}",
+                    out.1
+                );
+            }
+            assert!(out.1[2].abs() < 1e-9 * p.ftm);
+            assert!(
+                env > 0.0 && out.2[0][0] < 0.0,
+                "softening tangent at ε = {e}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked} doubly cracked steps");
 }
 
 /// Shear retention on a crack: τ = β(ε_max) G γ in crack axes, reduced also when closed.
