@@ -498,14 +498,16 @@ impl Observer for BeamTrace {
                     .any(|g| sys.committed[g].n_cracks() > 0);
             }
         }
-        // Moment in the constant-moment zone from statics of the left part: the plate's
-        // nodal loads F_i (the reactions of the imposed dofs) at x_i, the support at 0.1 m:
-        // M = Σ F_i (x_i − 0.1). The rigid plate does not load at its centre.
+        // Moment in the constant-moment zone from statics of the left part: the nodal loads
+        // F_i on top of the loading plate (the reaction of the imposed dof; the plate's other
+        // top nodes are free and carry none) at x_i, the support at 0.1 m:
+        // M = Σ F_i (x_i − 0.1) = P·a for the example's hinged plate.
+        let top = m.nodes.iter().map(|q| q[1]).fold(f64::MIN, f64::max);
         let moment: f64 = m
             .nodes
             .iter()
             .enumerate()
-            .filter(|(_, q)| (q[1] - 0.5).abs() < 1e-9 && (1.0 - 1e-9..=1.2 + 1e-9).contains(&q[0]))
+            .filter(|(_, q)| (q[1] - top).abs() < 1e-9 && (1.0 - 1e-9..=1.2 + 1e-9).contains(&q[0]))
             .map(|(i, q)| -snap.f_int[2 * i + 1] * (q[0] - 0.1))
             .sum();
         let bottom = m.bars.iter().position(|b| b.name == "bottom").unwrap();
@@ -536,7 +538,10 @@ impl Observer for BeamTrace {
 ///   model's MC90 compression curve, its crack-band tension softening and bilinear steel:
 ///   within 10 % (smeared cracks at Gauss points vs a fibre at the crack, the plate's
 ///   pressure distribution);
-/// - then a ductile plateau: the load stays within 8 % of P_y for ≥ 4 mm more deflection.
+/// - then a ductile plateau (issue #4): the run completes its step without crushing, the
+///   midspan deflection reaches ≥ 3 × the yield deflection, and the moment stays within
+///   −5 % / +12 % of M_y all along (the steel hardens with E_t = 1 GPa: the bar reaches
+///   ~540 MPa, +8 %, at 30 mm, and the lever arm grows as the compression zone shrinks).
 #[test]
 fn rc_beam_cracks_yields_and_holds_a_plateau() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/rc-beam.toml");
@@ -544,11 +549,12 @@ fn rc_beam_cracks_yields_and_holds_a_plateau() {
         .unwrap_or_else(|e| panic!("{e}"))
         .model;
     let mut t = BeamTrace::default();
-    // The run ends at failure (crushing under the plate, not converged): what came before
-    // is the curve under test.
-    if let Err(e) = steps::run(&m, &mut t) {
-        eprintln!("run ended: {e}");
-    }
+    let end = steps::run(&m, &mut t);
+    assert!(
+        end.is_ok(),
+        "the run must complete its step: {:?}",
+        end.err()
+    );
     let p = ConcreteParams::from_mc90(38e6, 0.2).with_crack_band();
     let (b, h, d, a_s, e_s, f_y) = (0.3, 0.5, 0.45, 6.03e-4, 200e9, 500e6);
     // Cracking: uncracked transformed section.
@@ -612,14 +618,20 @@ fn rc_beam_cracks_yields_and_holds_a_plateau() {
     let (_, _, _, w_y) = t.rows[iy];
     let after: Vec<_> = t.rows[iy..].iter().collect();
     let w_end = after.last().unwrap().3;
+    eprintln!(
+        "yield at w = {:.2} mm, end of the plateau at {:.2} mm",
+        w_y * 1e3,
+        w_end * 1e3
+    );
     assert!(
-        w_end - w_y >= 4e-3,
-        "only {:.2} mm past yield",
-        (w_end - w_y) * 1e3
+        w_end >= 3.0 * w_y,
+        "plateau to only {:.2} mm, yield at {:.2} mm",
+        w_end * 1e3,
+        w_y * 1e3
     );
     for r in &after {
         assert!(
-            (r.0 - fe_y).abs() < 0.08 * fe_y,
+            r.0 > 0.95 * fe_y && r.0 < 1.12 * fe_y,
             "M {:.0} N·m at w = {:.2} mm",
             r.0,
             r.3 * 1e3
@@ -628,18 +640,20 @@ fn rc_beam_cracks_yields_and_holds_a_plateau() {
 }
 
 /// Path independence of the RC beam example under the increment size (issue #4): with half
-/// (12 + 40) and twice (50 + 160) the example's increments the bottom steel first yields at
+/// (12 + 40) and twice (50 + 160) the example's increment size the bottom steel first yields at
 /// the same moment within 3 % (IMPL-EX has a first-order error in the increment size), and
-/// both runs hold the plateau to the end of the step (16 mm at the plate).
+/// both runs hold the plateau to the end of a step shortened to 16 mm at the plate (the
+/// example goes on to 24 mm in 120 increments; 16 mm keeps the test fast).
 #[test]
 fn rc_beam_yield_moment_does_not_depend_on_the_increment_size() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/rc-beam.toml");
     let text = std::fs::read_to_string(path).unwrap();
-    assert!(text.contains("increments = 25\n") && text.contains("increments = 80\n"));
+    let end = "value = -0.024 }\nincrements = 120\n";
+    assert!(text.contains("increments = 25\n") && text.contains(end));
     let yield_moment = |cracking: usize, failure: usize| {
         let t = text
             .replace("increments = 25\n", &format!("increments = {cracking}\n"))
-            .replace("increments = 80\n", &format!("increments = {failure}\n"));
+            .replace(end, &format!("value = -0.016 }}\nincrements = {failure}\n"));
         let m = model(&t);
         let mut tr = BeamTrace::default();
         let end = steps::run(&m, &mut tr);

@@ -58,7 +58,7 @@ fn creep_beam_short() -> String {
 /// The RC beam (cracking concrete, embedded bars, displacement control) taken to the first
 /// cracks in three steps.
 fn rc_beam_steps(last_value: f64, last_increments: usize, extra: &str) -> String {
-    let control = "control = { line = [[1.0, 0.5], [1.2, 0.5]], component = \"y\"";
+    let control = "control = { point = [1.1, 0.53], component = \"y\"";
     with_steps(
         &example("rc-beam"),
         &format!(
@@ -352,7 +352,7 @@ fn hard_convergence_failure_is_reported_and_results_kept() {
 }
 
 /// A fourth step of the RC beam: back to 0.2 mm.
-const UNLOAD: &str = "\n[[steps]]\nname = \"unload\"\nkind = \"displacement\"\ncontrol = { line = [[1.0, 0.5], [1.2, 0.5]], component = \"y\", value = -0.0002 }\nincrements = 8\n";
+const UNLOAD: &str = "\n[[steps]]\nname = \"unload\"\nkind = \"displacement\"\ncontrol = { point = [1.1, 0.53], component = \"y\", value = -0.0002 }\nincrements = 8\n";
 
 /// The RC beam pushed past the first cracks in step 3 with few iterations and cuts, so
 /// that step fails; then the unloading step.
