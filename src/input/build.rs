@@ -2257,9 +2257,7 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
                      give eps_cu only with compression_softening = \"mc90\"",
                 ));
             }
-            let gc = m
-                .gc
-                .unwrap_or(250.0 * mc90::fracture_energy(fcm, 30.0));
+            let gc = m.gc.unwrap_or(250.0 * mc90::fracture_energy(fcm, 30.0));
             CompressionSoftening::CrushBand {
                 gc: positive(ctx, &k("Gc"), gc)?,
             }

@@ -753,19 +753,32 @@ fn crush_band_dissipates_gc_per_unit_band_area() {
         let q = p.for_element(h).unwrap();
         let eu = q.crush_eu.unwrap();
         assert_eq!(q.eps_cu, eu);
-        assert!((eu - p.eps_c1 - 1.5 * gc / (h * p.fcm)).abs() < 1e-15, "h = {h}: floored");
+        assert!(
+            (eu - p.eps_c1 - 1.5 * gc / (h * p.fcm)).abs() < 1e-15,
+            "h = {h}: floored"
+        );
         let n = 2000;
         let dx = (eu - p.eps_c1) / n as f64;
         let f = |i: usize| hardening_curve(&q, p.eps_c1 + i as f64 * dx).0;
         let simpson: f64 = (0..=n)
             .map(|i| {
-                let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
                 w * f(i)
             })
             .sum::<f64>()
             * dx
             / 3.0;
-        assert!(((simpson - gc / h) / (gc / h)).abs() < 1e-6, "h = {h}: {simpson} vs {}", gc / h);
+        assert!(
+            ((simpson - gc / h) / (gc / h)).abs() < 1e-6,
+            "h = {h}: {simpson} vs {}",
+            gc / h
+        );
         let (s_peak, t_peak) = hardening_curve(&q, p.eps_c1 * (1.0 + 1e-9));
         assert!((s_peak - p.fcm).abs() < 1e-6 * p.fcm && t_peak.abs() < 1e-3 * p.ec);
         assert_eq!(hardening_curve(&q, eu).0, 0.0);
