@@ -129,6 +129,42 @@ fn uniaxial_compression_follows_mc90_curve_to_peak() {
     assert!((-f / 0.01 - p.fcm).abs() < 0.01 * p.fcm);
 }
 
+/// Crush band in uniaxial compression (one 0.1 m Q4, `compression_softening = "crush_band"`):
+/// past the peak the force follows the element's parabola f_cm (1 − x²),
+/// x = (ε − ε_c1)/(ε_u − ε_c1) with ε_u resolved for h = 0.1 m (1 % of f_cm, as the MC90
+/// test above), and the points crush only where that stress has come down to zero: the last
+/// increment before crushing carries < 2 % f_cm, so crushing is no jump.
+#[test]
+fn crush_band_follows_its_parabola_to_zero_before_crushing() {
+    let p = ConcreteParams::from_mc90(38e6, 0.2).with_crush_band();
+    let q = p.for_element(0.1).unwrap();
+    let eu = q.eps_cu;
+    let m = model(&block(
+        &[(-p.eps_c1 * 0.1, 22), (-1.1 * eu * 0.1, 120)],
+        "compression_softening = \"crush_band\"",
+    ));
+    let t = run(&m, 2);
+    let mut post_peak = 0;
+    let mut last_before_crush = f64::NAN;
+    for &(_, f, u, _, _) in &t.rows {
+        let eps = -u / 0.1;
+        let sigma = -f / 0.01;
+        if eps > p.eps_c1 && eps < eu * (1.0 - 1e-9) {
+            let x = (eps - p.eps_c1) / (eu - p.eps_c1);
+            let expect = p.fcm * (1.0 - x * x);
+            assert!(
+                (sigma - expect).abs() < 0.01 * p.fcm,
+                "ε = {eps:.4e}: σ = {sigma:.4e}, parabola {expect:.4e}"
+            );
+            post_peak += 1;
+            last_before_crush = sigma;
+        }
+    }
+    assert!(post_peak > 50, "{post_peak} post-peak increments");
+    assert!(last_before_crush < 0.02 * p.fcm, "{last_before_crush}");
+    assert_eq!(t.last_states.1, 4, "all four points crushed at the end");
+}
+
 /// Uniaxial tension: linear to f_tm (Ottosen uniaxial tensile strength = f_tm within
 /// 0.2 %, so 1 % on the peak), then the Hinton exponential softening
 /// σ = f_tm exp(−(ε − ε0)/α) (1 % of f_tm: the crack forms inside an increment, so the

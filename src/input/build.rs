@@ -15,7 +15,9 @@ use crate::elements::interface::{
 use crate::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
 use crate::fem::shape::map_point;
 use crate::fem::shape::QuadKind;
-use crate::materials::concrete::{ConcreteParams, ShearRetention, TensionSoftening};
+use crate::materials::concrete::{
+    CompressionSoftening, ConcreteParams, ShearRetention, TensionSoftening,
+};
 use crate::materials::mc90::{self, TensileRef};
 use crate::materials::point::Material;
 use crate::materials::steel::SteelParams;
@@ -1601,6 +1603,8 @@ fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
         f(m.gf.is_some(), "Gf"),
         f(m.eps_c1.is_some(), "eps_c1"),
         f(m.eps_cu.is_some(), "eps_cu"),
+        f(m.compression_softening.is_some(), "compression_softening"),
+        f(m.gc.is_some(), "Gc"),
         f(m.initial_yield_ratio.is_some(), "initial_yield_ratio"),
         f(m.softening_limit.is_some(), "softening_limit"),
         f(m.crack_ratio.is_some(), "crack_ratio"),
@@ -2072,6 +2076,8 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             "Gf",
             "eps_c1",
             "eps_cu",
+            "compression_softening",
+            "Gc",
             "initial_yield_ratio",
             "softening_limit",
             "crack_ratio",
@@ -2230,6 +2236,36 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             return Err(ctx.err(
                 k("tension_softening"),
                 format!("unknown value '{o}' (expected hinton or crack_band)"),
+            ))
+        }
+    };
+    p.compression_softening = match m.compression_softening.as_deref() {
+        None | Some("mc90") => {
+            if m.gc.is_some() {
+                return Err(ctx.err(
+                    k("Gc"),
+                    "Gc is used by compression_softening = \"crush_band\" only",
+                ));
+            }
+            CompressionSoftening::Mc90
+        }
+        Some("crush_band") => {
+            if m.eps_cu.is_some() {
+                return Err(ctx.err(
+                    k("eps_cu"),
+                    "the crush band sets the crushing strain from Gc and the element size; \
+                     give eps_cu only with compression_softening = \"mc90\"",
+                ));
+            }
+            let gc = m.gc.unwrap_or(250.0 * mc90::fracture_energy(fcm, 30.0));
+            CompressionSoftening::CrushBand {
+                gc: positive(ctx, &k("Gc"), gc)?,
+            }
+        }
+        Some(o) => {
+            return Err(ctx.err(
+                k("compression_softening"),
+                format!("unknown value '{o}' (expected mc90 or crush_band)"),
             ))
         }
     };

@@ -69,6 +69,9 @@ pub struct MaterialIn {
     pub gf: Option<f64>,
     pub eps_c1: Option<f64>,
     pub eps_cu: Option<f64>,
+    pub compression_softening: Option<String>,
+    #[serde(rename = "Gc")]
+    pub gc: Option<f64>,
     pub initial_yield_ratio: Option<f64>,
     pub softening_limit: Option<f64>,
     pub crack_ratio: Option<f64>,

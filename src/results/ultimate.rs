@@ -117,8 +117,9 @@ pub struct UltimateWatch {
 }
 
 /// Relative drop of the load below its peak, later in the same step, taken as a limit point
-/// (well above the Newton tolerance, so that convergence noise on a plateau is not one) [-].
-const LIMIT_DROP: f64 = 1e-3;
+/// [-]: well above the Newton tolerance and above the wiggles of a ductile plateau (cracks
+/// forming one by one: up to ≈ 0.3 % on the RC beam example).
+const LIMIT_DROP: f64 = 1e-2;
 
 impl UltimateWatch {
     /// A watch with nothing seen.

@@ -104,8 +104,23 @@ pub fn softening_start(p: &ConcreteParams) -> Option<f64> {
 /// (then σ_c = 0). The limit keeps the local return-mapping problem well posed: with the
 /// raw MC90 branch the plastic modulus reaches ≈ −0.54 E near ε_lim, below −nᵀDn for
 /// biaxial compression, where the strain-driven point problem has no (unique) solution.
+///
+/// With a resolved crush band (`p.crush_eu`, see [`ConcreteParams::for_element`]) the
+/// branch beyond the peak is instead the parabola f_cm (1 − x²), x = (ε̄ − ε_c1)/(ε_u − ε_c1),
+/// down to zero at ε_u.
 pub fn hardening_curve(p: &ConcreteParams, ebar: f64) -> (f64, f64) {
     let c = p.curve();
+    if let Some(eu) = p.crush_eu {
+        if ebar <= p.eps_c1 {
+            return c.eval(ebar);
+        }
+        if ebar >= eu {
+            return (0.0, 0.0);
+        }
+        let d = eu - p.eps_c1;
+        let x = (ebar - p.eps_c1) / d;
+        return (p.fcm * (1.0 - x * x), -2.0 * p.fcm * x / d);
+    }
     if let Some(es) = softening_start(p) {
         if ebar > es {
             let (s0, _) = c.eval(es);

@@ -42,6 +42,27 @@ pub enum TensionSoftening {
     },
 }
 
+/// Post-peak law of concrete in compression.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum CompressionSoftening {
+    /// The MC90 curve beyond the peak, continued by the straight line of
+    /// `softening_limit`; the point crushes at ε̄ = ε_cu (stress drops to zero there).
+    /// Not regularised: crushing localises in one element row whatever its size.
+    #[default]
+    Mc90,
+    /// Crush band (Feenstra 1993; Feenstra & de Borst 1995): beyond the peak
+    /// (ε_c1, f_cm) a parabola σ_c = f_cm (1 − ((ε̄ − ε_c1)/(ε_u − ε_c1))²) that reaches zero
+    /// at ε_u = ε_c1 + 1.5 G_c/(h f_cm), so that an element of characteristic length h
+    /// [m] dissipates G_c per unit area of the crushing band; the point crushes when the
+    /// stress has come down to zero (no jump). ε_u is floored so that the steepest slope,
+    /// −2 f_cm/(ε_u − ε_c1) at ε_u, stays within `softening_limit` (large elements then
+    /// dissipate more than G_c).
+    CrushBand {
+        /// Compressive fracture energy G_c [N/m = J/m²].
+        gc: f64,
+    },
+}
+
 /// Shear retention factor of seed eqs. 22–23 (Cervenka): G_c = β G,
 /// β = 1 − (ε/ε_ref)^k1, floored at β_min; ε = largest crack-normal strain reached.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -141,6 +162,13 @@ pub struct ConcreteParams {
     /// return mapping, the default; see [`compression::viscoplastic_update`]).
     #[serde(default)]
     pub viscoplastic: Option<compression::Viscoplastic>,
+    /// Post-peak compression law (default: MC90 with the softening limit, crushing at ε_cu).
+    #[serde(default)]
+    pub compression_softening: CompressionSoftening,
+    /// Crush-band ultimate strain ε_u [-] resolved for one element size (set by the update
+    /// from the characteristic length; None for [`CompressionSoftening::Mc90`]).
+    #[serde(skip)]
+    pub(crate) crush_eu: Option<f64>,
 }
 
 impl ConcreteParams {
@@ -176,6 +204,8 @@ impl ConcreteParams {
             zero_double_crack: false,
             implex: false,
             viscoplastic: None,
+            compression_softening: CompressionSoftening::Mc90,
+            crush_eu: None,
         }
     }
 
@@ -207,7 +237,12 @@ impl ConcreteParams {
         match self.tension {
             TensionSoftening::Hinton { alpha } if alpha <= 0.0 => bad("Hinton alpha must be > 0"),
             TensionSoftening::CrackBand { gf } if gf <= 0.0 => bad("G_f must be > 0"),
-            _ => Ok(()),
+            _ => match self.compression_softening {
+                CompressionSoftening::CrushBand { gc } if !(gc > 0.0 && gc.is_finite()) => {
+                    bad("G_c must be > 0")
+                }
+                _ => Ok(()),
+            },
         }
     }
 
@@ -239,6 +274,48 @@ impl ConcreteParams {
     /// Cracking strain ε0 = f_tm/E [-].
     pub fn eps0(&self) -> f64 {
         self.ftm / self.ec
+    }
+
+    /// Switch to crush-band compression softening with G_c = 250 G_f (MC90 G_f with
+    /// d_max = 16 mm; the ratio of the Dutch guidelines for nonlinear analysis, RTD 1016).
+    pub fn with_crush_band(mut self) -> Self {
+        self.compression_softening = CompressionSoftening::CrushBand {
+            gc: 250.0 * mc90::fracture_energy(self.fcm, 30.0),
+        };
+        self
+    }
+
+    /// Crush-band ultimate strain ε_u [-] for an element of characteristic length
+    /// `char_length` [m] (None for [`CompressionSoftening::Mc90`]): ε_c1 + 1.5 G_c/(h f_cm),
+    /// at least ε_c1 + 2 f_cm (1 − s)/(s E) (s = `softening_limit`, if in (0, 1)).
+    pub fn crush_band_strain(&self, char_length: f64) -> Option<f64> {
+        let CompressionSoftening::CrushBand { gc } = self.compression_softening else {
+            return None;
+        };
+        let mut d = 1.5 * gc / (char_length * self.fcm);
+        let s = self.softening_limit;
+        if s > 0.0 && s < 1.0 {
+            let floor = 2.0 * self.fcm * (1.0 - s) / (s * self.ec);
+            d = if d.is_finite() { d.max(floor) } else { floor };
+        }
+        Some(self.eps_c1 + d)
+    }
+
+    /// These parameters for one element: the crush-band ultimate strain resolved from the
+    /// characteristic length `char_length` [m] (and used as the crushing strain); a plain
+    /// copy for [`CompressionSoftening::Mc90`].
+    pub fn for_element(&self, char_length: f64) -> Result<Self, MaterialError> {
+        let mut p = self.clone();
+        if let Some(eu) = self.crush_band_strain(char_length) {
+            if !(char_length > 0.0 && char_length.is_finite()) {
+                return Err(MaterialError::InvalidParams(format!(
+                    "crush band needs a positive characteristic length, got {char_length}"
+                )));
+            }
+            p.crush_eu = Some(eu);
+            p.eps_cu = eu;
+        }
+        Ok(p)
     }
 
     /// Decay strain α [-] of the tension-softening law for an element of characteristic
@@ -442,6 +519,14 @@ pub fn update_full(
     if !strain.iter().all(|v| v.is_finite()) {
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
+    // Crush band: the post-peak law depends on the element size.
+    let local;
+    let p = if p.crush_eu.is_none() && p.compression_softening != CompressionSoftening::Mc90 {
+        local = p.for_element(char_length)?;
+        &local
+    } else {
+        p
+    };
     if committed.crushed {
         return Ok(crushed(p, committed, strain));
     }

@@ -735,3 +735,58 @@ fn held_plastic_point_returns_instead_of_jumping_to_the_trial() {
     let sc = compression::hardening(&p, held.ebar).sigma_c;
     assert!((on - sc).abs() < 1e-6 * p.fcm, "σ̂ {on:.4e} vs σ_c {sc:.4e}");
 }
+
+/// Crush band (Feenstra; G_c = 250 G_f after the Dutch NLFEA guidelines RTD 1016): beyond
+/// the peak the hardening law is the parabola f_cm (1 − x²) down to zero at
+/// ε_u = ε_c1 + 1.5 G_c/(h f_cm), so the post-peak area ∫σ dε̄ is G_c/h for every element
+/// size h that is not floored by the softening limit (Simpson, 1e-6 rel.); the law is
+/// continuous with zero slope at the peak and reaches zero at ε_u (no jump when the point
+/// crushes there).
+#[test]
+fn crush_band_dissipates_gc_per_unit_band_area() {
+    use super::compression::hardening_curve;
+    let p = params().with_crush_band();
+    let super::CompressionSoftening::CrushBand { gc } = p.compression_softening else {
+        panic!("not a crush band");
+    };
+    for h in [0.01, 0.02, 0.04] {
+        let q = p.for_element(h).unwrap();
+        let eu = q.crush_eu.unwrap();
+        assert_eq!(q.eps_cu, eu);
+        assert!(
+            (eu - p.eps_c1 - 1.5 * gc / (h * p.fcm)).abs() < 1e-15,
+            "h = {h}: floored"
+        );
+        let n = 2000;
+        let dx = (eu - p.eps_c1) / n as f64;
+        let f = |i: usize| hardening_curve(&q, p.eps_c1 + i as f64 * dx).0;
+        let simpson: f64 = (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(i)
+            })
+            .sum::<f64>()
+            * dx
+            / 3.0;
+        assert!(
+            ((simpson - gc / h) / (gc / h)).abs() < 1e-6,
+            "h = {h}: {simpson} vs {}",
+            gc / h
+        );
+        let (s_peak, t_peak) = hardening_curve(&q, p.eps_c1 * (1.0 + 1e-9));
+        assert!((s_peak - p.fcm).abs() < 1e-6 * p.fcm && t_peak.abs() < 1e-3 * p.ec);
+        assert_eq!(hardening_curve(&q, eu).0, 0.0);
+        assert!(hardening_curve(&q, eu * (1.0 - 1e-6)).0 < 1e-4 * p.fcm);
+    }
+    // A large element is floored: its steepest slope stays within the softening limit.
+    let big = p.for_element(10.0).unwrap();
+    let d = big.crush_eu.unwrap() - p.eps_c1;
+    let s = p.softening_limit;
+    assert!((2.0 * p.fcm / d - s * p.ec / (1.0 - s)).abs() < 1e-6 * p.ec);
+}
