@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{code, segfem, stdout, TempDir};
+use common::{block, code, segfem, stdout, TempDir};
 use segfem::materials::concrete::ConcreteParams;
 
 /// Runs `text` as `name`.toml in a fresh directory; returns (exit code, terminal output,
@@ -29,40 +29,8 @@ fn run(name: &str, text: &str) -> (i32, String, serde_json::Value) {
 /// so the crushing event comes later, at a force near zero.
 #[test]
 fn squashed_block_loses_equilibrium_at_fcm_then_crushes() {
-    let text = r#"
-[[materials]]
-name = "c30"
-kind = "concrete"
-fcm = 38e6
-nu = 0.2
-
-[[regions]]
-name = "r"
-material = "c30"
-thickness = 0.1
-
-[mesh]
-type = "explicit"
-nodes = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]
-blocks = [{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }]
-
-[[supports]]
-name = "left"
-line = [[0.0, 0.0], [0.0, 0.1]]
-ux = 0.0
-
-[[supports]]
-name = "pin"
-node = 1
-uy = 0.0
-
-[[steps]]
-name = "squash"
-kind = "displacement"
-control = { line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = -0.0005 }
-increments = 100
-"#;
-    let (rc, out, u) = run("ultimate-block", text);
+    let text = block(&[(-0.0005, 100)], "");
+    let (rc, out, u) = run("ultimate-block", &text);
     assert_eq!(rc, 0, "{out}");
     let p = ConcreteParams::from_mc90(38e6, 0.2);
     let fa = p.fcm * 0.01;

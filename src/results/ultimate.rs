@@ -371,7 +371,7 @@ fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Vec<Event> {
             continue;
         }
         let points: usize = here.iter().map(|&c| crushed_points(crushed[c])).sum();
-        if !here.iter().any(|&c| at_joint[c]) && events.is_empty() {
+        if events.is_empty() {
             events.push(Event {
                 mode: "crushing at an opened joint",
                 detail: format!(

@@ -90,3 +90,50 @@ pub fn code(o: &Output) -> i32 {
         )
     })
 }
+
+/// One 0.1 m Q4 (thickness 0.1 m) of C30 concrete, held at x = 0 (and at the origin in y),
+/// its right edge driven in x to each `value` in turn in `n` increments.
+pub fn block(stages: &[(f64, usize)], extra: &str) -> String {
+    let mut steps = String::new();
+    for (i, (value, n)) in stages.iter().enumerate() {
+        steps.push_str(&format!(
+            r#"
+[[steps]]
+name = "s{i}"
+kind = "displacement"
+control = {{ line = [[0.1, 0.0], [0.1, 0.1]], component = "x", value = {value} }}
+increments = {n}
+"#
+        ));
+    }
+    format!(
+        r#"
+[[materials]]
+name = "c30"
+kind = "concrete"
+fcm = 38e6
+nu = 0.2
+{extra}
+
+[[regions]]
+name = "r"
+material = "c30"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]
+blocks = [{{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }}]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+{steps}"#
+    )
+}
