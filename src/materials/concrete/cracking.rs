@@ -48,6 +48,12 @@ pub fn tension_envelope(p: &ConcreteParams, alpha: f64, eps: f64) -> (f64, f64) 
     }
 }
 
+/// Slope past the extrapolated largest crack strain of an IMPL-EX crack, as a fraction of
+/// its secant there [-]: small (the stress exceeds the envelope by at most this fraction of
+/// the secant times the unforeseen opening, corrected by the next extrapolation), but far
+/// from zero so that the tangent stays regular.
+pub const IMPLEX_CAP_SLOPE: f64 = 0.1;
+
 /// Result of one direction law.
 #[derive(Debug, Clone, Copy)]
 struct DirResult {
@@ -116,7 +122,10 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
                 r.sigma = s_ex / ex * e_el;
                 r.k = s_ex / ex;
             } else {
-                r.k = p.residual_stiffness * p.ec;
+                // Past ẽ_max the stress rises on a tenth of the secant: with a ~0 slope a
+                // band of cracks opening faster than extrapolated is a near-mechanism (the
+                // opening profile is held by the retained shear only) and Newton explodes.
+                r.k = IMPLEX_CAP_SLOPE * s_ex / ex;
                 r.sigma = s_ex + r.k * (e_el - ex);
             }
             r.emax = e_el.max(emax);
