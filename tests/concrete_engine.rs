@@ -658,6 +658,7 @@ fn rc_beam_yield_moment_does_not_depend_on_the_increment_size() {
     };
     let (half, half_ok, half_w) = yield_moment(12, 40);
     let (double, double_ok, double_w) = yield_moment(50, 160);
+    eprintln!("M_y = {half:.0} N·m (half the increments), {double:.0} N·m (twice)");
     assert!(
         (half - double).abs() < 0.03 * double,
         "M_y {half:.0} N·m (half the increments) vs {double:.0} N·m (twice)"

@@ -307,3 +307,31 @@ impl fmt::Display for FailureReport {
         )
     }
 }
+
+/// One line for `--verbose` iterations: how many points the current trial states changed
+/// against the committed ones (cracked, crushed, flowed plastically while uncracked) and how
+/// many are latched for the rest of the increment.
+pub(crate) fn census(sys: &System, residual: &[f64]) -> String {
+    let (mut cracked, mut crushed, mut plastic) = (0, 0, 0);
+    for (c, t) in sys.committed.iter().zip(&sys.trial) {
+        cracked += usize::from(t.n_cracks() > c.n_cracks());
+        crushed += usize::from(t.is_crushed() && !c.is_crushed());
+        if let (Some(c), Some(t)) = (c.concrete(), t.concrete()) {
+            plastic += usize::from(t.n_cracks() == 0 && t.plastic_strain() != c.plastic_strain());
+        }
+    }
+    let ws = worst_dofs(sys, residual);
+    let worst = ws
+        .first()
+        .map(|w| {
+            format!(
+                "; largest residual {:.3e} N at node {} ({:.4}, {:.4}) {}",
+                w.residual, w.node, w.x, w.y, w.direction
+            )
+        })
+        .unwrap_or_default();
+    format!(
+        "{cracked} newly cracked, {crushed} newly crushed, {plastic} flowing, {} latched{worst}",
+        sys.latched.len()
+    )
+}

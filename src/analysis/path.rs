@@ -277,21 +277,40 @@ fn newton_controlled(
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
     let mut u = ctx.u.clone();
+    let mut last: Option<Correction> = None;
     for it in 0..=controls.max_iterations {
-        let (f_int, mut k, scale) = ctx.tangent(&u)?;
-        let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
-        let mut rf = ctx.sys.to_free(&r);
-        for k in ctl {
-            rf[k.q] = 0.0; // the reaction of the control
+        let Residual {
+            mut f_int,
+            mut k,
+            mut rf,
+            mut rel,
+        } = controlled_residual(ctx, &u, f_ext, ctl)?;
+        if let Some(c) = last.take() {
+            if rel > BACKTRACK_GROWTH * c.rel {
+                // The correction overshot (a band of open cracks or yielded bars is nearly a
+                // mechanism: the linearised step closes cracks into compression at E): back
+                // along it to where the residual's work vanishes, or half-way.
+                let s = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl)?.unwrap_or(0.5);
+                u.copy_from_slice(&c.u);
+                ctx.add_free(&mut u, &c.du, s);
+                Residual { f_int, k, rf, rel } = controlled_residual(ctx, &u, f_ext, ctl)?;
+                if controls.verbose {
+                    eprintln!(
+                        "    residual grew: back to {s:.3} of the last correction, relative residual {rel:.3e}"
+                    );
+                }
+            }
         }
-        let rel = norm(&rf)
-            / norm(f_ext)
-                .max(norm(&f_int))
-                .max(scale)
-                .max(f64::MIN_POSITIVE);
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
+        }
+        if controls.verbose {
+            eprintln!(
+                "    iteration {it:2}: relative residual {rel:.3e}, {} negative pivots; {}",
+                ctx.solver.negative_pivots,
+                super::failure::census(ctx.sys, &rf)
+            );
         }
         if !rel.is_finite() {
             return Err(NewtonFailure::diverged(history, rf));
@@ -350,11 +369,67 @@ fn newton_controlled(
             let energy = du.iter().zip(&rf).map(|(a, b)| a * b).sum::<f64>().abs();
             first_energy.get_or_insert(energy);
             last_energy = Some(energy);
+            last = Some(Correction {
+                u: u.clone(),
+                du: du.clone(),
+                rf,
+                rel,
+            });
         }
         ctx.add_free(&mut u, &du, 1.0);
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// Growth of the relative residual over one Newton correction beyond which the displacement
+/// driver backtracks along that correction [-]: well above the ups and downs of an iteration
+/// that crosses a kink (≤ 1.5 on the RC beam), well below the jumps of an overshoot (10×).
+const BACKTRACK_GROWTH: f64 = 2.0;
+
+/// One Newton correction of the displacement driver, kept to backtrack along it.
+struct Correction {
+    /// Iterate the correction started from (all dofs) [m].
+    u: Vec<f64>,
+    /// The correction (free equations) [m].
+    du: Vec<f64>,
+    /// Free residual at `u` [N].
+    rf: Vec<f64>,
+    /// Relative residual norm at `u` [-].
+    rel: f64,
+}
+
+/// Out-of-balance state of the displacement driver at one iterate.
+struct Residual {
+    /// Internal forces (all dofs) [N].
+    f_int: Vec<f64>,
+    /// Tangent matrix values in the assembly pattern [N/m].
+    k: Vec<f64>,
+    /// Free residual, the controlled dofs' rows zeroed (their reactions) [N].
+    rf: Vec<f64>,
+    /// ‖rf‖ over the force scale [-].
+    rel: f64,
+}
+
+/// Internal forces, tangent, free residual and relative residual norm at `u`.
+fn controlled_residual(
+    ctx: &mut PathContext,
+    u: &[f64],
+    f_ext: &[f64],
+    ctl: &[Controlled],
+) -> Result<Residual, NewtonFailure> {
+    let (f_int, k, scale) = ctx.tangent(u)?;
+    let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
+    let mut rf = ctx.sys.to_free(&r);
+    for k in ctl {
+        rf[k.q] = 0.0; // the reaction of the control
+    }
+    let rel = norm(&rf)
+        / norm(f_ext)
+            .max(norm(&f_int))
+            .max(scale)
+            .max(f64::MIN_POSITIVE);
+    Ok(Residual { f_int, k, rf, rel })
 }
 
 /// Step length s ∈ (0, 1] along the correction `du` (free equations) from `u` where the

@@ -341,7 +341,9 @@ pub fn plastic_base(base: &PointState, trial: &PointState) -> Option<PointState>
                 && !b.crushed
                 && !t.crushed
                 && !b.hold_plastic
-                && t.ebar > b.ebar =>
+                // Flowed: the plastic strain moved (ε̄ alone also rises from 0 to the
+                // initial-yield value on a virgin point's first plastic-route update).
+                && t.plastic_strain != b.plastic_strain =>
         {
             let mut h = (**b).clone();
             h.hold_plastic = true;
