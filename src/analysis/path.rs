@@ -286,7 +286,7 @@ fn newton_controlled(
             mut rel,
         } = controlled_residual(ctx, &u, f_ext, ctl)?;
         if let Some(c) = last.take() {
-            if rel > BACKTRACK_GROWTH * c.rel {
+            if overshot(rel, c.rel) {
                 // The correction overshot (a band of open cracks or yielded bars is nearly a
                 // mechanism: the linearised step closes cracks into compression at E): back
                 // along it to where the residual's work vanishes, or half-way.
@@ -386,6 +386,12 @@ fn newton_controlled(
 /// driver backtracks along that correction [-]: well above the ups and downs of an iteration
 /// that crosses a kink (≤ 1.5 on the RC beam), well below the jumps of an overshoot (10×).
 const BACKTRACK_GROWTH: f64 = 2.0;
+
+/// Whether a Newton correction overshot: the relative residual after it grew more than
+/// [`BACKTRACK_GROWTH`] × the one before it, or is not a number.
+pub(super) fn overshot(after: f64, before: f64) -> bool {
+    after.is_nan() || after > BACKTRACK_GROWTH * before
+}
 
 /// One Newton correction of the displacement driver, kept to backtrack along it.
 struct Correction {
@@ -688,28 +694,33 @@ fn arc_increment(
     ctx.add_free(&mut u, &du, 1.0);
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
+    // The last correction (iterate, Δu and Δλ it started from, δu, δλ, relative residual).
+    let mut last: Option<ArcCorrection> = None;
     for it in 1..=controls.max_iterations + 1 {
-        let (f_int, k, scale) = ctx.tangent(&u)?;
-        let lam = lambda_n + d_lambda;
-        let r: Vec<f64> = f_base
-            .iter()
-            .zip(q_full)
-            .zip(&f_int)
-            .map(|((b, q), i)| b + lam * q - i)
-            .collect();
-        let rf = ctx.sys.to_free(&r);
-        let f_ext_norm = norm(
-            &f_base
-                .iter()
-                .zip(q_full)
-                .map(|(b, q)| b + lam * q)
-                .collect::<Vec<_>>(),
-        );
-        let rel = norm(&rf)
-            / f_ext_norm
-                .max(norm(&f_int))
-                .max(scale)
-                .max(f64::MIN_POSITIVE);
+        let mut eval = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full);
+        if let Some(c) = last.take() {
+            // An overshooting correction (the residual grows more than BACKTRACK_GROWTH×, or
+            // a material update fails at its wild strains) is halved, up to three times; the
+            // iterations after pull the iterate back onto the constraint.
+            let mut s = 1.0;
+            while s > 0.2 && eval.as_ref().map_or(true, |e| overshot(e.rel, c.rel)) {
+                s *= 0.5;
+                u.copy_from_slice(&c.u);
+                ctx.add_free(&mut u, &c.corr, s);
+                du.iter_mut()
+                    .zip(c.du.iter().zip(&c.corr))
+                    .for_each(|(d, (d0, k))| *d = d0 + s * k);
+                d_lambda = c.d_lambda + s * c.dlam;
+                eval = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full);
+                if controls.verbose {
+                    let r = eval.as_ref().map_or(f64::NAN, |e| e.rel);
+                    eprintln!(
+                        "    residual grew: back to {s:.3} of the last correction, relative residual {r:.3e}"
+                    );
+                }
+            }
+        }
+        let Residual { f_int, k, rf, rel } = eval?;
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
@@ -782,6 +793,14 @@ fn arc_increment(
         let energy = dot(&corr, &rf).abs();
         first_energy.get_or_insert(energy);
         last_energy = Some(energy);
+        last = Some(ArcCorrection {
+            u: u.clone(),
+            du: du.clone(),
+            d_lambda,
+            corr: corr.clone(),
+            dlam,
+            rel,
+        });
         for (d, c) in du.iter_mut().zip(&corr) {
             *d += c;
         }
@@ -790,6 +809,47 @@ fn arc_increment(
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// One corrective iteration of the arc-length driver, kept to backtrack along it.
+struct ArcCorrection {
+    /// Iterate it started from (all dofs) [m].
+    u: Vec<f64>,
+    /// Increment Δu of the step at that iterate (free equations) [m].
+    du: Vec<f64>,
+    /// Load-factor increment Δλ at that iterate [-].
+    d_lambda: f64,
+    /// The correction δu (free equations) [m].
+    corr: Vec<f64>,
+    /// The load-factor correction δλ [-].
+    dlam: f64,
+    /// Relative residual norm at that iterate [-].
+    rel: f64,
+}
+
+/// Internal forces, tangent, free residual and relative residual norm at `u` under the
+/// loads `f_base + lam q_full` (all dofs) [N].
+fn arc_residual(
+    ctx: &mut PathContext,
+    u: &[f64],
+    lam: f64,
+    f_base: &[f64],
+    q_full: &[f64],
+) -> Result<Residual, NewtonFailure> {
+    let (f_int, k, scale) = ctx.tangent(u)?;
+    let f_ext: Vec<f64> = f_base
+        .iter()
+        .zip(q_full)
+        .map(|(b, q)| b + lam * q)
+        .collect();
+    let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
+    let rf = ctx.sys.to_free(&r);
+    let rel = norm(&rf)
+        / norm(&f_ext)
+            .max(norm(&f_int))
+            .max(scale)
+            .max(f64::MIN_POSITIVE);
+    Ok(Residual { f_int, k, rf, rel })
 }
 
 /// Newton cycles: six iterations made and the relative residual not halved over the last

@@ -489,21 +489,37 @@ pub(super) fn newton(
     let mut history = Vec::new();
     let mut first_energy: Option<f64> = None;
     let mut last_energy: Option<f64> = None;
+    // The last correction (free equations) and the relative residual before it.
+    let mut last: Option<(Vec<f64>, f64)> = None;
     for it in 0..=max_it {
         let need_k = !(sys.linear && *factored_linear);
-        let t = Instant::now();
-        let a = sys
-            .assemble(u, need_k)
-            .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
-        sys.latch_cracks();
-        timings.assembly_s += t.elapsed().as_secs_f64();
-        let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
-        let rf = sys.to_free(&r);
+        let mut eval = residual_at(sys, u, f_ext, need_k, timings);
+        if let Some((du, rel0)) = last.take() {
+            // An overshooting correction (residual grown more than 2×, or a material update
+            // failing at its strains) is halved, up to three times (`path::overshot`).
+            let mut s = 1.0;
+            while s > 0.2
+                && eval
+                    .as_ref()
+                    .map_or(true, |e| super::path::overshot(e.3, rel0))
+            {
+                s *= 0.5;
+                for (d, &q) in sys.dofs.eq.iter().enumerate() {
+                    if q != CONSTRAINED {
+                        u[d] -= s * du[q];
+                    }
+                }
+                eval = residual_at(sys, u, f_ext, need_k, timings);
+                if c.verbose {
+                    let r = eval.as_ref().map_or(f64::NAN, |e| e.3);
+                    eprintln!(
+                        "    residual grew: back to {s:.3} of the last correction, relative residual {r:.3e}"
+                    );
+                }
+            }
+        }
+        let (a, r, rf, rel) = eval?;
         let rnorm = norm(&rf);
-        // Reference: the larger of the external force norm and the scale of the element
-        // forces (which stays finite under self-equilibrated prestress).
-        let reference = norm(f_ext).max(a.force_scale).max(f64::MIN_POSITIVE);
-        let rel = rnorm / reference;
         if !rel.is_finite() {
             history.push(rel);
             return Err(NewtonFailure::diverged(history, rf));
@@ -562,9 +578,38 @@ pub(super) fn newton(
                 u[d] += du[q];
             }
         }
+        if it > 0 && !sys.linear {
+            last = Some((du, rel));
+        }
     }
     // The loop returns at its last iteration; this is for max_it = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// An assembly, the full and free residuals [N] and the relative residual norm [-].
+type Evaluated = (crate::analysis::system::Assembled, Vec<f64>, Vec<f64>, f64);
+
+/// Assembly at `u` (with the tangent if `need_k`), crack latching, and the residual; the
+/// relative norm is taken against the larger of the external force norm and the
+/// element-force scale (which stays finite under self-equilibrated prestress).
+fn residual_at(
+    sys: &mut System,
+    u: &[f64],
+    f_ext: &[f64],
+    need_k: bool,
+    timings: &mut Timings,
+) -> Result<Evaluated, NewtonFailure> {
+    let t = Instant::now();
+    let a = sys
+        .assemble(u, need_k)
+        .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+    sys.latch_cracks();
+    timings.assembly_s += t.elapsed().as_secs_f64();
+    let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
+    let rf = sys.to_free(&r);
+    let reference = norm(f_ext).max(a.force_scale).max(f64::MIN_POSITIVE);
+    let rel = norm(&rf) / reference;
+    Ok((a, r, rf, rel))
 }
 
 pub(super) fn norm(v: &[f64]) -> f64 {

@@ -356,8 +356,9 @@ pub fn plastic_base(base: &PointState, trial: &PointState) -> Option<PointState>
 /// The state an update should start from for the rest of an increment whose Newton
 /// iterations cycle ("branch freezing"): `base` (the committed or latched state) with each
 /// crack held on the branch the trial state took — loading on the envelope or unloading on
-/// the secant — and a second crack that formed in the trial kept (IMPL-EX cracks follow a
-/// law without loading/unloading branches and ignore the hold). Returns None when there is
+/// the secant — and a second crack that formed in the trial kept (IMPL-EX cracks are held on
+/// the side of their kink at the extrapolated strain the trial took: the secant, or the
+/// capped line past it). Returns None when there is
 /// nothing to hold (not a cracked concrete point, or already frozen).
 ///
 /// Smeared cracks that compete for localisation make Newton alternate between iterates in
@@ -376,7 +377,10 @@ pub fn freeze_cracks(base: &PointState, trial: &PointState) -> Option<PointState
                 f.crack_max[1] = 0.0;
             }
             for i in 0..f.n_cracks as usize {
-                f.frozen[i] = if t.crack_max[i] > f.crack_max[i] {
+                // IMPL-EX cracks are held on the side of their kink at ẽ_max.
+                f.frozen[i] = if t.implex_side[i] != 0 {
+                    t.implex_side[i]
+                } else if t.crack_max[i] > f.crack_max[i] {
                     1
                 } else if t.crack_strain[i] > 0.0 {
                     -1

@@ -65,6 +65,8 @@ struct DirResult {
     open: bool,
     loading_crack: bool,
     e_el: f64,
+    /// IMPL-EX side of the kink at ẽ_max: 1 past it, −1 below it, 0 otherwise.
+    side: i8,
 }
 
 /// Committed history of one crack-axis direction.
@@ -106,6 +108,7 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         open: false,
         loading_crack: false,
         e_el,
+        side: 0,
     };
     if e_el >= 0.0 {
         if !cracked {
@@ -118,15 +121,25 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
             // is updated implicitly for the next extrapolation.
             let ex = ex.max(p.eps0());
             let s_ex = tension_envelope(p, alpha, ex).0;
-            if e_el <= ex {
+            let k_cap = IMPLEX_CAP_SLOPE * s_ex / ex;
+            let cap = s_ex + k_cap * (e_el - ex);
+            r.side = if e_el > ex { 1 } else { -1 };
+            if frozen < 0 || (frozen == 0 && e_el <= ex) {
+                // The secant (held on it by a frozen branch even a little past ẽ_max).
                 r.sigma = s_ex / ex * e_el;
                 r.k = s_ex / ex;
+            } else if frozen > 0 && p.ec * e_el < cap {
+                // Held past ẽ_max but nearly closed: elastic, so that the stress still
+                // vanishes with the strain.
+                r.sigma = p.ec * e_el;
+                r.k = p.ec;
             } else {
                 // Past ẽ_max the stress rises on a tenth of the secant: with a ~0 slope a
                 // band of cracks opening faster than extrapolated is a near-mechanism (the
                 // opening profile is held by the retained shear only) and Newton explodes.
-                r.k = IMPLEX_CAP_SLOPE * s_ex / ex;
-                r.sigma = s_ex + r.k * (e_el - ex);
+                // A frozen branch holds this line a little below ẽ_max too.
+                r.k = k_cap;
+                r.sigma = cap;
             }
             r.emax = e_el.max(emax);
             r.open = e_el > 0.0;
@@ -233,6 +246,7 @@ pub fn update_cracked(
     st.n_cracks = n_cracks;
     st.crack_max = [r0.emax, if n_cracks >= 2 { r1.emax } else { 0.0 }];
     st.crack_strain = [r0.e_el, if n_cracks >= 2 { r1.e_el } else { 0.0 }];
+    st.implex_side = [r0.side, if n_cracks >= 2 { r1.side } else { 0 }];
     st.dir_ebar = [r0.ebar, r1.ebar];
     st.dir_plastic = [r0.plastic, r1.plastic];
     st.crack_max_old = committed.crack_max;

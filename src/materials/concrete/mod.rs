@@ -365,6 +365,11 @@ pub struct ConcreteState {
     /// [`crate::materials::point::plastic_base`]); always false in committed states.
     #[serde(default)]
     pub(crate) hold_plastic: bool,
+    /// IMPL-EX: the side of the kink at the extrapolated largest crack strain each crack's
+    /// last update was on (1 past it, −1 below, 0 closed or not IMPL-EX); read by
+    /// [`crate::materials::point::freeze_cracks`] from trial states.
+    #[serde(default)]
+    pub(crate) implex_side: [i8; 2],
 }
 
 impl Default for ConcreteState {
@@ -392,6 +397,7 @@ impl ConcreteState {
             frozen: [0; 2],
             crack_max_old: [0.0; 2],
             hold_plastic: false,
+            implex_side: [0; 2],
         }
     }
 
