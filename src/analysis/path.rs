@@ -725,6 +725,13 @@ fn arc_increment(
         if cycling(&history) {
             ctx.sys.freeze_cracks();
         }
+        if controls.verbose {
+            eprintln!(
+                "    iteration {it:2}: relative residual {rel:.3e}, load factor increment {d_lambda:.4e}, {} negative pivots; {}",
+                ctx.solver.negative_pivots,
+                super::failure::census(ctx.sys, &rf)
+            );
+        }
         if !rel.is_finite() {
             return Err(NewtonFailure::diverged(history, rf));
         }
