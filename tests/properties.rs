@@ -13,6 +13,7 @@
 //! stiffness, a sign, a wrong hardening modulus) is of the order of the tangent itself.
 
 use proptest::prelude::*;
+use proptest::test_runner::{FileFailurePersistence, RngAlgorithm, RngSeed};
 use segfem::elements::bar::{add_bar_point, bar_strain, BarPoint};
 use segfem::elements::continuum::{response, GaussOutput, Integration};
 use segfem::elements::interface::{InterfaceElement, InterfaceParams};
@@ -21,10 +22,36 @@ use segfem::fem::shape::QuadKind;
 use segfem::materials::concrete::{self, ConcreteParams, ConcreteState};
 use segfem::materials::point::{update, Material, PointState};
 use segfem::materials::steel::{update_uniaxial, SteelParams, SteelState};
+use std::cell::Cell;
 
 // ------------------------------------------------------------------------------------------
 // Helpers
 // ------------------------------------------------------------------------------------------
+
+/// Every property runs from one fixed seed (ChaCha: the same cases on every machine and
+/// every run), and a failing case is saved to `proptest-regressions/properties.txt`, which
+/// is committed and replayed before the generated cases. `PROPTEST_CASES` and
+/// `PROPTEST_RNG_SEED` still override both for exploration.
+fn config(cases: u32) -> ProptestConfig {
+    ProptestConfig {
+        cases,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        rng_seed: RngSeed::Fixed(0x5e6f_e025),
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/proptest-regressions/properties.txt"
+        )))),
+        ..ProptestConfig::default()
+    }
+}
+
+/// Fewest of the 64 cases whose finite-difference comparison must run (the rest hit a
+/// regime switch inside the stencil and are skipped): well below the count the fixed seed
+/// gives, so a change of the generators that skips most cases fails.
+const MIN_PLASTIC: usize = 48;
+const MIN_INTERFACE: usize = 48;
+const MIN_TENDON: usize = 48;
+const MIN_BAR: usize = 48;
 
 fn rot(a: f64, v: [f64; 2]) -> [f64; 2] {
     let (s, c) = a.sin_cos();
@@ -203,7 +230,7 @@ fn asymmetry(k: &[f64], nd: usize) -> f64 {
 // ------------------------------------------------------------------------------------------
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    #![proptest_config(config(64))]
 
     /// Rigid-body motion (translation + infinitesimal rotation: the exact null space of the
     /// small-strain B) gives zero strain, zero stress and zero internal force, for elastic and
@@ -252,19 +279,23 @@ proptest! {
         prop_assert!(gap.unwrap() < 1e-7 * kmax, "gap {gap:?} of {kmax}");
     }
 
-    /// Concrete element in the plastic (hardening) compression range: from a committed plastic
-    /// state, a further homogeneous compressive strain; the element tangent (consistent,
-    /// symmetric with associated flow) must match central differences of the internal force.
-    /// Tolerance 1e-4 of max |K|: the point-level check allows 1e-5 E at h = 1e-8 in strain;
-    /// here h = 1e-9 L in displacement gives strains of O(1e-9) and the same bound relative to
-    /// the element stiffness, with margin for the nonlinear Ottosen surface. Perturbations
-    /// that switch the regime of any point are skipped.
-    #[test]
-    fn continuum_concrete_plastic_tangent_fd(
+}
+
+/// Concrete element in the plastic (hardening) compression range: from a committed plastic
+/// state, a further homogeneous compressive strain; the element tangent (consistent,
+/// symmetric with associated flow) must match central differences of the internal force.
+/// Tolerance 1e-4 of max |K|: the point-level check allows 1e-5 E at h = 1e-8 in strain;
+/// here h = 1e-9 L in displacement gives strains of O(1e-9) and the same bound relative to
+/// the element stiffness, with margin for the nonlinear Ottosen surface. Perturbations
+/// that switch the regime of any point are skipped.
+#[test]
+fn continuum_concrete_plastic_tangent_fd() {
+    let ran = Cell::new(0usize);
+    proptest!(config(64), |(
         kind in kinds(),
         d in prop::array::uniform8(-1.0..1.0f64), m in prop::array::uniform4(-1.0..1.0f64),
         ex in -1.8e-3..-6e-4f64, ry in -0.6..0.2f64, rg in -0.4..0.4f64, f1 in 0.5..0.9f64,
-    ) {
+    )| {
         let integ = Integration::Full;
         let x = quad_nodes(kind, 0.2, 0.2, &d, &m);
         let mat = concrete();
@@ -292,9 +323,22 @@ proptest! {
             (sig(&r.2) == s0).then_some(r.0)
         }, &u, &k, 2e-10);
         if let Some(g) = gap {
+            ran.set(ran.get() + 1);
             prop_assert!(g < 1e-4 * kmax, "gap {g} of {kmax}");
         }
-    }
+    });
+    // A stencil that switches a point's regime is skipped; most must compare.
+    eprintln!("FD cases: {}", ran.get());
+    assert!(
+        ran.get() >= MIN_PLASTIC,
+        "only {} of 64 cases compared with finite differences",
+        ran.get()
+    );
+}
+
+proptest! {
+    #![proptest_config(config(64))]
+
 
     /// Rotating the whole model (coordinates and displacements) rotates the internal forces
     /// and leaves their norm and the principal stresses unchanged: the element formulation
@@ -361,7 +405,7 @@ fn joint_params(kind: u8, lobatto: bool) -> InterfaceParams {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    #![proptest_config(config(64))]
 
     /// A rigid motion of both faces together (translation + infinitesimal rotation) leaves
     /// the relative displacement of coincident points zero: no traction, no force. Tolerance
@@ -383,19 +427,23 @@ proptest! {
         prop_assert!(max_abs(&r.f_int) < 1e-9 * scale, "{:?}", r.f_int);
     }
 
-    /// Tangent against central differences of the internal force, from a committed state
-    /// reached by a first relative displacement (closing, opening, sliding, debonding), for
-    /// dry, keyed and epoxy joints. The law is piecewise linear, so away from a regime switch
-    /// central differences are exact up to round-off: tolerance 1e-6 of max |K|; stencils that
-    /// change a point's regime are skipped. The tangent is symmetric whenever the element
-    /// reports it (`symmetric`: no sliding point).
-    #[test]
-    fn interface_tangent_fd_and_symmetry(
+}
+
+/// Tangent against central differences of the internal force, from a committed state
+/// reached by a first relative displacement (closing, opening, sliding, debonding), for
+/// dry, keyed and epoxy joints. The law is piecewise linear, so away from a regime switch
+/// central differences are exact up to round-off: tolerance 1e-6 of max |K|; stencils that
+/// change a point's regime are skipped. The tangent is symmetric whenever the element
+/// reports it (`symmetric`: no sliding point).
+#[test]
+fn interface_tangent_fd_and_symmetry() {
+    let ran = Cell::new(0usize);
+    proptest!(config(64), |(
         n in 2usize..=3, kind in 0u8..3, lobatto in any::<bool>(),
         a in -3.2..3.2f64,
         du1 in prop::collection::vec(-2e-5..2e-5f64, 12),
         du2 in prop::collection::vec(-2e-5..2e-5f64, 12),
-    ) {
+    )| {
         let p1 = [0.6 * a.cos(), 0.6 * a.sin()];
         let (fa, fb) = joint_faces([0.0, 0.0], p1, n);
         let prm = joint_params(kind, lobatto);
@@ -419,9 +467,22 @@ proptest! {
             (regime(&rr.states) == g0).then_some(rr.f_int)
         }, &u, &r.k, 1e-10);
         if let Some(g) = gap {
+            ran.set(ran.get() + 1);
             prop_assert!(g < 1e-6 * kmax, "gap {g} of {kmax}");
         }
-    }
+    });
+    // A stencil that switches a point's regime is skipped; most must compare.
+    eprintln!("FD cases: {}", ran.get());
+    assert!(
+        ran.get() >= MIN_INTERFACE,
+        "only {} of 64 cases compared with finite differences",
+        ran.get()
+    );
+}
+
+proptest! {
+    #![proptest_config(config(64))]
+
 
     /// Rotating the joint and its displacements rotates the forces (norm unchanged).
     /// Tolerance 1e-8 relative (round-off of the rotated geometry and projection).
@@ -477,7 +538,7 @@ fn tendon_points(l: f64, sag: &[f64]) -> Vec<[f64; 2]> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    #![proptest_config(config(64))]
 
     /// Finite rigid motions (any rotation angle: the tendon is geometrically exact) keep every
     /// span length, so the span forces are unchanged and the nodal forces of a prestressed
@@ -524,21 +585,26 @@ proptest! {
         prop_assert!(fx.abs() < 1e-9 * fref && fy.abs() < 1e-9 * fref && mz.abs() < 1e-8 * fref);
     }
 
-    /// Tangent (material + geometric stiffness, deviator coupling) against central differences
-    /// of the internal force, elastic and elastic–plastic steel, all deviator modes, from a
-    /// committed state after a first displacement. Step h = 1e-9 m on spans of metres: the
-    /// truncation error (geometric term, f''' ≈ N/L²) is ≈ 1e-18 N/m², round-off ≈ 1e-16 N /
-    /// 1e-9 m = 1e-7 of N/L; tolerance 1e-6 of max |K| (> E A / L ≈ 1e8 N/m). Stencils that
-    /// change a deviator's stick/slip flag or yield a span are skipped. Symmetric when the
-    /// element reports it (no slipping friction deviator).
-    #[test]
-    #[ignore = "finds tendon tangent defects (friction deviator beside a yielding span; some frictionless drapes with small sag): to be fixed in src/elements/tendon.rs, see the session-2 note"]
-    fn tendon_tangent_fd_and_symmetry(
+}
+
+/// Tangent (material + geometric stiffness, deviator coupling) against central differences
+/// of the internal force, elastic and elastic–plastic steel, all deviator modes, from a
+/// committed state after a first displacement. Step h = 1e-6 m on spans of metres: the
+/// truncation error (geometric term, f''' ≈ N/L³ ≈ 1e5 N/m³) is h²·1e5 ≈ 1e-7 N/m, the
+/// round-off ε|N|/h ≈ 2e-16 · 1e6 N / 1e-6 m ≈ 2e-4 N/m and the quantisation of h at
+/// coordinates of 6 m (ulp 9e-16 m) 1e-9 of K; tolerance 1e-6 of max |K| (> E A / L ≈ 1e8
+/// N/m). A smaller h (1e-9 m, used before) makes the quantisation alone 1e-6 of K. Stencils
+/// that change a deviator's stick/slip flag, yield a span or cross a span's slack point
+/// are skipped. Symmetric when the element reports it (no slipping friction deviator).
+#[test]
+fn tendon_tangent_fd_and_symmetry() {
+    let ran = Cell::new(0usize);
+    proptest!(config(64), |(
         mode in tendon_modes(), sag in prop::collection::vec(0.05..0.5f64, 1..3),
         plastic in any::<bool>(), sigma0 in 8e8..1.3e9f64,
         du1 in prop::collection::vec(-4e-3..4e-3f64, 8),
         du2 in prop::collection::vec(-4e-3..4e-3f64, 8),
-    ) {
+    )| {
         let pts = tendon_points(6.0, &sag);
         let law = if plastic {
             TendonLaw::ElasticPlastic { yield_stress: 1.4e9, hardening: 5e9, cap: f64::INFINITY }
@@ -551,9 +617,13 @@ proptest! {
         let c = tdn.response(&to_u(&du1[..2 * np]), &tdn.initial_state()).state;
         let u: Vec<f64> = du1[..2 * np].iter().zip(&du2).map(|(a, b)| a + b).collect();
         let r = tdn.response(&to_u(&u), &c);
-        let regime = |s: &segfem::elements::tendon::TendonState| -> (Vec<i8>, Vec<bool>) {
+        // Regime: stick/slip flags, and per span yielding and slack (the law's kink at zero
+        // stress); a stencil across any of them has no derivative to compare.
+        let regime = |s: &segfem::elements::tendon::TendonState| -> (Vec<i8>, Vec<(bool, bool)>) {
             (s.slipping.clone(),
-             s.spans.iter().zip(&c.spans).map(|(a, b)| a.law.plastic_strain != b.law.plastic_strain).collect())
+             s.spans.iter().zip(&c.spans)
+                .map(|(a, b)| (a.law.plastic_strain != b.law.plastic_strain, a.stress > 0.0))
+                .collect())
         };
         let g0 = regime(&r.state);
         let nd = 2 * np;
@@ -564,11 +634,19 @@ proptest! {
         let gap = fd_gap(&mut |v| {
             let rr = tdn.response(&to_u(v), &c);
             (regime(&rr.state) == g0).then_some(rr.f_int)
-        }, &u, &r.k, 1e-9);
+        }, &u, &r.k, 1e-6);
         if let Some(g) = gap {
+            ran.set(ran.get() + 1);
             prop_assert!(g < 1e-6 * kmax, "gap {g} of {kmax}");
         }
-    }
+    });
+    // A stencil that changes a stick/slip flag or yields a span is skipped; most must compare.
+    eprintln!("FD cases: {}", ran.get());
+    assert!(
+        ran.get() >= MIN_TENDON,
+        "only {} of 64 cases compared with finite differences",
+        ran.get()
+    );
 }
 
 // ------------------------------------------------------------------------------------------
@@ -576,7 +654,7 @@ proptest! {
 // ------------------------------------------------------------------------------------------
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    #![proptest_config(config(64))]
 
     /// A rigid motion of the host element gives no bar strain and so no bar force, whatever
     /// the bar's direction and position in the host. Tolerance 1e-12 (round-off of ∇N·u).
@@ -593,18 +671,22 @@ proptest! {
         prop_assert!(bar_strain(kind, &x, &p, &u).abs() < 1e-12);
     }
 
-    /// Bar tangent against central differences of the bar force, with the rebar law in its
-    /// elastic, hardening and perfectly plastic ranges; the bar stiffness gᵀ E_t A g is
-    /// symmetric. Tolerance 1e-6 of max |K| (the force is piecewise linear in u); stencils
-    /// that cross the yield point are skipped. Also: the strain of a homogeneous field along
-    /// the bar equals tᵀ ε t, which is invariant when bar and field are rotated together.
-    #[test]
-    fn bar_tangent_fd_and_rotation(
+}
+
+/// Bar tangent against central differences of the bar force, with the rebar law in its
+/// elastic, hardening and perfectly plastic ranges; the bar stiffness gᵀ E_t A g is
+/// symmetric. Tolerance 1e-6 of max |K| (the force is piecewise linear in u); stencils
+/// that cross the yield point are skipped. Also: the strain of a homogeneous field along
+/// the bar equals tᵀ ε t, which is invariant when bar and field are rotated together.
+#[test]
+fn bar_tangent_fd_and_rotation() {
+    let ran = Cell::new(0usize);
+    proptest!(config(64), |(
         kind in kinds(),
         d in prop::array::uniform8(-1.0..1.0f64), m in prop::array::uniform4(-1.0..1.0f64),
         xi in -1.0..1.0f64, eta in -1.0..1.0f64, phi in -3.2..3.2f64, a in -3.2..3.2f64,
         e in prop::array::uniform3(-4e-3..4e-3f64), hard in any::<bool>(),
-    ) {
+    )| {
         let x = quad_nodes(kind, 0.4, 0.3, &d, &m);
         let p = BarPoint { xi, eta, dir: [phi.cos(), phi.sin()], weight_length: 0.1, s: 0.0, x: [0.0; 2] };
         let steel = if hard { SteelParams::rebar_hardening(200e9, 500e6, 2e9) } else { SteelParams::rebar(200e9, 500e6) };
@@ -626,6 +708,7 @@ proptest! {
         prop_assert!(asymmetry(&k, nd) <= 1e-12 * kmax);
         let gap = fd_gap(&mut |v| { let r = force(v); (r.2 == yielded).then_some(r.0) }, &u, &k, 1e-10);
         if let Some(g) = gap {
+            ran.set(ran.get() + 1);
             prop_assert!(g < 1e-6 * kmax, "gap {g} of {kmax}");
         }
         // Rotation: bar direction and strain field rotated together.
@@ -635,7 +718,14 @@ proptest! {
         let ur = rot_vec(a, &u);
         let epsr = bar_strain(kind, &xr, &pr, &ur);
         prop_assert!((eps - epsr).abs() < 1e-12, "{eps} vs {epsr}");
-    }
+    });
+    // A stencil that crosses the yield point is skipped; most must compare.
+    eprintln!("FD cases: {}", ran.get());
+    assert!(
+        ran.get() >= MIN_BAR,
+        "only {} of 64 cases compared with finite differences",
+        ran.get()
+    );
 }
 
 // ------------------------------------------------------------------------------------------
@@ -653,7 +743,7 @@ fn steel_params() -> impl Strategy<Value = SteelParams> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, .. ProptestConfig::default() })]
+    #![proptest_config(config(128))]
 
     /// Elastic plane stress: tangent equals D (central differences exact for a linear map,
     /// tolerance 1e-6 E for round-off at h = 1e-9), D symmetric, and σ(R ε Rᵀ) = R σ Rᵀ

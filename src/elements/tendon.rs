@@ -712,10 +712,21 @@ impl ExternalTendon {
                     break;
                 }
                 let ds = dense_solve(jac, res.iter().map(|x| -x).collect());
-                for (r, &j) in idx.iter().enumerate() {
-                    s[j] += ds[r];
+                // Backtrack while the residual grows: the span laws are piecewise linear
+                // (yield, slack at zero force with the floor stiffness), and a full step
+                // taken on a kinked or slack span's tangent can jump far past the root.
+                let base = s.clone();
+                let mut step = 1.0;
+                for _ in 0..60 {
+                    for (r, &j) in idx.iter().enumerate() {
+                        s[j] = base[j] + step * ds[r];
+                    }
+                    st = eval(&s);
+                    if capstan_residual(&idx, &act, &ratio, self.area, &st) < rmax {
+                        break;
+                    }
+                    step *= 0.5;
                 }
-                st = eval(&s);
             }
             // Consistency checks.
             let mut changed = false;
@@ -749,6 +760,26 @@ impl ExternalTendon {
         let st = eval(&s);
         (s, act, st)
     }
+}
+
+/// Largest capstan residual |a N_l − b N_r| \[N\] over the active deviators `idx`.
+fn capstan_residual(
+    idx: &[usize],
+    act: &[i8],
+    ratio: &[f64],
+    area: f64,
+    st: &[(f64, f64, LawState)],
+) -> f64 {
+    idx.iter()
+        .map(|&j| {
+            let (a, b) = if act[j] > 0 {
+                (1.0, ratio[j])
+            } else {
+                (ratio[j], 1.0)
+            };
+            (a * area * st[j].0 - b * area * st[j + 1].0).abs()
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Dense Gaussian elimination with partial pivoting (small systems: active deviators).
