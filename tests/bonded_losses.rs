@@ -211,6 +211,10 @@ fn grouted_tendon_relaxes_as_mc90_at_constant_strain() {
 /// 3. The relaxation part lies below the constant-strain MC90 value ρ(t) σ_0 (the tendon
 ///    shortens as the concrete creeps and the linear chain relaxes the lost strain no more)
 ///    and above 80 % of it (the shortening is ~7 % of the strain).
+///
+/// 1–3 check the model against itself (its own J_0 and relaxation). 4 is the independent
+/// reference: MC90 compliance, the code relaxation and EC2's combined-loss formula, with the
+/// measured difference asserted as a known-deviation band.
 #[test]
 fn grouted_tendon_loses_concrete_creep_and_relaxation() {
     let material = "kind = \"elastic_creep\"\nfcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"\nshrinkage = false\ndrying_start = 7.0";
@@ -247,6 +251,37 @@ fn grouted_tendon_loses_concrete_creep_and_relaxation() {
         last[2]
     );
     assert!(r < code && r > 0.8 * code, "relaxation {r} vs {code}");
+
+    // 4. Independent reference: the age-adjusted effective modulus with MC90's own
+    //    compliance, J_0 = 1/E_ci(t_0) and J(t, t_0), and the code relaxation as EC2
+    //    5.10.6 (5.46) takes it, 0.8 ρ(t) σ_0 (reduced for the falling strain), χ = 0.8:
+    //      loss = [E_p σ_c0 (J − J_0) + 0.8 ρ σ_0] / [1 + E_p ρ_s (J_0 + χ (J − J_0))].
+    //    Nothing here comes from the run.
+    let j0_code = compliance(&p, t0, t0);
+    let dj_code = compliance(&p, t, t0) - j0_code;
+    let den = 1.0 + EP * rho * (j0_code + 0.8 * dj_code);
+    let reference = (EP * sc0 * dj_code + 0.8 * code) / den;
+    let creep_code = EP * sc0 * dj_code / den;
+    eprintln!(
+        "independent reference {reference:.4e} (creep {creep_code:.4e}, relaxation {:.4e}); FE {:.4e}: {:+.2} %",
+        0.8 * code / den,
+        last[2],
+        100.0 * (last[2] / reference - 1.0)
+    );
+    // Known deviation, measured +2.6 % (band +1 … +4 %, so that a regression and an
+    // unexplained improvement both fail). Its two causes pull apart: the chain's
+    // instantaneous compliance at 28 d is 14 % above MC90's 1/E_ci(t_0) (the chain cannot
+    // hold MC90's creep of the first hours, docs/theory-time.md) while J(t, t_0) agrees at
+    // long durations, so less creep follows the stressing (≈ −8 % of the creep part); and
+    // the chain relaxes the steel at 96 % of the constant-strain value (checked in 3) where
+    // EC2 takes 80 % (+9 % of the relaxation part).
+    let dev = last[2] / reference - 1.0;
+    assert!(
+        (0.01..0.04).contains(&dev),
+        "total {:.4e} vs reference {reference:.4e}: {:+.2} % (known deviation band +1 … +4 %)",
+        last[2],
+        100.0 * dev
+    );
 }
 
 /// Elastic shortening of pre-tensioned tendons at release, computed by the model: a tendon
