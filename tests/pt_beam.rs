@@ -1,6 +1,8 @@
 //! The bundled post-tensioned beam example (examples/pt-beam.toml) through the `segfem`
 //! binary: it runs to the end, and its camber after stressing has the sign and size of the
-//! closed form.
+//! closed form. The lock-off stresses (friction and anchorage sets at both ends, whose
+//! zones overlap) are computed here in closed form, for the example's parabola and for a
+//! straight–parabola–straight tendon.
 
 mod common;
 
@@ -28,13 +30,191 @@ fn col(head: &[String], name: &str) -> usize {
         .unwrap_or_else(|| panic!("no column {name}"))
 }
 
+/// A symmetric tendon over a span L: straight from (0, y_0) to (x_a, y_a), parabola with its
+/// vertex y_v at L/2, straight again to (L, y_0); x_a = 0 for a plain parabola. Lengths in
+/// m.
+struct Sps {
+    l: f64,
+    xa: f64,
+    y0: f64,
+    ya: f64,
+    yv: f64,
+}
+
+/// Friction and anchorage sets in closed form: jacked at σ_j from both ends, friction μ
+/// with wobble k \[1/m\], set δ \[m\] at both ends, E_p \[Pa\].
+struct LockOff {
+    sj: f64,
+    mu: f64,
+    k: f64,
+    delta: f64,
+    ep: f64,
+}
+
+impl Sps {
+    /// Parabola y = y_v + c (x − L/2)².
+    fn c(&self) -> f64 {
+        (self.ya - self.yv) / (0.5 * self.l - self.xa).powi(2)
+    }
+    /// Slope y′(x) for x ≤ L/2.
+    fn slope(&self, x: f64) -> f64 {
+        if x < self.xa {
+            (self.ya - self.y0) / self.xa
+        } else {
+            2.0 * self.c() * (x - 0.5 * self.l)
+        }
+    }
+    /// Arc length s(x) \[m\] and angle change α(x) \[rad\] from the nearer anchor: exact
+    /// (straight part; parabola: ∫√(1 + y′²) dx = [u√(1 + u²) + asinh u]/(4c), u = y′).
+    fn s_alpha(&self, x: f64) -> (f64, f64) {
+        let x = x.min(self.l - x);
+        let m0 = self.slope(0.0);
+        if x <= self.xa {
+            return (x * m0.hypot(1.0), 0.0);
+        }
+        let c = self.c();
+        let f = |u: f64| (u * u.hypot(1.0) + u.asinh()) / (4.0 * c);
+        let (ua, u) = (self.slope(self.xa), self.slope(x));
+        let kink = (ua.atan() - m0.atan()).abs();
+        (
+            self.xa * m0.hypot(1.0) + f(u) - f(ua),
+            kink + (u.atan() - ua.atan()).abs(),
+        )
+    }
+}
+
+impl LockOff {
+    /// Stress after friction, σ_j exp[−μ(α + k s)] (the jack at the nearer end governs).
+    fn friction(&self, t: &Sps, x: f64) -> f64 {
+        let (s, a) = t.s_alpha(x);
+        self.sj * (-self.mu * (a + self.k * s)).exp()
+    }
+    /// Reference stress σ_ref of the area method when each set zone covers its whole half
+    /// (the zones overlap at midspan): with the mirror image σ_after = 2σ_ref − σ over the
+    /// half of arc length L_h, 2 ∫(σ − σ_ref) ds = E_p δ, so
+    /// σ_ref = (∫σ ds − E_p δ/2)/L_h. Simpson's rule in x on each smooth part (2,000
+    /// intervals: error ~1e-14 of the integral).
+    fn reference(&self, t: &Sps) -> f64 {
+        let half = 0.5 * t.l;
+        let simpson = |a: f64, b: f64| {
+            let n = 2000;
+            let h = (b - a) / n as f64;
+            let g = |x: f64| self.friction(t, x) * t.slope(x).hypot(1.0);
+            let mut acc = g(a) + g(b);
+            for i in 1..n {
+                acc += g(a + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+            }
+            acc * h / 3.0
+        };
+        let mut integral = simpson(t.xa, half);
+        if t.xa > 0.0 {
+            integral += simpson(0.0, t.xa);
+        }
+        let lh = t.s_alpha(half).0;
+        let sref = (integral - 0.5 * self.ep * self.delta) / lh;
+        // The zones overlap: σ_ref lies below the friction profile's minimum at midspan.
+        assert!(sref < self.friction(t, half), "set zones do not overlap");
+        sref
+    }
+    /// Lock-off stress at abscissa x \[Pa\].
+    fn at(&self, t: &Sps, x: f64, sref: f64) -> f64 {
+        2.0 * sref - self.friction(t, x)
+    }
+}
+
+/// The example's lock-off: parabola (0, 0.4) → (12, 0.4), vertex 0.15 m; 1395 MPa at both
+/// jacks, μ = 0.19, k = 0.01/m, 6 mm sets (E_p δ = 1170 MPa·m against ≈ 230 MPa·m of
+/// friction loss over a half: the zones overlap).
+fn example_lock_off() -> (Sps, LockOff) {
+    (
+        Sps {
+            l: 12.0,
+            xa: 0.0,
+            y0: 0.4,
+            ya: 0.4,
+            yv: 0.15,
+        },
+        LockOff {
+            sj: 1395e6,
+            mu: 0.19,
+            k: 0.01,
+            delta: 0.006,
+            ep: 195e9,
+        },
+    )
+}
+
+/// Lock-off stress at every integration point of a straight–parabola–straight tendon
+/// (tangent-continuous: straight (0, 0.55) → (2, 0.45), parabola to (10, 0.45) with its
+/// vertex 0.35 at midspan, straight to (12, 0.55)), jacked at both ends with friction and
+/// 6 mm sets whose zones overlap, against the closed form above (friction with α and s
+/// exact, the area method's mirror image over each whole half). Also the example's
+/// parabola, the profile the camber test below integrates. Tolerances beside the checks.
+#[test]
+fn lock_off_with_overlapping_sets_matches_the_closed_form() {
+    let (_, lo) = example_lock_off();
+    let sps = Sps {
+        l: 12.0,
+        xa: 2.0,
+        y0: 0.55,
+        ya: 0.45,
+        yv: 0.35,
+    };
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/pt-beam.toml"
+    ))
+    .unwrap();
+    let spsline = "segments = [\n  { points = [[0.0, 0.55], [2.0, 0.45]] },\n  { parabola = { start = [2.0, 0.45], end = [10.0, 0.45], sag = -0.1 } },\n  { points = [[10.0, 0.45], [12.0, 0.55]] },\n]";
+    let parabola = "parabola = { start = [0.0, 0.4], end = [12.0, 0.4], sag = -0.25 }";
+    assert!(text.contains(parabola));
+    let (example, _) = example_lock_off();
+    for (t, toml) in [(&sps, text.replace(parabola, spsline)), (&example, text)] {
+        let model = segfem::input::parse(&toml, "pt.toml")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .model;
+        let bar = &model.bars[0];
+        let pt = bar.post_tension.as_ref().unwrap();
+        let sref = lo.reference(t);
+        let d: Vec<f64> = bar
+            .points
+            .iter()
+            .zip(&pt.point_stress)
+            .map(|(gp, s)| s - lo.at(t, gp.point.x[0], sref))
+            .collect();
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let spread = d.iter().map(|v| (v - mean).abs()).fold(0.0, f64::max);
+        eprintln!(
+            "x_a = {}: σ_ref {:.4} MPa, anchor {:.3} MPa, midspan {:.3} MPa; model − closed form {:.4} MPa (spread {spread:.2e} Pa)",
+            t.xa,
+            sref / 1e6,
+            lo.at(t, 0.0, sref) / 1e6,
+            lo.at(t, 6.0, sref) / 1e6,
+            mean / 1e6
+        );
+        // The shape (friction and mirror image) exactly: 1e-9 of σ_j (round-off).
+        assert!(spread < 1e-9 * lo.sj, "spread {spread} Pa");
+        // The level σ_ref within 1e-3 of σ_j (measured +5e-4, a known deviation): the
+        // model lumps the path's angle changes at its points (a polyline through the bar's
+        // points), so its set area ∫σ ds is a staircase of the smooth one, biased by about
+        // σ μ Δα h/2 per segment; exact at the points themselves (the spread above).
+        assert!(mean.abs() < 1e-3 * lo.sj, "σ_ref off by {mean} Pa");
+        // Both set zones reach midspan.
+        assert!(
+            pt.set_length[0] > 0.999 * t.s_alpha(6.0).0,
+            "{:?}",
+            pt.set_length
+        );
+    }
+}
+
 /// Camber at midspan after stressing (self weight and prestress, ungrouted tendon) against
 /// the closed form for the statically determinate beam by virtual work (unit load at
 /// midspan, m̄ = x/2 and v̄ = ±1/2):
 ///
 /// * prestress: the section moment is P(x) cos θ e(x) and the shear P(x) sin θ, with P(x)
-///   the tendon's lock-off force after friction and anchorage set at each of its
-///   integration points (itself checked against seed eq. 27 in tests/prestress.rs) and e
+///   the tendon's lock-off force after friction and anchorage sets in closed form (below)
+///   at each of its integration points and e
 ///   the point's distance below the centroid: δ_p = Σ [P cos θ e m̄/EI + P |sin θ| v̄/(κGA)]
 ///   dx, dx = cos θ ds from the tendon's own weights;
 /// * self weight w = ρ g b h: δ_g = 5 w L⁴/(384 EI) + w L²/(8 κGA), κ = 5/6.
@@ -61,9 +241,14 @@ fn pt_beam_example_runs_and_cambers_as_the_closed_form() {
     let kga = 5.0 / 6.0 * e / (2.0 * (1.0 + nu)) * b * h;
     let bar = &model.bars[0];
     let pt = bar.post_tension.as_ref().unwrap();
+    // The lock-off force from the closed form (checked against the model in
+    // `lock_off_with_overlapping_sets_matches_the_closed_form`), not from the model.
+    let (t, lo) = example_lock_off();
+    let sref = lo.reference(&t);
+    assert_eq!(pt.point_stress.len(), bar.points.len());
     let mut dp = 0.0;
-    for (gp, s) in bar.points.iter().zip(&pt.point_stress) {
-        let p = s * bar.area;
+    for gp in &bar.points {
+        let p = lo.at(&t, gp.point.x[0], sref) * bar.area;
         let [c, sn] = gp.point.dir;
         let x = gp.point.x[0];
         let ecc = 0.5 * h - gp.point.x[1];
