@@ -91,16 +91,8 @@ fn seed_beam_behaves_as_the_seed_reports() {
         rate(100.0, 140.0),
         rate(14.0, 56.0)
     );
-    // The seed's computed values at the highest loads (VALIDATION.md §1: 25 % because part of
-    // the geometry is assumed). Lower loads are reported in docs/validation.md: the model is
-    // stiffer there (elastic concrete; see the account there).
-    for (q, seed_mm) in [(126.0, 36.08), (140.0, 41.85)] {
-        let d = (u0 - at(r, q).1) * 1e3;
-        assert!(
-            ((d - seed_mm) / seed_mm).abs() < 0.25,
-            "Q = {q}: {d:.2} mm vs seed {seed_mm} mm"
-        );
-    }
+    // Deflections at every reference load: see
+    // `seed_beam_deflections_at_every_reference_load_are_the_known_deviations`.
     let open140 = at(r, 140.0).3 * 1e3;
     assert!(
         ((open140 - 6.0) / 6.0).abs() < 0.25,
@@ -249,4 +241,131 @@ fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
     ] {
         assert!(tmp.join(&format!("seed/figures/{f}.png")).is_file(), "{f}");
     }
+}
+
+/// The seed's computed deflections [mm] at Q = 56 … 140 kN (validation/seed-beam-reference.csv).
+fn seed_reference() -> Vec<(f64, f64)> {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/validation/seed-beam-reference.csv"
+    ))
+    .unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let mut it = l.split(',').map(|v| v.trim().parse::<f64>().unwrap());
+            (it.next().unwrap(), -it.next().unwrap() * 1e3)
+        })
+        .collect()
+}
+
+/// The load-controlled steps (to Q = 140 kN) of `text`, the step on to failure cut off:
+/// rows as in [`Rows`] and the deflection from Q = 0 [mm] at each reference load.
+fn deflections(text: &str) -> (Vec<(f64, f64, f64, f64, bool)>, Vec<f64>) {
+    let cut = text
+        .find("[[steps]]\nname = \"failure\"")
+        .expect("failure step");
+    let model = segfem::input::parse(&text[..cut], "seed-beam.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let mut rows = Rows::default();
+    steps::run(&model, &mut rows).unwrap_or_else(|e| panic!("{e}"));
+    let r = rows.0;
+    let u0 = r[0].1;
+    let d = seed_reference()
+        .iter()
+        .map(|&(q, _)| (u0 - at(&r, q).1) * 1e3)
+        .collect();
+    (r, d)
+}
+
+fn example_text() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/seed-beam.toml"
+    ))
+    .unwrap()
+}
+
+/// The MC90-concrete variant of the example, as `segfem bench --case
+/// seed-failure-concrete` builds it (IMPL-EX cracking, elastic 0.3 m end blocks, the RC
+/// example's solver settings), without the step on to failure.
+fn mc90_text() -> String {
+    let t = example_text();
+    let cut = t.find("[[steps]]\nname = \"failure\"").unwrap();
+    let t = t[..cut]
+        .replace(
+            "kind = \"elastic\"\nE = 35.5e9",
+            "kind = \"concrete\"\nfcm = 45e6\ncrack_integration = \"implex\"\nE = 35.5e9",
+        )
+        .replace(
+            "[[joint_materials]]",
+            "[[materials]]\nname = \"block\"\nkind = \"elastic\"\nE = 35.5e9\nnu = 0.2\ndensity = 2548.4\n\n\
+             [[regions]]\nname = \"end_blocks\"\nmaterial = \"block\"\nthickness = 0.70\n\
+             boxes = [[[0.0, 0.0], [0.3, 0.6]], [[6.9, 0.0], [7.2, 0.6]]]\n\n[[joint_materials]]",
+        );
+    assert!(t.contains("implex") && t.contains("end_blocks"));
+    // `deflections` cuts at the failure step: give it an empty one after the solver table.
+    t + "\n[solver]\nforce_tolerance = 1e-4\nmax_iterations = 30\nmax_cuts = 8\n\n[[steps]]\nname = \"failure\"\n"
+}
+
+/// Known deviations from the seed's deflections (docs/validation.md, the seed beam): the
+/// deflection [mm] segfem gives at each reference load. Elastic concrete, nonlinear
+/// geometry (the example): much stiffer than the seed from 70 to 112 kN (−74, −59, −37,
+/// −24 %: the seed's beam softens from 70 kN on, ours only once the joints open wide;
+/// the seed's crack model and mesh are not given), +13 % at 56 kN, −8 % and +6 % at 126
+/// and 140 kN.
+const ELASTIC_MM: [f64; 7] = [1.749, 2.349, 5.574, 12.126, 21.835, 33.032, 44.337];
+
+/// MC90 concrete (the bench variant): as the elastic run to 84 kN, softer from 98 kN on
+/// (cracking of the web beside the opened joints, docs/validation.md): −19, +3, +19, +35 %
+/// against the seed at 98 … 140 kN.
+const MC90_MM: [f64; 7] = [1.744, 2.374, 5.955, 15.626, 29.763, 42.812, 56.334];
+
+/// Each deflection against its known-deviation value, so that a regression and an
+/// unexplained improvement both fail. Tolerance `tol` relative, stated by the caller.
+fn check_band(what: &str, got: &[f64], known: &[f64], tol: f64) {
+    for ((&(q, seed), &d), &k) in seed_reference().iter().zip(got).zip(known) {
+        eprintln!(
+            "{what}, Q = {q} kN: {d:.3} mm (known {k:.3} mm, seed {seed:.2} mm, {:+.0} %)",
+            100.0 * (d / seed - 1.0)
+        );
+        assert!(
+            (d / k - 1.0).abs() < tol,
+            "{what}, Q = {q} kN: {d:.3} mm outside the known-deviation band {k:.3} mm ± {:.0} % (seed {seed} mm)",
+            100.0 * tol
+        );
+    }
+}
+
+/// The example (elastic concrete, nonlinear geometry) at every reference load within 2 % of
+/// its known-deviation value (the only nonlinearities are the joints' contact and the
+/// geometry; the increments and the solver tolerance move these values by < 0.5 %). The
+/// band at 140 kN (43.4–45.2 mm) rejects the same beam with linear geometry (35.6 mm),
+/// which the old ±25 % band around the seed's 41.85 mm admitted.
+#[test]
+fn seed_beam_deflections_at_every_reference_load_are_the_known_deviations() {
+    let text = example_text();
+    let (_, d) = deflections(&text);
+    check_band("elastic", &d, &ELASTIC_MM, 0.02);
+    let linear = text.replace("geometry = \"nonlinear\"", "geometry = \"linear\"");
+    assert_ne!(linear, text);
+    let (_, dl) = deflections(&linear);
+    assert!(
+        (dl[6] / ELASTIC_MM[6] - 1.0).abs() > 0.02,
+        "linear geometry at 140 kN: {:.2} mm inside the band",
+        dl[6]
+    );
+}
+
+/// The MC90-concrete variant at every reference load within 4 % of its known-deviation
+/// value: cracking makes the path depend on the increments more than the elastic run
+/// (IMPL-EX cracks lag one increment; changes of the crack algorithm between sessions moved
+/// these values by up to 2 %).
+#[test]
+fn seed_beam_with_concrete_deflections_are_the_known_deviations() {
+    let (r, d) = deflections(&mc90_text());
+    check_band("MC90", &d, &MC90_MM, 0.04);
+    // The load-controlled steps reached 140 kN.
+    assert!((r.last().unwrap().0 - 140.0).abs() < 1e-9);
 }
