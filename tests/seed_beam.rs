@@ -12,7 +12,10 @@ use segfem::results::joints::summarise;
 /// One row per converged increment: Q [kN], midspan deflection [m], tendon stress [Pa],
 /// largest opening [m], all joint points closed and compressed.
 #[derive(Default)]
-struct Rows(Vec<(f64, f64, f64, f64, bool)>);
+struct Rows(Vec<Row>);
+
+/// Q, deflection, tendon stress, opening, all closed (see [`Rows`]).
+type Row = (f64, f64, f64, f64, bool);
 
 impl Observer for Rows {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
@@ -261,7 +264,7 @@ fn seed_reference() -> Vec<(f64, f64)> {
 
 /// The load-controlled steps (to Q = 140 kN) of `text`, the step on to failure cut off:
 /// rows as in [`Rows`] and the deflection from Q = 0 [mm] at each reference load.
-fn deflections(text: &str) -> (Vec<(f64, f64, f64, f64, bool)>, Vec<f64>) {
+fn deflections(text: &str) -> (Vec<Row>, Vec<f64>) {
     let cut = text
         .find("[[steps]]\nname = \"failure\"")
         .expect("failure step");
