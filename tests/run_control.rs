@@ -223,51 +223,59 @@ fn interruption_keeps_results_and_restarts() {
     same_outputs(&tmp.join("straight"), &out);
 }
 
-/// The real thing: SIGINT sent to a running `segfem run` (a 20 000-substep creep run that
-/// would take minutes) once its first checkpoint exists; it finishes the increment, writes
-/// its results and exits 130 with a summary saying where to restart.
+/// The real thing: SIGINT sent to the `segfem` binary, at a deterministic point. The model
+/// file is a named pipe: the binary installs its signal handlers before it reads the
+/// model, so once its read end is open (our write end's open returns) the signal is
+/// caught, and it is pending before the model text arrives. The run must then do the first
+/// increment in hand, write its results and exit 130 with a summary saying where to
+/// restart: exactly one history row (step 1 is one increment), status "interrupted",
+/// resume at step 2.
 #[test]
 fn sigint_stops_the_binary_cleanly() {
+    use std::io::Write;
     let tmp = TempDir::new("sigint");
-    let text = edit(&example("creep-beam"), "substeps = 50", "substeps = 20000");
-    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let text = example("creep-beam");
+    let fifo = tmp.join("m.toml");
+    let mk = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(mk.success());
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
         .current_dir(tmp.path())
         .args(["run", "m.toml", "-o", "out", "-q", "--threads", "2"])
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // The history file is first written at the end of step 1, after the signal handlers
-    // are in place (they are set before the run starts).
-    while !tmp.join("out/history.csv").exists() {
-        if let Some(st) = child.try_wait().unwrap() {
-            panic!("segfem ended before the signal: {st}");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let pid = child.id().to_string();
+    // Blocks until the binary opens the pipe to read the model (handlers in place).
+    let mut w = std::fs::OpenOptions::new().write(true).open(&fifo).unwrap();
     let k = std::process::Command::new("kill")
-        .args(["-INT", &pid])
+        .args(["-INT", &child.id().to_string()])
         .status()
         .unwrap();
     assert!(k.success());
+    w.write_all(text.as_bytes()).unwrap();
+    // The binary opens the file a second time for the checkpoint's digest: by then the
+    // path must be a plain file with the same text (the rename does not touch the pipe
+    // it is reading).
+    std::fs::write(tmp.join("plain.toml"), &text).unwrap();
+    std::fs::rename(tmp.join("plain.toml"), &fifo).unwrap();
+    drop(w);
     let o = child.wait_with_output().unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
     let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
     assert!(err.contains("interrupted by SIGINT"), "{err}");
     assert!(err.contains("segfem run --restart out"), "{err}");
     let s = summary(&tmp.join("out"));
-    assert_eq!(s["status"], "interrupted");
-    assert_eq!(s["resume_step"], 2);
-    // Step 1 (one row) and what step 2 did before the signal (possibly nothing, if the
-    // signal came between the end of step 1 and the start of step 2), not all of it.
+    assert_eq!(s["status"], "interrupted", "{s}");
+    // Step 1 (prestress) is one increment: the run stops after it, with its checkpoint.
+    assert_eq!(s["resume_step"], 2, "{s}");
+    assert_eq!(
+        s["error"],
+        "interrupted by SIGINT after step 1; a restart continues with step 2"
+    );
     let rows = read(&tmp.join("out/history.csv")).lines().count() - 1;
-    assert!((1..20000).contains(&rows), "{rows} rows");
+    assert_eq!(rows, 1, "the increment in hand only");
     assert!(tmp.join("out/checkpoint.bin").is_file());
 }
 
