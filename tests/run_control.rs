@@ -241,7 +241,7 @@ fn sigint_stops_the_binary_cleanly() {
         .status()
         .unwrap();
     assert!(mk.success());
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
         .current_dir(tmp.path())
         .args(["run", "m.toml", "-o", "out", "-q", "--threads", "2"])
         .stderr(std::process::Stdio::piped())
