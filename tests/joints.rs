@@ -426,3 +426,124 @@ fn reactions_match_statics_at_every_increment_with_joints_opening() {
         }
     }
 }
+
+/// A dry joint that slides, opens, closes and opens again, driven through one interface
+/// element (faces along y, 0.5 m, thickness 0.2 m, K_n = 1e12, K_t = 4e11 Pa/m, μ = 0.7,
+/// no residual stiffness) by uniform relative displacements of face B, each state committed
+/// before the next. The law (docs/theory-joints-tendons.md): closed, τ = K_t (g_t − s_p)
+/// up to μσ_n; open, no traction and the plastic slip follows g_t, so that the joint
+/// re-closes with zero shear wherever it moved while open. Expected at every point, in
+/// closed form:
+///
+/// 1. pressed by λ = 1e-5 m and slid g = 1 mm: σ_n = K_n λ, τ = μσ_n, s_p = g − τ/K_t;
+/// 2. opened (λ = −1e-4) and moved to g = 3 mm: σ_n = τ = 0, s_p = 3 mm (the reset);
+/// 3. closed again at g = 3 mm: σ_n = K_n λ and τ = 0 (not K_t (3 − 1) mm);
+/// 4. moved 1e-7 m while closed: sticks, τ = K_t · 1e-7;
+/// 5. reopened: σ_n = τ = 0, s_p = g.
+///
+/// Tolerance 1e-9 of σ_n (the law is algebraic: round-off only).
+#[test]
+fn joint_opens_closes_and_reopens_with_the_slip_reset() {
+    use segfem::elements::interface::{InterfaceElement, InterfaceParams};
+    let prm = InterfaceParams::dry(1e12, 4e11, 0.7);
+    let face = [[0.5, 0.0], [0.5, 0.5]];
+    let el = InterfaceElement::new(&face, &face, &prm).unwrap();
+    let nd = el.n_dofs();
+    // Face B (second half of the dofs) moved by (dx, dy); which sign of dx presses the
+    // joint is read from the element itself on a virgin state.
+    let u = |dx: f64, dy: f64| -> Vec<f64> {
+        (0..nd)
+            .map(|k| {
+                if k < nd / 2 {
+                    0.0
+                } else if k % 2 == 0 {
+                    dx
+                } else {
+                    dy
+                }
+            })
+            .collect()
+    };
+    let c0 = el.initial_states(&prm);
+    let press = if el.response(&prm, 0.2, &u(-1e-5, 0.0), &c0).states[0].lambda > 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    // Slip sign: g_t of face B moved +y, read the same way.
+    let gsign = el.response(&prm, 0.2, &u(press * 1e-5, 1e-9), &c0).states[0]
+        .slip
+        .signum();
+    let (kn, kt, mu, lam) = (1e12, 4e11, 0.7, 1e-5);
+    let sn = kn * lam;
+    let tol = 1e-9 * sn;
+    let mut c = c0;
+    let mut go =
+        |dx: f64,
+         g: f64,
+         what: &str,
+         check: &dyn Fn(&[segfem::elements::interface::InterfacePointState])| {
+            let r = el.response(&prm, 0.2, &u(dx, g), &c);
+            check(&r.states);
+            for p in &r.states {
+                eprintln!(
+                    "{what}: λ {:.3e} g {:.3e} s_p {:.4e} σ_n {:.4e} τ {:.4e} closed {} sliding {}",
+                    p.lambda,
+                    p.slip,
+                    p.plastic_slip,
+                    p.normal_stress,
+                    p.shear_stress,
+                    p.closed,
+                    p.sliding
+                );
+            }
+            c = r.states;
+        };
+    // 1. Pressed and slid 1 mm.
+    go(press * lam, 1e-3, "slide", &|s| {
+        for p in s {
+            assert!(p.closed && p.sliding);
+            assert!((p.normal_stress - sn).abs() < tol, "{p:?}");
+            assert!((p.shear_stress.abs() - mu * sn).abs() < tol, "{p:?}");
+            let sp = gsign * (1e-3 - mu * sn / kt);
+            assert!((p.plastic_slip - sp).abs() < 1e-12, "{p:?}");
+        }
+    });
+    // 2. Opened and moved to 3 mm.
+    go(-press * 1e-4, 3e-3, "open", &|s| {
+        for p in s {
+            assert!(!p.closed);
+            assert!(
+                p.normal_stress.abs() < tol && p.shear_stress.abs() < tol,
+                "{p:?}"
+            );
+            assert!((p.plastic_slip - gsign * 3e-3).abs() < 1e-12, "{p:?}");
+        }
+    });
+    // 3. Closed again where it stands: no shear.
+    go(press * lam, 3e-3, "reclose", &|s| {
+        for p in s {
+            assert!(p.closed && !p.sliding);
+            assert!((p.normal_stress - sn).abs() < tol, "{p:?}");
+            assert!(p.shear_stress.abs() < tol, "{p:?}");
+        }
+    });
+    // 4. A small move sticks with the elastic shear.
+    go(press * lam, 3e-3 + 1e-7, "stick", &|s| {
+        for p in s {
+            assert!(p.closed && !p.sliding);
+            assert!((p.shear_stress.abs() - kt * 1e-7).abs() < tol, "{p:?}");
+        }
+    });
+    // 5. Reopened: nothing carried, the slip follows again.
+    go(-press * 1e-4, 2e-3, "reopen", &|s| {
+        for p in s {
+            assert!(!p.closed);
+            assert!(
+                p.normal_stress.abs() < tol && p.shear_stress.abs() < tol,
+                "{p:?}"
+            );
+            assert!((p.plastic_slip - gsign * 2e-3).abs() < 1e-12, "{p:?}");
+        }
+    });
+}
