@@ -255,3 +255,156 @@ increments = 8
     assert!((v - v_ref).abs() < 0.005, "v/L {v} vs {v_ref}");
     assert!((w - w_ref).abs() < 0.005, "u/L {w} vs {w_ref}");
 }
+
+/// Snap-through of a shallow two-bar (von Mises) truss, traced by arc length through its
+/// limit point, the descending branch and the negative-load branch to the inverted
+/// position. Half model: one bar from the pin at (0, 0) to the apex at (a, h₀) = (1, 0.1) m,
+/// a strip 0.1 m deep (ν = 0, E = 200 GPa, thickness 0.01 m: A₀ = 1e-3 m²), 40 × 2 Q4,
+/// pinned at its end centre nodes, the apex node held on the symmetry line (u_x = 0) and
+/// loaded downwards by P/2. The end elements are 1e4 times stiffer caps (a plane point
+/// load's indentation is logarithmically singular: at the bare end nodes it would add
+/// ~40 % to the bar's compliance); the closed form stretches the rest, L − 2L₀/n. Closed form (total Lagrangian, Saint-Venant–Kirchhoff: the
+/// second Piola–Kirchhoff stress S = E·E_GL of the bar's Green–Lagrange strain):
+///
+///   L = √(a² + (h₀ − w)²), λ = L/L₀, N = E A₀ λ (λ² − 1)/2, P/2 = −N (h₀ − w)/L,
+///
+/// with w the apex deflection. The strip is pinned, so it carries axial force only; the
+/// Euler load of the strip is well above the force at the limit point. Tolerance 1e-3 of
+/// the peak load at every increment (the caps' spreading into the strip over about one
+/// depth at each end, and their own 1e-4 compliance; the Newton tolerance).
+#[test]
+fn von_mises_truss_snaps_through_on_the_closed_form_path() {
+    let (a, h0, t, b, e, n) = (1.0f64, 0.1f64, 0.1f64, 0.01f64, 200e9f64, 40usize);
+    let l0 = a.hypot(h0);
+    let dir = [a / l0, h0 / l0];
+    let nrm = [-dir[1], dir[0]];
+    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+    let mut nodes = Vec::new();
+    for j in 0..3 {
+        for i in 0..=n {
+            let s = i as f64 / n as f64;
+            let o = (j as f64 - 1.0) * 0.5 * t;
+            nodes.push(format!(
+                "[{:.15}, {:.15}]",
+                s * a + o * nrm[0],
+                s * h0 + o * nrm[1]
+            ));
+        }
+    }
+    let (mut els, mut caps) = (Vec::new(), Vec::new());
+    for j in 0..2 {
+        for i in 0..n {
+            let els = if i == 0 || i == n - 1 {
+                &mut caps
+            } else {
+                &mut els
+            };
+            els.push(format!(
+                "[{}, {}, {}, {}]",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            ));
+        }
+    }
+    let apex = id(n, 1);
+    let text = format!(
+        r#"
+[analysis]
+geometry = "nonlinear"
+[[materials]]
+name = "steel"
+kind = "elastic"
+E = {e}
+nu = 0.0
+[[materials]]
+name = "rigid"
+kind = "elastic"
+E = {e_cap}
+nu = 0.0
+[[regions]]
+name = "bar"
+material = "steel"
+thickness = {b}
+[[regions]]
+name = "cap"
+material = "rigid"
+thickness = {b}
+[mesh]
+type = "explicit"
+nodes = [{}]
+blocks = [
+  {{ region = "bar", element = "Q4", elements = [{}] }},
+  {{ region = "cap", element = "Q4", elements = [{}] }},
+]
+[[supports]]
+name = "pin"
+node = {}
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "symmetry"
+node = {apex}
+ux = 0.0
+[[load_cases]]
+name = "P"
+point_loads = [{{ node = {apex}, force = [0.0, -1e3] }}]
+[[steps]]
+name = "snap"
+kind = "arc_length"
+loads = {{ P = 1.0 }}
+initial_increment = 1.0
+max_growth = 2.0
+increments = 400
+stop_displacement = {{ node = {apex}, component = "y", value = -0.2 }}
+"#,
+        nodes.join(", "),
+        els.join(", "),
+        caps.join(", "),
+        id(0, 1),
+        e_cap = 1e4 * e
+    );
+    let m = segfem::input::parse(&text, "truss.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    #[derive(Default)]
+    struct Path(Vec<(f64, f64)>, usize);
+    impl Observer for Path {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            self.0
+                .push((-s.system.u[2 * self.1 + 1], s.factors[0] * 1e3));
+            Ok(())
+        }
+    }
+    let mut p = Path(Vec::new(), apex - 1);
+    steps::run(&m, &mut p).unwrap_or_else(|e| panic!("{e}"));
+    let a0 = b * t;
+    // The end caps (one element each, 1e4 × stiffer) keep their length L₀/n.
+    let cap = l0 / n as f64;
+    let closed = |w: f64| {
+        let l = a.hypot(h0 - w);
+        let lam = (l - 2.0 * cap) / (l0 - 2.0 * cap);
+        let nf = e * a0 * lam * (lam * lam - 1.0) / 2.0;
+        -nf * (h0 - w) / l
+    };
+    let peak = (0..200)
+        .map(|k| closed(h0 * k as f64 / 200.0))
+        .fold(0.0, f64::max);
+    let (mut fell, mut negative) = (false, false);
+    let mut prev = 0.0;
+    for &(w, f) in &p.0 {
+        let want = closed(w);
+        assert!(
+            (f - want).abs() < 1e-3 * peak,
+            "w = {w:.5} m: P/2 = {f:.1} N vs closed form {want:.1} N (peak {peak:.1} N)"
+        );
+        fell |= f < prev && w > 0.0 && f > 0.0;
+        negative |= f < -0.5 * peak;
+        prev = f;
+    }
+    let w_end = p.0.last().unwrap().0;
+    assert!(fell, "no descending branch");
+    assert!(negative, "no negative-load branch");
+    assert!(w_end >= 0.2 - 1e-9, "stopped at w = {w_end}");
+}
