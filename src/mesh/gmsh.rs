@@ -1323,7 +1323,13 @@ $EndElements
     }
 
     proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+        // Fixed seed: the same cases on every run; failures persist in proptest-regressions/.
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            cases: 300,
+            rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e6f_e025),
+            ..proptest::prelude::ProptestConfig::default()
+        })]
         /// Random byte mutations of valid ASCII and binary files never panic.
         #[test]
         fn mutations_never_panic(

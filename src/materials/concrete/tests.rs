@@ -474,7 +474,13 @@ fn fd_params() -> ConcreteParams {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+    // Fixed seed: the same cases on every run; failures persist in proptest-regressions/.
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e6f_e025),
+        .. ProptestConfig::default()
+    })]
 
     /// Plastic compression-dominated regime: random path of 3 proportional-ish steps into
     /// compression. Tolerance 1e-5 E: FD noise from the Newton tolerance (1e-11 f_cm / h
