@@ -124,8 +124,9 @@ from = {t0}
 
 #[test]
 fn creep_under_constant_stress_follows_mc90() {
-    // σ = −4 MPa < 0.4 fcm (linear creep). ε(t)/(σ J(t, t0)) within 2 % from 1 to 1e4 days
-    // after loading for t0 = 7, 28, 365 d: the chain itself reproduces J within 0.6 % at
+    // σ = −4 MPa < 0.4 fcm (linear creep). ε(t)/(σ J(t, t0)) within 2 % at every substep
+    // from 0.1 to 1e4 days after loading (the first day included: measured 1.8 % at 0.1 d)
+    // for t0 = 7, 28, 365 d: the chain itself reproduces J within 0.6 % at
     // 10 steps/decade (docs/theory-time.md §2); the default 5 substeps/decade adds < 0.7 %
     // at 1e4 d; 2 % leaves room for both but fails for a missing creep term (φ ≈ 1.5–2.8)
     // or a wrong loading age (J(1e4, 7) vs J(1e4, 28) differ by 20 %).
@@ -140,6 +141,16 @@ fn creep_under_constant_stress_follows_mc90() {
             "{:?}",
             load.stress
         );
+        // The strain at loading: the chain is fitted to MC90 from 0.1 d on, so a load step
+        // gives the 0.1-day response σ J(t0 + 0.1 d, t0), 9–16 % above σ/E_ci(t0)
+        // (docs/theory-time.md, instantaneous response). 1 %: the chain's fit at 0.1 d
+        // (0.15 % at the material point) and the element's uniform stress (exact).
+        let at_loading = sigma * compliance(&p, t0 + 0.1, t0);
+        assert!(
+            (load.strain[0] / at_loading - 1.0).abs() < 0.01,
+            "t0 = {t0} d: strain at loading {} vs σ J(t0 + 0.1 d, t0) = {at_loading}",
+            load.strain[0]
+        );
         let mut checked = 0;
         let mut worst: f64 = 0.0;
         for r in &rec[1..] {
@@ -148,9 +159,6 @@ fn creep_under_constant_stress_follows_mc90() {
                 (r.stress[0] / sigma - 1.0).abs() < 1e-8,
                 "stress held constant"
             );
-            if d < 0.999 {
-                continue;
-            }
             let want = sigma * compliance(&p, r.time, t0);
             let ratio = r.strain[0] / want;
             assert!(
