@@ -18,6 +18,7 @@
 pub mod compression;
 pub mod cracking;
 pub mod ottosen;
+pub mod panel_bench;
 pub mod reduction;
 pub mod rotating;
 
