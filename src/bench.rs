@@ -689,4 +689,9 @@ pub fn material_point_rates(n: usize) -> Vec<(String, f64)> {
             }),
         ),
     ]
+    .into_iter()
+    .chain(crate::materials::concrete::panel_bench::shear_model_rates(
+        rate,
+    ))
+    .collect()
 }

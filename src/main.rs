@@ -155,7 +155,9 @@ enum Command {
         /// "seed-failure" (the seed beam on to failure by arc length, each --refine) or
         /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete), "rc" (the RC
         /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations) or
-        /// "material-point" (concrete material-point updates per second).
+        /// "material-point" (concrete material-point updates per second) or "panels" (the
+        /// membrane-panel series of validation/panels/panels.csv, or of --model, under each
+        /// concrete model option: test/predicted ratios, mean, COV).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -279,7 +281,9 @@ fn main() -> ExitCode {
             refine,
             model,
         } => match case.as_str() {
-            _ if model.is_some() => bench_bare(model.as_deref().expect("checked")),
+            _ if model.is_some() && case != "panels" => {
+                bench_bare(model.as_deref().expect("checked"))
+            }
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine, segfem::bench::seed_case),
             "long_term" => bench_seed(refine, segfem::bench::seed_long_term_case),
@@ -287,8 +291,9 @@ fn main() -> ExitCode {
             "rc" => bench_rc(refine),
             "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
+            "panels" => bench_panels(model.as_deref()),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc or material-point)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, material-point or panels)");
                 ExitCode::from(2)
             }
         },
@@ -689,6 +694,21 @@ fn bench_rc(refine: Vec<usize>) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
+    let path = file.unwrap_or(std::path::Path::new("validation/panels/panels.csv"));
+    match segfem::materials::concrete::panel_bench::series(path) {
+        Ok((report, secs)) => {
+            outln!("{report}");
+            outln!("total time of the series: {secs:.1} s");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 fn bench_material_point() -> ExitCode {

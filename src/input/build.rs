@@ -1620,6 +1620,14 @@ fn given_material_keys(m: &MaterialIn) -> Vec<&'static str> {
             "normalize_equivalent_stress",
         ),
         f(m.viscoplastic.is_some(), "viscoplastic"),
+        f(m.crack_model.is_some(), "crack_model"),
+        f(m.compression_reduction.is_some(), "compression_reduction"),
+        f(
+            m.compression_reduction_min.is_some(),
+            "compression_reduction_min",
+        ),
+        f(m.shear_retention.is_some(), "shear_retention"),
+        f(m.aggregate_size.is_some(), "aggregate_size"),
         f(m.fy.is_some(), "fy"),
         f(m.et.is_some(), "Et"),
         f(m.ep.is_some(), "Ep"),
@@ -2090,6 +2098,11 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
             "crack_integration",
             "normalize_equivalent_stress",
             "viscoplastic",
+            "crack_model",
+            "compression_reduction",
+            "compression_reduction_min",
+            "shear_retention",
+            "aggregate_size",
         ],
     )?;
     let fcm = positive(
@@ -2272,12 +2285,107 @@ fn concrete_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>)
     if let Some(v) = &m.viscoplastic {
         p.viscoplastic = Some(viscoplastic_option(ctx, i, v)?);
     }
+    shear_options(ctx, i, m, &mut p)?;
     p.validate()
         .map_err(|e| ctx.err(format!("materials[{i}]"), e.to_string()))?;
     Ok(Material::Concrete {
         params: Box::new(p),
         density,
     })
+}
+
+/// The concrete keys of shear behaviour: crack model, compression softening of cracked
+/// concrete, shear retention of fixed cracks (docs/input.md).
+fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) -> R<()> {
+    use crate::materials::concrete::{CompressionReduction, CrackModel, ShearRetentionLaw};
+    let k = |f: &str| format!("materials[{i}].{f}");
+    p.crack_model = match m.crack_model.as_deref() {
+        None | Some("fixed") => CrackModel::Fixed,
+        Some("rotating") => CrackModel::Rotating,
+        Some(o) => {
+            return Err(ctx.err(
+                k("crack_model"),
+                format!("unknown value '{o}' (expected fixed or rotating)"),
+            ))
+        }
+    };
+    p.compression_reduction = match m.compression_reduction.as_deref() {
+        None | Some("none") => {
+            if m.compression_reduction_min.is_some() {
+                return Err(ctx.err(
+                    k("compression_reduction_min"),
+                    "used by compression_reduction = \"vecchio_collins_1993\" only",
+                ));
+            }
+            CompressionReduction::None
+        }
+        Some("vecchio_collins_1993") => CompressionReduction::VecchioCollins1993 {
+            beta_min: fraction(
+                ctx,
+                &k("compression_reduction_min"),
+                m.compression_reduction_min.unwrap_or(0.4),
+                1e-3,
+                1.0,
+            )?,
+        },
+        Some(o) => {
+            return Err(ctx.err(
+                k("compression_reduction"),
+                format!("unknown value '{o}' (expected none or vecchio_collins_1993)"),
+            ))
+        }
+    };
+    let seed_keys = m.shear_k1.is_some() || m.shear_eps_ref.is_some();
+    p.shear_retention = match m.shear_retention.as_deref() {
+        None | Some("seed") => {
+            if m.aggregate_size.is_some() {
+                return Err(ctx.err(
+                    k("aggregate_size"),
+                    "used by shear_retention = \"aggregate\" only",
+                ));
+            }
+            ShearRetentionLaw::Seed
+        }
+        Some("aggregate") if seed_keys => {
+            return Err(ctx.err(
+                k("shear_retention"),
+                "shear_k1 and shear_eps_ref belong to shear_retention = \"seed\"",
+            ))
+        }
+        Some("aggregate") => ShearRetentionLaw::Aggregate {
+            d_agg: positive(ctx, &k("aggregate_size"), m.aggregate_size.unwrap_or(0.016))?,
+        },
+        Some(o) => {
+            return Err(ctx.err(
+                k("shear_retention"),
+                format!("unknown value '{o}' (expected seed or aggregate)"),
+            ))
+        }
+    };
+    if p.crack_model == CrackModel::Rotating {
+        if m.shear_retention.is_some() || seed_keys || m.shear_beta_min.is_some() {
+            return Err(ctx.err(
+                k("shear_retention"),
+                "rotating cracks carry no shear across cracks: shear retention keys belong to crack_model = \"fixed\"",
+            ));
+        }
+        for (f, given) in [
+            (
+                "crack_integration",
+                m.crack_integration.as_deref() == Some("implex"),
+            ),
+            ("viscoplastic", m.viscoplastic.is_some()),
+            ("initial_yield_ratio", m.initial_yield_ratio.is_some()),
+        ] {
+            if given {
+                return Err(ctx.err(
+                    k(f),
+                    "not available with crack_model = \"rotating\" (fixed cracks only)",
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `kind = "rebar"` or `"prestressing_steel"`: the uniaxial law of embedded bars.

@@ -84,6 +84,11 @@ pub struct MaterialIn {
     pub crack_integration: Option<String>,
     pub normalize_equivalent_stress: Option<bool>,
     pub viscoplastic: Option<ViscoplasticIn>,
+    pub crack_model: Option<String>,
+    pub compression_reduction: Option<String>,
+    pub compression_reduction_min: Option<f64>,
+    pub shear_retention: Option<String>,
+    pub aggregate_size: Option<f64>,
     // steel
     pub fy: Option<f64>,
     #[serde(rename = "Et")]

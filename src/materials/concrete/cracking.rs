@@ -67,6 +67,10 @@ struct DirResult {
     e_el: f64,
     /// IMPL-EX side of the kink at ẽ_max: 1 past it, −1 below it, 0 otherwise.
     side: i8,
+    /// ∂σ/∂ε_lat [Pa]: compression softening by the other direction's tensile strain.
+    d_lateral: f64,
+    /// Compression reduction factor β_d applied [-] (1 without compression softening).
+    beta: f64,
 }
 
 /// Committed history of one crack-axis direction.
@@ -85,6 +89,9 @@ struct DirHistory {
     /// IMPL-EX: the extrapolated largest crack strain [-] whose secant this direction
     /// follows in tension (None: implicit law).
     extrapolated: Option<f64>,
+    /// Compression reduction β_d [-] and dβ_d/dε_lat [-] from the other direction's tensile
+    /// strain ([`super::reduction`]).
+    reduction: (f64, f64),
 }
 
 /// Uniaxial law of one crack-axis direction at strain `e`.
@@ -96,6 +103,7 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         plastic,
         frozen,
         extrapolated,
+        reduction: (beta, dbeta),
     } = h;
     let e_el = e + plastic;
     let ebar = ebar.max(compression::initial_yield(p).0);
@@ -109,6 +117,8 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         loading_crack: false,
         e_el,
         side: 0,
+        d_lateral: 0.0,
+        beta,
     };
     if e_el >= 0.0 {
         if !cracked {
@@ -170,8 +180,9 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
     }
     // Compression: 1-D return on the MC90 curve (closed form, see module doc of
     // `compression`): σ_c(ε̄) = −E(e + p + Δp), Δp = κ(ε̄) − κ(ε̄_n) ⇒
-    // ε̄ = −e − p + κ(ε̄_n) + κ0.
-    let h_n = compression::hardening(p, ebar);
+    // ε̄ = −e − p + κ(ε̄_n) + κ0. With compression softening the curve is the one scaled by
+    // β_d (κ0 scales with it).
+    let (h_n, ds_n, _) = super::reduction::scaled_hardening(p, beta, ebar);
     let s_tr = p.ec * e_el;
     if -s_tr <= h_n.sigma_c {
         r.sigma = s_tr;
@@ -179,12 +190,16 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         return r;
     }
     let (_, k0) = compression::initial_yield(p);
-    let eb = (-e - plastic + h_n.kappa + k0).max(ebar);
-    let h = compression::hardening(p, eb);
+    let eb = (-e - plastic + h_n.kappa + beta * k0).max(ebar);
+    let (h, ds, _) = super::reduction::scaled_hardening(p, beta, eb);
     r.ebar = eb;
     r.plastic = plastic + (h.kappa - h_n.kappa).max(0.0);
     r.sigma = -h.sigma_c;
     r.k = h.dsigma_c;
+    if dbeta != 0.0 && eb > ebar {
+        // σ = −σ_β(ε̄), ε̄ = −e − p + κ_β(ε̄_n) + β κ0: ∂ε̄/∂β = −(∂σ_β/∂β)(ε̄_n)/E.
+        r.d_lateral = -(ds - h.dsigma_c * ds_n / p.ec) * dbeta;
+    }
     r
 }
 
@@ -214,6 +229,12 @@ pub fn update_cracked(
         let (m, o) = (committed.crack_max[i], committed.crack_max_old[i]);
         m + ratio.max(0.0) * (m - o).max(0.0)
     };
+    // Compression softening of each direction by the other one's tensile strain.
+    let lateral = |j: usize| (el[j] + committed.dir_plastic[j]).max(0.0);
+    let red = [
+        super::reduction::factor(p, lateral(1)),
+        super::reduction::factor(p, lateral(0)),
+    ];
     let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
         let cracked = (i as u8) < n_cracks;
         let h = DirHistory {
@@ -223,6 +244,7 @@ pub fn update_cracked(
             plastic: committed.dir_plastic[i],
             frozen: committed.frozen[i],
             extrapolated: (p.implex && cracked).then(|| extrapolate(i)),
+            reduction: red[i],
         };
         direction(p, alpha, h, el[i])
     };
@@ -253,7 +275,7 @@ pub fn update_cracked(
     if formed_second {
         st.crack_max_old[1] = st.crack_max[1];
     }
-    if r0.ebar >= p.eps_cu || r1.ebar >= p.eps_cu {
+    if r0.ebar >= r0.beta * p.eps_cu || r1.ebar >= r1.beta * p.eps_cu {
         st.crushed = true;
         st.stress = [0.0; 3];
         let d = super::d_matrix(p.ec, p.nu).map(|r| r.map(|v| v * p.residual_stiffness));
@@ -280,6 +302,8 @@ pub fn update_cracked(
         sl[1] = r1.sigma;
         dl[0][0] = r0.k;
         dl[1][1] = r1.k;
+        dl[0][1] = r0.d_lateral;
+        dl[1][0] = r1.d_lateral;
         // Shear retention at the largest crack strain reached by the existing cracks.
         let reached = if p.implex {
             [
@@ -298,7 +322,7 @@ pub fn update_cracked(
         } else {
             (0, reached[0])
         };
-        let (beta, dbeta) = p.shear.beta(emax);
+        let (beta, dbeta) = p.shear_beta(emax, char_length);
         sl[2] = beta * g * el[2];
         dl[2][2] = beta * g;
         let loading = if imax == 0 {

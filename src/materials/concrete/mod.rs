@@ -18,6 +18,9 @@
 pub mod compression;
 pub mod cracking;
 pub mod ottosen;
+pub mod panel_bench;
+pub mod reduction;
+pub mod rotating;
 
 pub use crate::materials::error::MaterialError;
 use crate::materials::mc90::{self, CompressionCurve, OttosenParams, TensileRef};
@@ -101,6 +104,50 @@ impl ShearRetention {
     }
 }
 
+/// Smeared crack model of a concrete point.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum CrackModel {
+    /// The seed's model: Ottosen/MC90 compression plasticity while uncracked, fixed
+    /// orthogonal cracks with shear retention once cracked ([`cracking`]).
+    #[default]
+    Fixed,
+    /// Rotating (total-strain, coaxial) cracks: uniaxial laws along the principal axes of the
+    /// total strain, secant unloading, no shear retention needed ([`rotating`]).
+    Rotating,
+}
+
+/// Reduction of the compressive strength (and peak strain) of cracked concrete under a
+/// lateral tensile strain ("compression softening").
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum CompressionReduction {
+    /// No reduction (the seed).
+    #[default]
+    None,
+    /// Vecchio & Collins (1993), e1/e0 form: β_d = 1/(1 + 0.27 (ε_lat/ε_c1 − 0.37)) ≤ 1,
+    /// applied to strength and peak strain (σ = β_d σ_c(ε/β_d)), floored at `beta_min`
+    /// ([`reduction`]).
+    VecchioCollins1993 {
+        /// Lower bound of β_d [-] (default 0.4).
+        beta_min: f64,
+    },
+}
+
+/// Shear retention law of fixed cracks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum ShearRetentionLaw {
+    /// The seed's law (eqs. 22–23), parameters in [`ConcreteParams::shear`].
+    #[default]
+    Seed,
+    /// Aggregate interlock tied to the crack width (after Walraven; DIANA's
+    /// "aggregate-size based" retention): β = 1 − 2w/d_agg, w = h ε_max (crack band width
+    /// h = the element's characteristic length), floored at `shear.beta_min`: the shear
+    /// transfer vanishes when the crack has opened to half the aggregate size.
+    Aggregate {
+        /// Largest aggregate size d_agg [m].
+        d_agg: f64,
+    },
+}
+
 /// Concrete parameters. Build with [`ConcreteParams::from_mc90`] and adjust fields.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ConcreteParams {
@@ -169,6 +216,15 @@ pub struct ConcreteParams {
     /// from the characteristic length; None for [`CompressionSoftening::Mc90`]).
     #[serde(skip)]
     pub(crate) crush_eu: Option<f64>,
+    /// Crack model (default fixed, the seed's).
+    #[serde(default)]
+    pub crack_model: CrackModel,
+    /// Compression softening of cracked concrete (default none, the seed's).
+    #[serde(default)]
+    pub compression_reduction: CompressionReduction,
+    /// Shear retention law of fixed cracks (default the seed's β law).
+    #[serde(default)]
+    pub shear_retention: ShearRetentionLaw,
 }
 
 impl ConcreteParams {
@@ -206,6 +262,9 @@ impl ConcreteParams {
             viscoplastic: None,
             compression_softening: CompressionSoftening::Mc90,
             crush_eu: None,
+            crack_model: CrackModel::Fixed,
+            compression_reduction: CompressionReduction::None,
+            shear_retention: ShearRetentionLaw::Seed,
         }
     }
 
@@ -241,9 +300,32 @@ impl ConcreteParams {
                 CompressionSoftening::CrushBand { gc } if !(gc > 0.0 && gc.is_finite()) => {
                     bad("G_c must be > 0")
                 }
-                _ => Ok(()),
+                _ => self.validate_shear_laws(),
             },
         }
+    }
+
+    /// Check the options of compression softening, shear retention and crack model.
+    fn validate_shear_laws(&self) -> Result<(), MaterialError> {
+        let bad = |m: &str| Err(MaterialError::InvalidParams(m.to_string()));
+        if let CompressionReduction::VecchioCollins1993 { beta_min } = self.compression_reduction {
+            if !(beta_min > 0.0 && beta_min <= 1.0) {
+                return bad("the compression reduction floor must lie in (0, 1]");
+            }
+        }
+        if let ShearRetentionLaw::Aggregate { d_agg } = self.shear_retention {
+            if !(d_agg > 0.0 && d_agg.is_finite()) {
+                return bad("the aggregate size must be > 0");
+            }
+        }
+        if self.crack_model == CrackModel::Rotating
+            && (self.implex || self.viscoplastic.is_some() || self.initial_yield_ratio > 0.0)
+        {
+            return bad(
+                "the rotating crack model has no IMPL-EX, viscoplastic or initial-yield option",
+            );
+        }
+        Ok(())
     }
 
     /// MC90 uniaxial compression curve with this E, f_cm and ε_c1.
@@ -269,6 +351,27 @@ impl ConcreteParams {
     /// bifurcation: the points then take different stresses and crack early).
     pub fn compression_dominated(&self, s: &[f64; 3]) -> bool {
         principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < -1e-9 * self.ftm
+    }
+
+    /// Shear retention β [-] and dβ/dε [-] of a fixed crack whose largest normal strain is
+    /// `eps` [-], in an element of characteristic length `char_length` [m] (the crack band
+    /// width of the aggregate-interlock law).
+    pub fn shear_beta(&self, eps: f64, char_length: f64) -> (f64, f64) {
+        match self.shear_retention {
+            ShearRetentionLaw::Seed => self.shear.beta(eps),
+            ShearRetentionLaw::Aggregate { d_agg } => {
+                if eps <= 0.0 {
+                    return (1.0, 0.0);
+                }
+                let slope = 2.0 * char_length / d_agg;
+                let b = 1.0 - slope * eps;
+                if b <= self.shear.beta_min {
+                    (self.shear.beta_min, 0.0)
+                } else {
+                    (b, -slope)
+                }
+            }
+        }
     }
 
     /// Cracking strain ε0 = f_tm/E [-].
@@ -535,6 +638,9 @@ pub fn update_full(
     };
     if committed.crushed {
         return Ok(crushed(p, committed, strain));
+    }
+    if p.crack_model == CrackModel::Rotating {
+        return rotating::update(p, committed, strain, char_length);
     }
     if committed.n_cracks > 0 {
         return cracking::update_cracked(p, committed, strain, char_length, ratio);

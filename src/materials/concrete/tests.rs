@@ -799,3 +799,6 @@ fn crush_band_dissipates_gc_per_unit_band_area() {
     let s = p.softening_limit;
     assert!((2.0 * p.fcm / d - s * p.ec / (1.0 - s)).abs() < 1e-6 * p.ec);
 }
+
+/// Compression softening, rotating cracks and aggregate-interlock shear retention.
+mod shear;

@@ -1,0 +1,287 @@
+//! Tests of the shear-related laws: compression softening of cracked concrete (fixed and
+//! rotating cracks), the rotating-crack model, the aggregate-interlock shear retention.
+
+use super::*;
+use crate::materials::concrete::rotating::principal_strains;
+
+fn vc93(p: &mut ConcreteParams) {
+    p.compression_reduction = CompressionReduction::VecchioCollins1993 { beta_min: 0.4 };
+}
+
+fn rotating() -> ConcreteParams {
+    let mut p = params();
+    p.crack_model = CrackModel::Rotating;
+    p
+}
+
+/// Vecchio & Collins (1993) β_d = 1/(1 + 0.27 (ε1/ε0 − 0.37)) at hand-computed points
+/// (ε0 = ε_c1 = 0.0022): 1 below 0.37 ε0; at ε1 = 2.2e-3, 1/(1 + 0.1701) = 0.854628…; at
+/// 1.1e-2, 1/(1 + 1.2501) = 0.444425…; the floor 0.4 beyond ε1 = 1.3e-2; derivative
+/// against central differences. Round-off tolerance (closed form).
+#[test]
+fn vecchio_collins_factor_closed_form() {
+    let mut p = params();
+    assert_eq!(reduction::factor(&p, 5e-3), (1.0, 0.0), "off by default");
+    vc93(&mut p);
+    assert_eq!(reduction::factor(&p, 0.37 * 0.0022 * 0.999).0, 1.0);
+    for (e, want) in [(2.2e-3, 1.0 / 1.1701), (1.1e-2, 1.0 / 2.2501), (2e-2, 0.4)] {
+        let (b, db) = reduction::factor(&p, e);
+        assert!((b - want).abs() < 1e-12, "β({e}) = {b}, want {want}");
+        let h = 1e-9;
+        let fd = (reduction::factor(&p, e + h).0 - reduction::factor(&p, e - h).0) / (2.0 * h);
+        assert!((fd - db).abs() < 1e-6 * db.abs().max(1.0), "{fd} vs {db}");
+    }
+}
+
+/// Closed form of the softened uniaxial law: σ = −β σ_c(−ε/β) with β = β_d(ε_lat).
+fn softened(p: &ConcreteParams, e: f64, lat: f64) -> f64 {
+    let (b, _) = reduction::factor(p, lat);
+    -b * compression::hardening_curve(p, -e / b).0
+}
+
+/// Fixed crack opened in x (ε_x = 3e-3 held), then the direction along the crack
+/// compressed: σ_y follows the softened curve −β σ_c(−ε_y/β) (closed form of the 1-D law
+/// with zero initial yield, round-off tolerance 1e-9 f_cm), its peak is β f_cm at β ε_c1
+/// (β = 1/(1 + 0.27 (3/2.2 − 0.37)) = 0.78803…), and without the option the peak is f_cm.
+#[test]
+fn fixed_crack_compression_softening_follows_the_scaled_curve() {
+    for on in [true, false] {
+        let mut p = params();
+        if on {
+            vc93(&mut p);
+        }
+        let ex = 3e-3;
+        let mut st = upd(&p, &ConcreteState::new(), [ex, 0.0, 0.0]).0;
+        assert_eq!(st.n_cracks(), 1);
+        let mut peak: f64 = 0.0;
+        for k in 1..=200 {
+            let ey = -4e-3 * k as f64 / 200.0;
+            let out = upd(&p, &st, [ex, ey, 0.0]);
+            if out.0.is_crushed() {
+                break;
+            }
+            let want = softened(&p, ey, ex);
+            assert!(
+                (out.1[1] - want).abs() < 1e-9 * FCM,
+                "ε_y = {ey}: σ_y = {}, closed form {want}",
+                out.1[1]
+            );
+            peak = peak.min(out.1[1]);
+            st = out.0;
+        }
+        let b = if on {
+            1.0 / (1.0 + 0.27 * (3.0 / 2.2 - 0.37))
+        } else {
+            1.0
+        };
+        // Peak sampled every 2e-5 in strain near a smooth maximum: 1e-4 relative.
+        assert!(
+            ((-peak) - b * FCM).abs() < 1e-4 * FCM,
+            "peak {peak}, want {}",
+            b * FCM
+        );
+    }
+}
+
+/// Rotating model, uniaxial tension along x with ε_y = 0: elastic with the Poisson
+/// coupling (σx = E εx/(1 − ν²)) until E ε̃ = f_tm, then the tension envelope of the fixed
+/// model (ν = 0 once cracked, σ_y = 0), secant unloading to the origin. Closed forms,
+/// round-off tolerance.
+#[test]
+fn rotating_uniaxial_tension_envelope_and_secant() {
+    let p = rotating();
+    let alpha = p.softening_alpha(0.1);
+    let mut st = ConcreteState::new();
+    let e0 = p.eps0();
+    for k in 1..=60 {
+        let ex = 2e-3 * k as f64 / 60.0;
+        let out = upd(&p, &st, [ex, 0.0, 0.0]);
+        let want = if ex * p.ec / (1.0 - p.nu * p.nu) < p.ftm {
+            p.ec * ex / (1.0 - p.nu * p.nu)
+        } else {
+            tension_envelope(&p, alpha, ex).0
+        };
+        assert!(
+            (out.1[0] - want).abs() < 1e-9 * p.ftm,
+            "εx {ex}: {:?}",
+            out.1
+        );
+        if ex > 2.0 * e0 {
+            assert_eq!(out.0.n_cracks(), 1);
+            assert!(out.1[1].abs() < 1e-9 * p.ftm && out.1[2].abs() < 1e-9 * p.ftm);
+        }
+        st = out.0;
+    }
+    let smax = tension_envelope(&p, alpha, 2e-3).0;
+    let out = upd(&p, &st, [1e-3, 0.0, 0.0]);
+    assert!((out.1[0] - 0.5 * smax).abs() < 1e-9 * p.ftm, "secant");
+}
+
+/// Rotating model, uniaxial compression (ε_y = −ν ε_x before cracking gives σ_y = 0) and
+/// equal biaxial compression (ε̃ = ε/(1 − ν)): each principal stress is the uniaxial curve
+/// of its equivalent strain (closed form, 1e-9 f_cm); secant unloading from the peak.
+#[test]
+fn rotating_uniaxial_and_biaxial_compression() {
+    let p = rotating();
+    let nu = p.nu;
+    let (mut su, mut sb) = (ConcreteState::new(), ConcreteState::new());
+    for k in 1..=50 {
+        let e = -3e-3 * k as f64 / 50.0;
+        let u = upd(&p, &su, [e, -nu * e, 0.0]);
+        let want = -compression::hardening_curve(&p, -e).0;
+        assert!(
+            (u.1[0] - want).abs() < 1e-9 * FCM,
+            "uniaxial {e}: {:?}",
+            u.1
+        );
+        assert!(u.1[1].abs() < 1e-9 * FCM);
+        su = u.0;
+        // ε̃ = ε/(1 − ν) stays below ε_cu = 3.5e-3 (crushing).
+        let e = 0.8 * e;
+        let b = upd(&p, &sb, [e, e, 0.0]);
+        let want = -compression::hardening_curve(&p, -e / (1.0 - nu)).0;
+        for s in &b.1[..2] {
+            assert!((s - want).abs() < 1e-9 * FCM, "biaxial {e}: {:?}", b.1);
+        }
+        assert!(b.1[2].abs() < 1e-9 * FCM);
+        sb = b.0;
+    }
+    // Unloading to half the strain: the secant σ_max/ε_max · ε.
+    let smax = compression::hardening_curve(&p, 3e-3).0;
+    let u = upd(&p, &su, [-1.5e-3, nu * 1.5e-3, 0.0]);
+    assert!((u.1[0] + 0.5 * smax).abs() < 1e-9 * FCM, "{:?}", u.1);
+}
+
+/// Rotating model under a strain path whose principal axes turn by ~60° (stretch in x,
+/// then growing shear while εx falls back): the stress stays coaxial with the strain, (σx − σy) γ = 2τ (εx − εy)
+/// (1e-9 relative), and its principal values are the uniaxial laws of the principal
+/// strains — the tension envelope of ε1 and, with compression softening, −β(ε1) σ_c(−ε2/β)
+/// (both loading monotonically on this path; 1e-9 f_cm).
+#[test]
+fn rotating_principal_axes_turn_and_stress_stays_coaxial() {
+    let mut p = rotating();
+    vc93(&mut p);
+    let alpha = p.softening_alpha(0.1);
+    let mut st = ConcreteState::new();
+    let mut angles = Vec::new();
+    for k in 1..=100 {
+        let t = k as f64 / 100.0;
+        // Scaled so that the compressive principal strain stays below crushing.
+        let e = [2e-3 * t - 4e-3 * t * t, -0.5e-3 * t, 6e-3 * t * t].map(|v| 0.6 * v);
+        let (s, st2) = {
+            let o = upd(&p, &st, e);
+            (o.1, o.0)
+        };
+        let (e1, e2, th) = principal_strains(&e);
+        angles.push(th);
+        let lhs = (s[0] - s[1]) * e[2];
+        let rhs = 2.0 * s[2] * (e[0] - e[1]);
+        assert!(
+            (lhs - rhs).abs() <= 1e-9 * (lhs.abs() + rhs.abs() + 1e-300),
+            "t {t}: not coaxial"
+        );
+        let (s1, s2, _) = {
+            let c = 0.5 * (s[0] + s[1]);
+            let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+            (c + r, c - r, 0.0)
+        };
+        if st2.n_cracks() > 0 && e1 > 2.0 * p.eps0() {
+            let w1 = tension_envelope(&p, alpha, e1).0;
+            let w2 = softened(&p, e2, e1);
+            assert!((s1 - w1).abs() < 1e-9 * FCM, "t {t}: σ1 {s1} vs {w1}");
+            assert!((s2 - w2).abs() < 1e-9 * FCM, "t {t}: σ2 {s2} vs {w2}");
+        }
+        st = st2;
+    }
+    let turn = angles.last().unwrap() - angles[0];
+    assert!(turn > 0.85, "the principal axes turned by {turn} rad only");
+}
+
+fn rot_fd_params() -> ConcreteParams {
+    let mut p = rotating();
+    vc93(&mut p);
+    p.residual_stiffness = 0.0;
+    p
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+
+    /// Rotating model: tangent (with the coaxiality shear term and the compression-
+    /// softening cross terms) against central differences, from a cracked or compressed
+    /// committed state to random strains (loading, unloading, closing). Tolerance 1e-5 E:
+    /// closed-form laws, FD truncation ≈ h²/ε² ≈ 1e-8 relative; a missing shear term or
+    /// cross term is off by O(0.01–1) E.
+    #[test]
+    fn rotating_tangent_fd(
+        phi in -1.5..1.5f64,
+        e1 in -2e-3..2e-3f64,
+        e2 in -3e-3..1e-3f64,
+        f in 0.2..1.3f64,
+        g in -2e-3..2e-3f64,
+    ) {
+        let p = rot_fd_params();
+        let (s, c) = phi.sin_cos();
+        let glob = |a: f64, b: f64| [c * c * a + s * s * b, s * s * a + c * c * b, 2.0 * s * c * (a - b)];
+        let base = upd(&p, &ConcreteState::new(), glob(e1, e2)).0;
+        prop_assume!(!base.is_crushed());
+        let e = glob(e1 * f, e2 * f);
+        let e = [e[0], e[1], e[2] + g];
+        let (a, b, _) = principal_strains(&e);
+        prop_assume!(a - b > 1e-5);
+        if let Some(err) = fd_error(&p, &base, e) {
+            prop_assert!(err < 1e-5 * p.ec, "err {err} at {e:?}");
+        }
+    }
+
+    /// Fixed cracks with compression softening: the cross term ∂σ_t/∂ε_n of the compressed
+    /// direction along an open crack, against central differences (same setting and
+    /// tolerance as `tangent_fd_cracked`).
+    #[test]
+    fn fixed_compression_softening_tangent_fd(
+        phi in -1.5..1.5f64,
+        e1 in 1e-3..6e-3f64,
+        dn in 0.5..1.5f64,
+        dt in -3e-3..-1e-4f64,
+        dg in -1e-3..1e-3f64,
+    ) {
+        let mut p = fd_params();
+        vc93(&mut p);
+        let (s, co) = phi.sin_cos();
+        let to_global = |n: f64, tt: f64, g: f64| -> [f64; 3] {
+            [co * co * n + s * s * tt - s * co * g,
+             s * s * n + co * co * tt + s * co * g,
+             2.0 * s * co * (n - tt) + (co * co - s * s) * g]
+        };
+        let c = upd(&p, &ConcreteState::new(), to_global(e1, 0.0, 0.0)).0;
+        prop_assume!(c.n_cracks() == 1);
+        let e = to_global(e1 * dn, dt, dg);
+        if let Some(err) = fd_error(&p, &c, e) {
+            prop_assert!(err < 1e-5 * p.ec, "err {err} at n={} t={dt} g={dg}", e1 * dn);
+        }
+    }
+}
+
+/// Aggregate-interlock shear retention β = 1 − 2 h ε/d_agg (floored at β_min) through a
+/// cracked point: τ = β G γ in crack axes at hand values (h = 0.1 m, d_agg = 16 mm,
+/// ε = 2e-3 → β = 0.975), round-off tolerance; the floor reached at ε ≥ 0.08.
+#[test]
+fn aggregate_interlock_shear_retention() {
+    let mut p = params();
+    p.shear_retention = ShearRetentionLaw::Aggregate { d_agg: 0.016 };
+    assert_eq!(
+        p.shear_beta(2e-3, 0.1),
+        (1.0 - 2.0 * 0.1 * 2e-3 / 0.016, -2.0 * 0.1 / 0.016)
+    );
+    assert_eq!(p.shear_beta(0.09, 0.1).0, p.shear.beta_min);
+    let st = upd(&p, &ConcreteState::new(), [2e-3, 0.0, 0.0]).0;
+    assert_eq!(st.n_cracks(), 1);
+    let out = upd(&p, &st, [2e-3, 0.0, 1e-4]);
+    let g = 0.5 * p.ec / (1.0 + p.nu);
+    let want = 0.975 * g * 1e-4;
+    assert!(
+        (out.1[2] - want).abs() < 1e-9 * want,
+        "{} vs {want}",
+        out.1[2]
+    );
+}
