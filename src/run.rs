@@ -4,6 +4,7 @@ use crate::analysis::failure::FailureReport;
 use crate::analysis::steps::{
     self, AnalysisError, Observer, Snapshot, StepEnd, StopReason, Timings,
 };
+use crate::analysis::system::System;
 use crate::input::{self, InputError};
 use crate::model::Model;
 use crate::results::atomic::write_atomic;
@@ -159,6 +160,8 @@ struct Progress<'a, 'm> {
     stop_after_step: Option<usize>,
     stop_now: bool,
     signal: Option<Arc<AtomicUsize>>,
+    /// Timings when a step stopped early (the analysis returns none with its error).
+    timings: Option<Timings>,
 }
 
 impl Observer for Progress<'_, '_> {
@@ -186,6 +189,12 @@ impl Observer for Progress<'_, '_> {
 
     fn step_failed(&mut self, report: &FailureReport) {
         self.failures.push(report.clone());
+    }
+
+    fn step_stopped(&mut self, system: &System, timings: &Timings) -> std::io::Result<()> {
+        self.timings = Some(timings.clone());
+        // A failed or stopped run still shows its last converged state.
+        self.rec.write_last_fields(system)
     }
 
     fn stop_requested(&self) -> Option<StopReason> {
@@ -309,6 +318,7 @@ pub fn run_file_opts(
         stop_after_step: opts.stop_after_step,
         stop_now: false,
         signal: opts.signal.clone(),
+        timings: None,
     };
     let result = steps::run_with(
         &model,
@@ -318,12 +328,12 @@ pub fn run_file_opts(
             resume,
         },
     );
-    let rec = obs.rec;
+    let mut rec = obs.rec;
     let watch = obs.watch;
     let mut failures = obs.failures;
     let (timings, error) = match result {
         Ok(t) => (t, None),
-        Err(e) => (Timings::default(), Some(e)),
+        Err(e) => (obs.timings.unwrap_or_default(), Some(e)),
     };
     if let Some(AnalysisError::NotConverged(r)) = &error {
         failures.push((**r).clone());

@@ -80,6 +80,15 @@ fn unique_names<'a>(ctx: &Ctx, list: &str, names: impl Iterator<Item = &'a str>)
         if n.trim().is_empty() {
             return Err(ctx.err(format!("{list}[{i}].name"), "must not be empty"));
         }
+        // Names head the columns of history.csv and are typed on the command line.
+        if let Some(c) = n.chars().find(|c| *c == ',' || *c == '"' || c.is_control()) {
+            return Err(ctx.err(
+                format!("{list}[{i}].name"),
+                format!(
+                    "{c:?} is not allowed in a name (names head the columns of history.csv: no commas, quotes or control characters)"
+                ),
+            ));
+        }
         if let Some(j) = seen.insert(n, i) {
             return Err(ctx.err(
                 format!("{list}[{i}].name"),
