@@ -447,11 +447,16 @@ fn run(
         }
         Err(e) => {
             eprintln!("error: {e}");
-            if matches!(e, segfem::run::RunError::NotConverged(_)) {
-                eprintln!(
+            match &e {
+                segfem::run::RunError::NotConverged(_) => eprintln!(
                     "results up to the last converged increment are in {}",
                     out.display()
-                );
+                ),
+                segfem::run::RunError::Implausible(_) => eprintln!(
+                    "all results are in {} (check them before any use)",
+                    out.display()
+                ),
+                _ => {}
             }
             ExitCode::from(e.exit_code().clamp(0, 255) as u8)
         }

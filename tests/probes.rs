@@ -241,3 +241,150 @@ fn damaged_checkpoint_is_refused() {
     let o = segfem(tmp.path(), &["run", "--restart", "out"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
 }
+
+fn example(name: &str) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/{name}.toml")),
+    )
+    .unwrap()
+}
+
+/// Replace `from` (present exactly once) by `to`.
+fn edit(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "{from}");
+    text.replacen(from, to, 1)
+}
+
+/// Frictionless dry joints without prestress cannot carry bending: the segments stand only
+/// on the open joints' residual stiffness. The run converges (3.4 m of deflection on the
+/// 6 m span), and must not end "completed": exit 5, status "implausible", both findings.
+#[test]
+fn model_held_by_residual_stiffness_is_implausible() {
+    let tmp = TempDir::new("probe-dry");
+    let text = example("segmental-decompression");
+    let text = edit(&text, "friction = 0.7", "friction = 0.0");
+    let text = edit(&text, "loads = { P = 1.0 }\n", "loads = { P = 0.0 }\n");
+    let text = edit(
+        &text,
+        "loads = { P = 1.0, Q = 150.0 }",
+        "loads = { Q = 150.0 }",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 5, "{err}");
+    assert!(err.contains("not physically meaningful"), "{err}");
+    assert!(
+        err.contains("through the residual stiffness of its open points"),
+        "{err}"
+    );
+    let s = summary(&tmp.join("out"));
+    assert_eq!(s["status"], "implausible");
+    let found = s["plausibility"].as_array().unwrap();
+    assert!(found[0].as_str().unwrap().contains("joint J"), "{found:?}");
+    // The deflection that gave it away: over a tenth of the model size (6.02 m diagonal).
+    assert!(
+        found
+            .iter()
+            .any(|f| f.as_str().unwrap().contains("of the model size")),
+        "{found:?}"
+    );
+    // The same model with its prestress and friction is a plausible result.
+    std::fs::write(tmp.join("ok.toml"), example("segmental-decompression")).unwrap();
+    let o = segfem(tmp.path(), &["run", "ok.toml", "-o", "ok", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert_eq!(
+        summary(&tmp.join("ok"))["plausibility"],
+        serde_json::json!([])
+    );
+}
+
+/// A time step to 1e300 days is a typing slip: refused, naming the field.
+#[test]
+fn absurd_time_is_an_input_error() {
+    let tmp = TempDir::new("probe-time");
+    let text = edit(&example("creep-beam"), "to = 10000.0", "to = 1e300");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["check", "m.toml"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.contains("steps[1].to: 1e300 d is beyond 1e6 d"),
+        "{err}"
+    );
+}
+
+/// An arc-length step that uses its increments before its stop_displacement says so.
+/// Elastic cantilever: 3 increments of Δλ = 0.1 cannot move the tip 1 m.
+#[test]
+fn arc_length_out_of_increments_says_so() {
+    let tmp = TempDir::new("probe-arc");
+    let text = edit(
+        &example("cantilever"),
+        "kind = \"linear\"\nloads = { tip = 1.0 }",
+        "kind = \"arc_length\"\nloads = { tip = 1.0 }\ninitial_increment = 0.1\nmax_growth = 1.0\nincrements = 3\nstop_displacement = { point = [4.0, 0.0], component = \"y\", value = -1.0 }",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 0, "{err}");
+    assert!(
+        err.contains("warning: step 'load' used all its 3 increments before its stop_displacement"),
+        "{err}"
+    );
+    let s = summary(&tmp.join("out"));
+    let ended = s["ultimate"]["ended"].as_str().unwrap();
+    assert!(ended.contains("used up their increments"), "{ended}");
+}
+
+/// Newton stalling while the load still rises is "no convergence", not a limit point:
+/// the plain beam driven down in 0.1 mm increments, 4 iterations and no cuts allowed, stops
+/// when cracking starts; the load measure peaks at the last converged increment.
+#[test]
+fn stall_while_load_rises_is_no_convergence() {
+    let tmp = TempDir::new("probe-stall");
+    let text = edit(
+        &plain_beam(100, "max_iterations = 4\n"),
+        "kind = \"load\"\nloads = { P = 1.0 }",
+        "kind = \"displacement\"\ncontrol = { point = [2.0, 0.4], component = \"y\", value = -0.01 }",
+    );
+    let text = edit(&text, "max_cuts = 2", "max_cuts = 0");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 3, "{err}");
+    assert!(
+        err.contains("ultimate: no convergence at control force"),
+        "{err}"
+    );
+    assert!(!err.contains("loss of equilibrium"), "{err}");
+    let u = &summary(&tmp.join("out"))["ultimate"];
+    assert_eq!(u["mode"], "no convergence");
+    let rows = history_rows(&read(&tmp.join("out/history.csv")));
+    assert_eq!(
+        u["peak_increment"].as_u64(),
+        Some(rows.last().unwrap().1 as u64)
+    );
+}
+
+/// A peak that is the first crack of the model is named as such: a one-row plain beam
+/// under displacement control loses its load when its midspan element cracks.
+#[test]
+fn cracking_peak_is_named() {
+    let tmp = TempDir::new("probe-crack");
+    let text = edit(
+        &plain_beam(40, ""),
+        "kind = \"load\"\nloads = { P = 1.0 }",
+        "kind = \"displacement\"\ncontrol = { point = [2.0, 0.4], component = \"y\", value = -0.002 }",
+    );
+    let text = edit(&text, "rows = 4", "rows = 1");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let u = &summary(&tmp.join("out"))["ultimate"];
+    assert_eq!(u["mode"], "first cracking", "{u}");
+    assert!(
+        u["detail"].as_str().unwrap().contains("cracking load"),
+        "{u}"
+    );
+}
