@@ -55,7 +55,7 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "seed-beam",
-        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (VALIDATION.md §1)",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (docs/validation.md)",
         include_str!("../examples/seed-beam.toml"),
     ),
     (
@@ -83,7 +83,20 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         "RC beam in four-point bending to failure (concrete, embedded bars, displacement control)",
         include_str!("../examples/rc-beam.toml"),
     ),
+    (
+        "gmsh-tapered",
+        "two segments meshed with Gmsh (prismatic and tapered), dry joint; -o also writes gmsh-tapered.msh",
+        include_str!("../examples/gmsh-tapered.toml"),
+    ),
 ];
+
+/// Files an example reads, written beside it by `segfem example NAME -o FILE`:
+/// (example, file name, contents).
+const COMPANIONS: &[(&str, &str, &str)] = &[(
+    "gmsh-tapered",
+    "gmsh-tapered.msh",
+    include_str!("../examples/gmsh-tapered.msh"),
+)];
 
 #[derive(Parser)]
 #[command(
@@ -242,6 +255,10 @@ fn main() -> ExitCode {
             stop_after_step,
             threads,
         } => {
+            if stop_after_step == Some(0) {
+                eprintln!("error: --stop-after-step: steps are numbered from 1");
+                return ExitCode::from(2);
+            }
             if let Some(n) = threads {
                 if n == 0 {
                     eprintln!("error: --threads: at least 1 thread");
@@ -538,16 +555,25 @@ fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
         );
         return ExitCode::from(2);
     };
+    let companions = COMPANIONS.iter().filter(|(n, _, _)| *n == name);
     match output {
-        Some(p) => match std::fs::write(&p, text) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {}: {e}", p.display());
-                ExitCode::from(1)
+        Some(p) => {
+            let dir = p.parent().unwrap_or(std::path::Path::new(""));
+            let files = std::iter::once((p.clone(), *text))
+                .chain(companions.map(|(_, f, t)| (dir.join(f), *t)));
+            for (path, text) in files {
+                if let Err(e) = std::fs::write(&path, text) {
+                    eprintln!("error: {}: {e}", path.display());
+                    return ExitCode::from(1);
+                }
             }
-        },
+            ExitCode::SUCCESS
+        }
         None => {
             out!("{text}");
+            for (_, f, _) in companions {
+                eprintln!("note: this example reads {f}; `segfem example {name} -o FILE` writes it beside FILE");
+            }
             ExitCode::SUCCESS
         }
     }

@@ -388,3 +388,46 @@ fn cracking_peak_is_named() {
         "{u}"
     );
 }
+
+/// Every bundled example file is offered by `segfem example`, and one that reads a mesh
+/// file gets it written beside it, so that it checks as written.
+#[test]
+fn every_shipped_example_is_offered_and_checks() {
+    let tmp = TempDir::new("probe-examples");
+    let o = segfem(tmp.path(), &["example"]);
+    assert_eq!(code(&o), 0);
+    let list = common::stdout(&o);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            let name = p.file_stem().unwrap().to_string_lossy().to_string();
+            assert!(
+                list.lines()
+                    .any(|l| l.split_whitespace().next() == Some(&name)),
+                "{name} not listed:\n{list}"
+            );
+        }
+    }
+    let o = segfem(tmp.path(), &["example", "gmsh-tapered", "-o", "g.toml"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = segfem(tmp.path(), &["check", "g.toml"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+}
+
+/// `--stop-after-step 0` names no step: an error, not a run that never stops.
+#[test]
+fn stop_after_step_zero_is_an_error() {
+    let tmp = TempDir::new("probe-stop0");
+    std::fs::write(tmp.join("c.toml"), example("cantilever")).unwrap();
+    let o = segfem(
+        tmp.path(),
+        &["run", "c.toml", "-o", "out", "--stop-after-step", "0"],
+    );
+    let err = stderr(&o);
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.contains("--stop-after-step: steps are numbered from 1"),
+        "{err}"
+    );
+}
