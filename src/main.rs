@@ -491,7 +491,37 @@ fn check(model: PathBuf) -> ExitCode {
             outln!("  title:     {}", m.title);
             outln!("  nodes:     {}", m.nodes.len());
             outln!("  elements:  {}", m.elements.len());
+            let fixed: Vec<(usize, f64)> = m
+                .supports
+                .iter()
+                .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+                .collect();
+            let equations = segfem::fem::dofs::DofMap::new(m.nodes.len(), &fixed).n_eq;
             outln!("  dofs:      {}", m.n_dofs());
+            outln!("  equations: {equations} (dofs not held by supports)");
+            let names = |v: Vec<&str>| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    v.join(", ")
+                }
+            };
+            outln!(
+                "  materials: {}",
+                names(m.materials.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  joints:    {}",
+                names(m.joints.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  tendons:   {}",
+                names(m.tendons.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  bars:      {}",
+                names(m.bars.iter().map(|x| x.name.as_str()).collect())
+            );
             outln!(
                 "  regions:   {}",
                 m.regions
@@ -504,7 +534,10 @@ fn check(model: PathBuf) -> ExitCode {
                 "  supports:  {}",
                 m.supports
                     .iter()
-                    .map(|s| format!("{} ({} dofs)", s.name, s.dofs.len()))
+                    .map(|s| match s.dofs.len() {
+                        1 => format!("{} (1 dof)", s.name),
+                        n => format!("{} ({n} dofs)", s.name),
+                    })
                     .collect::<Vec<_>>()
                     .join(", ")
             );
