@@ -431,3 +431,34 @@ fn stop_after_step_zero_is_an_error() {
         "{err}"
     );
 }
+
+/// The report's default curve and peak are the load (here the control force), never a
+/// crack strain listed among the monitors.
+#[test]
+fn report_peak_is_the_load_not_a_crack_strain() {
+    let tmp = TempDir::new("probe-report");
+    let text = edit(
+        &plain_beam(40, ""),
+        "kind = \"load\"\nloads = { P = 1.0 }",
+        "kind = \"displacement\"\ncontrol = { point = [2.0, 0.4], component = \"y\", value = -0.002 }",
+    );
+    let text = edit(
+        &text,
+        "[[steps]]",
+        "[[monitors]]\nname = \"crack_max\"\nkind = \"max_crack_strain\"\n\n[[steps]]",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = segfem(tmp.path(), &["report", "out"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let html = read(&tmp.join("out/report.html"));
+    assert!(
+        html.contains("<b>Peak load:</b> control_force = "),
+        "peak line"
+    );
+    assert!(
+        !html.contains("Peak load factor:</b> crack_max"),
+        "crack strain as load"
+    );
+}
