@@ -55,7 +55,7 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "seed-beam",
-        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (VALIDATION.md §1)",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (docs/validation.md)",
         include_str!("../examples/seed-beam.toml"),
     ),
     (
@@ -83,7 +83,20 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         "RC beam in four-point bending to failure (concrete, embedded bars, displacement control)",
         include_str!("../examples/rc-beam.toml"),
     ),
+    (
+        "gmsh-tapered",
+        "two segments meshed with Gmsh (prismatic and tapered), dry joint; -o also writes gmsh-tapered.msh",
+        include_str!("../examples/gmsh-tapered.toml"),
+    ),
 ];
+
+/// Files an example reads, written beside it by `segfem example NAME -o FILE`:
+/// (example, file name, contents).
+const COMPANIONS: &[(&str, &str, &str)] = &[(
+    "gmsh-tapered",
+    "gmsh-tapered.msh",
+    include_str!("../examples/gmsh-tapered.msh"),
+)];
 
 #[derive(Parser)]
 #[command(
@@ -244,6 +257,10 @@ fn main() -> ExitCode {
             stop_after_step,
             threads,
         } => {
+            if stop_after_step == Some(0) {
+                eprintln!("error: --stop-after-step: steps are numbered from 1");
+                return ExitCode::from(2);
+            }
             if let Some(n) = threads {
                 if n == 0 {
                     eprintln!("error: --threads: at least 1 thread");
@@ -452,11 +469,16 @@ fn run(
         }
         Err(e) => {
             eprintln!("error: {e}");
-            if matches!(e, segfem::run::RunError::NotConverged(_)) {
-                eprintln!(
+            match &e {
+                segfem::run::RunError::NotConverged(_) => eprintln!(
                     "results up to the last converged increment are in {}",
                     out.display()
-                );
+                ),
+                segfem::run::RunError::Implausible(_) => eprintln!(
+                    "all results are in {} (check them before any use)",
+                    out.display()
+                ),
+                _ => {}
             }
             ExitCode::from(e.exit_code().clamp(0, 255) as u8)
         }
@@ -474,7 +496,37 @@ fn check(model: PathBuf) -> ExitCode {
             outln!("  title:     {}", m.title);
             outln!("  nodes:     {}", m.nodes.len());
             outln!("  elements:  {}", m.elements.len());
+            let fixed: Vec<(usize, f64)> = m
+                .supports
+                .iter()
+                .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+                .collect();
+            let equations = segfem::fem::dofs::DofMap::new(m.nodes.len(), &fixed).n_eq;
             outln!("  dofs:      {}", m.n_dofs());
+            outln!("  equations: {equations} (dofs not held by supports)");
+            let names = |v: Vec<&str>| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    v.join(", ")
+                }
+            };
+            outln!(
+                "  materials: {}",
+                names(m.materials.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  joints:    {}",
+                names(m.joints.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  tendons:   {}",
+                names(m.tendons.iter().map(|x| x.name.as_str()).collect())
+            );
+            outln!(
+                "  bars:      {}",
+                names(m.bars.iter().map(|x| x.name.as_str()).collect())
+            );
             outln!(
                 "  regions:   {}",
                 m.regions
@@ -487,7 +539,10 @@ fn check(model: PathBuf) -> ExitCode {
                 "  supports:  {}",
                 m.supports
                     .iter()
-                    .map(|s| format!("{} ({} dofs)", s.name, s.dofs.len()))
+                    .map(|s| match s.dofs.len() {
+                        1 => format!("{} (1 dof)", s.name),
+                        n => format!("{} ({n} dofs)", s.name),
+                    })
                     .collect::<Vec<_>>()
                     .join(", ")
             );
@@ -538,16 +593,25 @@ fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
         );
         return ExitCode::from(2);
     };
+    let companions = COMPANIONS.iter().filter(|(n, _, _)| *n == name);
     match output {
-        Some(p) => match std::fs::write(&p, text) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {}: {e}", p.display());
-                ExitCode::from(1)
+        Some(p) => {
+            let dir = p.parent().unwrap_or(std::path::Path::new(""));
+            let files = std::iter::once((p.clone(), *text))
+                .chain(companions.map(|(_, f, t)| (dir.join(f), *t)));
+            for (path, text) in files {
+                if let Err(e) = std::fs::write(&path, text) {
+                    eprintln!("error: {}: {e}", path.display());
+                    return ExitCode::from(1);
+                }
             }
-        },
+            ExitCode::SUCCESS
+        }
         None => {
             out!("{text}");
+            for (_, f, _) in companions {
+                eprintln!("note: this example reads {f}; `segfem example {name} -o FILE` writes it beside FILE");
+            }
             ExitCode::SUCCESS
         }
     }

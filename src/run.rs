@@ -4,10 +4,12 @@ use crate::analysis::failure::FailureReport;
 use crate::analysis::steps::{
     self, AnalysisError, Observer, Snapshot, StepEnd, StopReason, Timings,
 };
+use crate::analysis::system::System;
 use crate::input::{self, InputError};
 use crate::model::Model;
 use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
+use crate::results::plausibility::Plausibility;
 use crate::results::recorder::Recorder;
 use crate::results::ultimate::{Ultimate, UltimateWatch};
 use serde::Serialize;
@@ -49,6 +51,10 @@ pub enum RunError {
     /// Stopped as asked after a step (`--stop-after-step`, exit 4).
     #[error("{0}")]
     Stopped(String),
+    /// Every step converged but the result is not physically meaningful (exit 5):
+    /// `results::plausibility` (a model held by numerical stiffness).
+    #[error("{0}")]
+    Implausible(String),
     /// Files could not be written (exit 1).
     #[error("{0}")]
     Io(String),
@@ -61,6 +67,7 @@ impl RunError {
             RunError::Input(_) | RunError::Mechanism { .. } | RunError::Restart(_) => 2,
             RunError::NotConverged(_) => 3,
             RunError::Stopped(_) => 4,
+            RunError::Implausible(_) => 5,
             RunError::Interrupted { signal, .. } => 128 + signal,
             RunError::Io(_) => 1,
         }
@@ -100,8 +107,9 @@ pub struct Size {
 pub struct Summary {
     /// Model title.
     pub title: String,
-    /// "completed", "failed" (a step did not converge), "interrupted" (signal) or
-    /// "stopped" (`--stop-after-step`).
+    /// "completed", "implausible" (every step converged but the result is held by
+    /// numerical stiffness: `plausibility`), "failed" (a step did not converge),
+    /// "interrupted" (signal) or "stopped" (`--stop-after-step`).
     pub status: String,
     /// Failure message, if any.
     pub error: Option<String>,
@@ -127,7 +135,11 @@ pub struct Summary {
     /// Runs to failure (a displacement or arc-length step, or a failure met): which
     /// failure was reached first and at what load, and the peak load.
     pub ultimate: Option<Ultimate>,
-    /// Warnings met in the input.
+    /// Why the result is not physically meaningful (empty when it is): load carried
+    /// through open joints' residual stiffness, displacements beyond a tenth of the model
+    /// size (docs/running.md, "Implausible results").
+    pub plausibility: Vec<String>,
+    /// Warnings met in the input and in the results.
     pub warnings: Vec<String>,
 }
 
@@ -152,6 +164,7 @@ pub fn size_of(model: &Model, equations: usize) -> Size {
 struct Progress<'a, 'm> {
     rec: Recorder<'m>,
     watch: UltimateWatch,
+    plausible: Plausibility,
     on_increment: &'a mut dyn FnMut(&Snapshot),
     dir: PathBuf,
     origin: Origin,
@@ -159,12 +172,15 @@ struct Progress<'a, 'm> {
     stop_after_step: Option<usize>,
     stop_now: bool,
     signal: Option<Arc<AtomicUsize>>,
+    /// Timings when a step stopped early (the analysis returns none with its error).
+    timings: Option<Timings>,
 }
 
 impl Observer for Progress<'_, '_> {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         self.rec.increment(snap)?;
         self.watch.increment(snap);
+        self.plausible.increment(snap);
         (self.on_increment)(snap);
         Ok(())
     }
@@ -186,6 +202,12 @@ impl Observer for Progress<'_, '_> {
 
     fn step_failed(&mut self, report: &FailureReport) {
         self.failures.push(report.clone());
+    }
+
+    fn step_stopped(&mut self, system: &System, timings: &Timings) -> std::io::Result<()> {
+        self.timings = Some(timings.clone());
+        // A failed or stopped run still shows its last converged state.
+        self.rec.write_last_fields(system)
     }
 
     fn stop_requested(&self) -> Option<StopReason> {
@@ -299,6 +321,7 @@ pub fn run_file_opts(
     let mut obs = Progress {
         rec,
         watch: UltimateWatch::new(),
+        plausible: Plausibility::new(),
         on_increment,
         dir: PathBuf::from(out),
         origin: Origin {
@@ -309,6 +332,7 @@ pub fn run_file_opts(
         stop_after_step: opts.stop_after_step,
         stop_now: false,
         signal: opts.signal.clone(),
+        timings: None,
     };
     let result = steps::run_with(
         &model,
@@ -318,12 +342,13 @@ pub fn run_file_opts(
             resume,
         },
     );
-    let rec = obs.rec;
+    let mut rec = obs.rec;
     let watch = obs.watch;
+    let plausibility = obs.plausible.findings();
     let mut failures = obs.failures;
     let (timings, error) = match result {
         Ok(t) => (t, None),
-        Err(e) => (Timings::default(), Some(e)),
+        Err(e) => (obs.timings.unwrap_or_default(), Some(e)),
     };
     if let Some(AnalysisError::NotConverged(r)) = &error {
         failures.push((**r).clone());
@@ -353,6 +378,7 @@ pub fn run_file_opts(
     )
     .n_eq;
     let (status, resume_step) = match &error {
+        None if failures.is_empty() && !plausibility.is_empty() => ("implausible", None),
         None if failures.is_empty() => ("completed", None),
         None | Some(AnalysisError::NotConverged(_)) => ("failed", None),
         Some(AnalysisError::Stopped {
@@ -370,6 +396,10 @@ pub fn run_file_opts(
     };
     let error_text = match (&error, failures.len()) {
         (Some(e), _) => Some(e.to_string()),
+        (None, 0) if !plausibility.is_empty() => Some(format!(
+            "every step converged but the result is not physically meaningful:\n{}",
+            plausibility.join("\n")
+        )),
         (None, 0) => None,
         (None, n) => Some(format!(
             "{n} step(s) did not converge (the run went on): {}\n{}",
@@ -389,6 +419,12 @@ pub fn run_file_opts(
         &model,
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
+    let mut warnings = built.warnings;
+    warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
+    if error.is_some() || !failures.is_empty() {
+        // A failed or stopped run says why it failed; the findings still go with it.
+        warnings.extend(plausibility.iter().cloned());
+    }
     let summary = Summary {
         title: model.title.clone(),
         status: status.into(),
@@ -403,13 +439,20 @@ pub fn run_file_opts(
         peak_memory_bytes: peak_memory(),
         final_monitors,
         ultimate,
-        warnings: built.warnings,
+        plausibility,
+        warnings,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_atomic(&out.join("summary.json"), json.as_bytes())
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("summary.json").display())))?;
     let file = path.display();
     match error {
+        None if summary.failures.is_empty() && !summary.plausibility.is_empty() => {
+            Err(RunError::Implausible(format!(
+                "{file}: {}",
+                error_text.expect("set with findings")
+            )))
+        }
         None if summary.failures.is_empty() => Ok(summary),
         None => Err(RunError::NotConverged(format!(
             "{file}: {}",

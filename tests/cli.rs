@@ -396,7 +396,13 @@ fn check_prints_the_summary() {
     assert_eq!(field("title"), "Box-section beam, 7.2 m span, elastic");
     assert!(field("regions").contains("webs (t = 0.2 m)"), "{out}");
     // left holds ux and uy at one node, right uy at one node.
-    assert_eq!(field("supports"), "left (2 dofs), right (1 dofs)");
+    assert_eq!(field("supports"), "left (2 dofs), right (1 dof)");
+    // Free equations: every dof but the three held (left x and y, right y).
+    assert_eq!(
+        field("equations").split(' ').next(),
+        Some((2 * nodes - 3).to_string()).as_deref()
+    );
+    assert_eq!(field("joints"), "none");
     assert_eq!(field("loads"), "self_weight, Q");
     assert_eq!(field("monitors"), "midspan_uy, R_left, Q");
     assert_eq!(field("steps"), "self_weight, service");

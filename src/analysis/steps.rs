@@ -54,6 +54,13 @@ pub trait Observer {
     /// Called when a step failed and the run goes on with the next one. Default: nothing.
     fn step_failed(&mut self, _report: &FailureReport) {}
 
+    /// Called when a step ends early (an increment failed after all cuts, a stop was asked,
+    /// an error), with the system at its last converged state and the timings so far.
+    /// Default: nothing.
+    fn step_stopped(&mut self, _system: &System, _timings: &Timings) -> std::io::Result<()> {
+        Ok(())
+    }
+
     /// Asked after every converged increment and every step end: `Some` stops the analysis
     /// there. Default: never.
     fn stop_requested(&self) -> Option<StopReason> {
@@ -263,6 +270,7 @@ pub fn run_with(
                 }
             }
             Err(AnalysisError::NotConverged(r)) if options.continue_on_failure => {
+                obs.step_stopped(&sys, &timings)?;
                 obs.step_failed(&r);
                 // Go on from the last converged state. A load or time step set the clock of
                 // its failed attempt: back to the time reached, and the tendons' initial
@@ -272,7 +280,11 @@ pub fn run_with(
                     sys.begin_time_increment(TimeContext::at(clock));
                 }
             }
-            Err(e) => return Err(e),
+            Err(e) => {
+                timings.solver = solver.stats.clone();
+                obs.step_stopped(&sys, &timings)?;
+                return Err(e);
+            }
         }
         driver = DriverState {
             next_step: si + 1,

@@ -80,6 +80,15 @@ fn unique_names<'a>(ctx: &Ctx, list: &str, names: impl Iterator<Item = &'a str>)
         if n.trim().is_empty() {
             return Err(ctx.err(format!("{list}[{i}].name"), "must not be empty"));
         }
+        // Names head the columns of history.csv and are typed on the command line.
+        if let Some(c) = n.chars().find(|c| *c == ',' || *c == '"' || c.is_control()) {
+            return Err(ctx.err(
+                format!("{list}[{i}].name"),
+                format!(
+                    "{c:?} is not allowed in a name (names head the columns of history.csv: no commas, quotes or control characters)"
+                ),
+            ));
+        }
         if let Some(j) = seen.insert(n, i) {
             return Err(ctx.err(
                 format!("{list}[{i}].name"),
@@ -3246,6 +3255,9 @@ pub const SUBSTEPS_PER_DECADE: f64 = 5.0;
 pub const DEFAULT_FIRST_SUBSTEP: f64 = 0.1;
 
 /// The interval and substeps of a time step; `clock` = end of the previous time step.
+/// Latest analysis day accepted [d].
+const MAX_DAY: f64 = 1e6;
+
 fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) -> R<TimeSpan> {
     if !s.loads.is_empty() {
         return Err(ctx.err(
@@ -3292,6 +3304,14 @@ fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) -> R<TimeSpan
         return Err(ctx.err(
             format!("{key}.to"),
             format!("must be later than from = {from} d (got {to})"),
+        ));
+    }
+    // MC90 creep and shrinkage are at their final values within 1e5 d; a later day is a
+    // typing or unit slip (seconds for days), and the power laws lose precision there.
+    if to > MAX_DAY {
+        return Err(ctx.err(
+            format!("{key}.to"),
+            format!("{to:e} d is beyond {MAX_DAY:e} d (2700 years; creep and shrinkage end long before): times are in days"),
         ));
     }
     let d = to - from;

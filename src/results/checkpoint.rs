@@ -6,7 +6,9 @@
 //! restored state is bit-identical to the saved one, NaN and infinities included (JSON
 //! would turn NaN into null and needs care to round-trip every double). A small header
 //! (magic text, format version, model file and its digest) is read first, so that an
-//! older or foreign file gives a clear message rather than a decoding error.
+//! older or foreign file gives a clear message rather than a decoding error. The file ends
+//! with the 8-byte FNV-1a digest of everything before it: a damaged file (a flipped bit, a
+//! truncated copy) is refused instead of restarting from a silently different state.
 
 use super::atomic::write_atomic;
 use super::recorder::RecorderState;
@@ -18,8 +20,10 @@ use std::path::Path;
 /// File name of the checkpoint in the output directory.
 pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &str = "segfem checkpoint";
-/// Format version; bumped whenever a saved structure changes.
-const VERSION: u32 = 1;
+/// Format version; bumped whenever a saved structure changes (2: trailing checksum).
+const VERSION: u32 = 2;
+/// Bytes of the trailing checksum.
+const CHECKSUM_BYTES: usize = 8;
 
 #[derive(Serialize, Deserialize)]
 struct Header {
@@ -90,6 +94,8 @@ pub fn write(
         system,
     };
     bytes.extend(postcard::to_stdvec(&body).map_err(std::io::Error::other)?);
+    let sum = digest(&bytes);
+    bytes.extend(sum.to_le_bytes());
     write_atomic(&dir.join(FILE), &bytes)
 }
 
@@ -103,10 +109,21 @@ pub fn read(dir: &Path) -> Result<(Origin, Checkpoint), String> {
         )
     })?;
     let bad = |what: &str| format!("{}: not a segfem checkpoint ({what})", path.display());
-    let (header, rest) =
+    let (header, _) =
         postcard::take_from_bytes::<Header>(&bytes).map_err(|_| bad("unreadable header"))?;
     if header.magic != MAGIC {
         return Err(bad("wrong magic text"));
+    }
+    // The checksum before the version: a flipped bit may sit in the version field itself.
+    let intact = bytes.len() >= CHECKSUM_BYTES && {
+        let (data, sum) = bytes.split_at(bytes.len() - CHECKSUM_BYTES);
+        digest(data).to_le_bytes() == sum
+    };
+    if !intact && header.version == VERSION {
+        return Err(format!(
+            "{}: the checkpoint is damaged (its checksum does not match its contents: the file was altered or truncated after it was written); rerun from the start",
+            path.display()
+        ));
     }
     if header.version != VERSION {
         return Err(format!(
@@ -115,6 +132,9 @@ pub fn read(dir: &Path) -> Result<(Origin, Checkpoint), String> {
             header.version
         ));
     }
+    let body = &bytes[..bytes.len() - CHECKSUM_BYTES];
+    let (_, rest) =
+        postcard::take_from_bytes::<Header>(body).map_err(|_| bad("unreadable header"))?;
     let cp: Checkpoint = postcard::from_bytes(rest).map_err(|e| {
         format!(
             "{}: the checkpoint is damaged ({e}); rerun from the start",

@@ -1,13 +1,17 @@
 //! The observer that records monitors into a history and writes field files (.vtu/.pvd)
-//! as increments converge. Files are rewritten whole (atomically) so that a run stopped at
-//! any point leaves complete files of everything computed so far.
+//! as increments converge. Field files are rewritten whole (atomically); history.csv gets
+//! one appended line per converged increment, written before that increment's fields are
+//! listed in results.pvd, so that a run killed at any point leaves a history at least as far
+//! as its fields (docs/running.md, "Output files").
 
 use super::atomic::write_atomic;
 use super::fields::{principal, recover};
 use super::joints::summarise;
 use super::vtu::{render, render_pvd, Array, Grid};
 use crate::analysis::steps::{Observer, Snapshot};
+use crate::analysis::system::System;
 use crate::model::{Model, MonitorKind};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// One row of the history: step, increment, iterations, load factors, monitor values.
@@ -54,6 +58,26 @@ pub struct Recorder<'m> {
     /// Displacements at the end of each step some monitor measures from.
     step_end_u: std::collections::HashMap<usize, Vec<f64>>,
     write_fields: bool,
+    /// history.csv opened for appending, and the rows it holds.
+    history: Option<(std::fs::File, usize)>,
+    /// The last converged increment when its fields were not written (what a failed or
+    /// stopped run needs to write them from the committed state).
+    unwritten: Option<Unwritten>,
+}
+
+/// What a snapshot holds besides the system, kept for an increment whose fields were not
+/// written.
+struct Unwritten {
+    step: usize,
+    increment: usize,
+    end_of_step: bool,
+    factors: Vec<f64>,
+    f_int: Vec<f64>,
+    f_ext: Vec<f64>,
+    iterations: usize,
+    negative_pivots: usize,
+    arc_length_factor: Option<f64>,
+    control_force: Option<f64>,
 }
 
 impl<'m> Recorder<'m> {
@@ -68,6 +92,8 @@ impl<'m> Recorder<'m> {
             pvd: Vec::new(),
             step_end_u: Default::default(),
             write_fields,
+            history: None,
+            unwritten: None,
         })
     }
 
@@ -91,10 +117,20 @@ impl<'m> Recorder<'m> {
         self.rows = s.rows;
         self.pvd = s.pvd;
         self.step_end_u = s.step_end_u.into_iter().collect();
+        self.history = None;
     }
 
     /// The CSV text of the history (header with units).
     pub fn history_csv(&self) -> String {
+        let mut s = self.history_header();
+        for r in &self.rows {
+            s.push_str(&self.history_line(r));
+        }
+        s
+    }
+
+    /// The header line of history.csv: every column with its unit.
+    fn history_header(&self) -> String {
         let mut s = String::from("step,increment,iterations,time [d]");
         for c in &self.model.load_cases {
             s.push_str(&format!(",factor:{} [-]", c.name));
@@ -113,34 +149,89 @@ impl<'m> Recorder<'m> {
             s.push_str(",arc_length_factor [-]");
         }
         s.push('\n');
-        for r in &self.rows {
-            s.push_str(&format!(
-                "{},{},{},{:e}",
-                r.step + 1,
-                r.increment,
-                r.iterations,
-                r.time
-            ));
-            for v in r.factors.iter().chain(&r.monitors) {
-                s.push_str(&format!(",{v:e}"));
-            }
-            if nonlinear {
-                s.push_str(&format!(",{}", r.negative_pivots));
-            }
-            if disp {
-                s.push_str(&format!(",{:e}", r.control_force));
-            }
-            if arc {
-                s.push_str(&format!(",{:e}", r.arc_length_factor));
-            }
-            s.push('\n');
-        }
         s
     }
 
-    /// Write history.csv (atomically).
-    pub fn write_history(&self) -> std::io::Result<()> {
+    /// One data line of history.csv.
+    fn history_line(&self, r: &Row) -> String {
+        let (nonlinear, disp, arc) = path_columns(self.model);
+        let mut s = format!(
+            "{},{},{},{:e}",
+            r.step + 1,
+            r.increment,
+            r.iterations,
+            r.time
+        );
+        for v in r.factors.iter().chain(&r.monitors) {
+            s.push_str(&format!(",{v:e}"));
+        }
+        if nonlinear {
+            s.push_str(&format!(",{}", r.negative_pivots));
+        }
+        if disp {
+            s.push_str(&format!(",{:e}", r.control_force));
+        }
+        if arc {
+            s.push_str(&format!(",{:e}", r.arc_length_factor));
+        }
+        s.push('\n');
+        s
+    }
+
+    /// Write history.csv whole (atomically).
+    pub fn write_history(&mut self) -> std::io::Result<()> {
+        self.history = None;
         write_atomic(&self.dir.join("history.csv"), self.history_csv().as_bytes())
+    }
+
+    /// Bring history.csv up to the rows recorded: append the new lines in one write (a
+    /// kill leaves whole lines; the page cache keeps them after the process dies), or
+    /// rewrite the file whole when it is not open yet (first row, after a restart).
+    fn flush_history(&mut self) -> std::io::Result<()> {
+        let open = self.history.as_ref().map(|h| h.1);
+        if let Some(done) = open.filter(|&n| n <= self.rows.len()) {
+            let text: String = self.rows[done..]
+                .iter()
+                .map(|r| self.history_line(r))
+                .collect();
+            let rows = self.rows.len();
+            let (f, n) = self.history.as_mut().expect("open");
+            f.write_all(text.as_bytes())?;
+            *n = rows;
+            return Ok(());
+        }
+        self.write_history()?;
+        let f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(self.dir.join("history.csv"))?;
+        self.history = Some((f, self.rows.len()));
+        Ok(())
+    }
+
+    /// After a run stopped early (an increment failed, a signal): write the fields of the
+    /// last converged increment if they were not written, from `system`, which holds that
+    /// increment's committed state.
+    pub fn write_last_fields(&mut self, system: &System) -> std::io::Result<()> {
+        let Some(w) = self.unwritten.take() else {
+            return Ok(());
+        };
+        if !self.write_fields {
+            return Ok(());
+        }
+        let snap = Snapshot {
+            system,
+            step: w.step,
+            increment: w.increment,
+            end_of_step: w.end_of_step,
+            factors: &w.factors,
+            f_int: &w.f_int,
+            f_ext: &w.f_ext,
+            iterations: w.iterations,
+            negative_pivots: w.negative_pivots,
+            arc_length_factor: w.arc_length_factor,
+            control_force: w.control_force,
+        };
+        self.write_vtu(&snap)
     }
 
     fn monitor_values(&self, snap: &Snapshot) -> Vec<f64> {
@@ -403,12 +494,25 @@ impl Observer for Recorder<'_> {
             arc_length_factor: snap.arc_length_factor.unwrap_or(f64::NAN),
             control_force: snap.control_force.unwrap_or(f64::NAN),
         });
+        // The history first: results.pvd never lists an increment history.csv lacks.
+        self.flush_history()?;
         let step = &self.model.steps[snap.step];
         if self.write_fields && (snap.end_of_step || step.output_every_increment) {
+            self.unwritten = None;
             self.write_vtu(snap)?;
-        }
-        if snap.end_of_step {
-            self.write_history()?;
+        } else if self.write_fields {
+            self.unwritten = Some(Unwritten {
+                step: snap.step,
+                increment: snap.increment,
+                end_of_step: snap.end_of_step,
+                factors: snap.factors.to_vec(),
+                f_int: snap.f_int.to_vec(),
+                f_ext: snap.f_ext.to_vec(),
+                iterations: snap.iterations,
+                negative_pivots: snap.negative_pivots,
+                arc_length_factor: snap.arc_length_factor,
+                control_force: snap.control_force,
+            });
         }
         Ok(())
     }

@@ -50,8 +50,13 @@ pub struct Ultimate {
     /// Every event met, in order: (mode, load measure when first met). Besides the failure
     /// modes it lists "reinforcement yield" (first yield of a bar that is not a tendon).
     pub events: Vec<(String, f64)>,
-    /// How the run ended: "completed" or "no convergence beyond the last increment".
+    /// How the run ended: "completed", "completed, but ... increments used up before
+    /// stop_displacement" or "stopped: no convergence beyond the last increment".
     pub ended: String,
+    /// Arc-length steps that used up their increments before their `stop_displacement`
+    /// (one sentence each: step, displacement reached and aimed at).
+    #[serde(default)]
+    pub unfinished: Vec<String>,
 }
 
 impl fmt::Display for Ultimate {
@@ -104,6 +109,12 @@ struct Row {
     negative_pivots: usize,
 }
 
+/// Mode of a peak that is the first cracking of the concrete (the load falls as the first
+/// crack opens).
+pub const CRACKING_PEAK: &str = "first cracking";
+/// Mode of a run that stopped with the load still rising (Newton stalled, no limit point).
+pub const NO_CONVERGENCE: &str = "no convergence";
+
 /// Follows the converged increments of a run and tells which failure it reached.
 #[derive(Debug, Default)]
 pub struct UltimateWatch {
@@ -114,6 +125,12 @@ pub struct UltimateWatch {
     joint_crushing: Option<Event>,
     /// First crushing elsewhere (or before the joint it touches opened).
     crushing: Option<Event>,
+    /// First cracked concrete point (the element named).
+    first_crack: Option<Event>,
+    /// Start value [m] of the stop_displacement dof of the arc-length step in hand.
+    arc_start: Option<f64>,
+    /// Arc-length steps that used up their increments before their stop_displacement.
+    unfinished: Vec<String>,
 }
 
 /// Relative drop of the load below its peak at the end of the same step, taken as a limit
@@ -163,6 +180,20 @@ impl UltimateWatch {
         if self.tendon_yield.is_none() || self.bar_yield.is_none() {
             self.bar_events(snap, k);
         }
+        if self.first_crack.is_none() {
+            if let Some(e) = (0..model.elements.len()).find(|&e| {
+                sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
+                    .iter()
+                    .any(|p| p.n_cracks() > 0)
+            }) {
+                self.first_crack = Some(Event {
+                    mode: CRACKING_PEAK,
+                    detail: format!("element {}", e + 1),
+                    at: k,
+                });
+            }
+        }
+        self.arc_length_end(snap);
         if self.crushing.is_none() || self.joint_crushing.is_none() {
             for e in crushing(model, snap, k) {
                 let slot = if e.mode == "concrete crushing" {
@@ -174,6 +205,44 @@ impl UltimateWatch {
                     *slot = Some(e);
                 }
             }
+        }
+    }
+
+    /// An arc-length step with a stop_displacement: note it when its last increment stops
+    /// short of that displacement (and of its target_factor).
+    fn arc_length_end(&mut self, snap: &Snapshot) {
+        use crate::model::PathControl;
+        let sys = snap.system;
+        let step = &sys.model.steps[snap.step];
+        let Some(PathControl::ArcLength(a)) = &step.path else {
+            return;
+        };
+        let Some((n, d, v)) = a.target_displacement else {
+            return;
+        };
+        let k = 2 * n + d.index();
+        if snap.increment == 1 {
+            self.arc_start = Some(sys.u_prev[k]);
+        }
+        if !snap.end_of_step {
+            return;
+        }
+        let x = sys.u[k];
+        let start = self.arc_start.unwrap_or(0.0);
+        let reached_u = (x - v) * (v - start).signum() >= 0.0;
+        let reached_f = match (a.target_factor, snap.arc_length_factor) {
+            (Some(t), Some(l)) => l >= t,
+            _ => false,
+        };
+        if !reached_u && !reached_f && snap.increment >= a.max_increments {
+            self.unfinished.push(format!(
+                "step '{}' used all its {} increments before its stop_displacement: node {} moved {:.3} mm of the {:.3} mm asked (raise `increments` or `max_growth`)",
+                step.name,
+                a.max_increments,
+                n + 1,
+                1e3 * (x - start),
+                1e3 * (v - start)
+            ));
         }
     }
 
@@ -276,6 +345,18 @@ impl UltimateWatch {
         } else {
             return None;
         };
+        // The load falls as the first crack opens: the peak is the cracking load of an
+        // element, which reinforcement or prestress may carry past.
+        if let Some(c) = self.first_crack.as_ref().filter(|c| c.at == p + 1) {
+            return Some(Event {
+                mode: CRACKING_PEAK,
+                detail: format!(
+                    "the load falls as {} cracks, the first crack of the model: this peak is a cracking load, not a collapse",
+                    c.detail
+                ),
+                at: p,
+            });
+        }
         Some(Event {
             mode: "loss of equilibrium",
             detail,
@@ -296,7 +377,18 @@ impl UltimateWatch {
         let peak = (0..v.len())
             .max_by(|&a, &b| v[a].total_cmp(&v[b]).then(b.cmp(&a)))
             .unwrap_or(0);
-        let equilibrium = self.limit_point(&v, peak);
+        // Newton stalled with the load still rising (the peak is the last converged
+        // increment): no convergence, not a limit point.
+        let stalled = !converged && peak + 1 == self.rows.len();
+        let equilibrium = if stalled {
+            Some(Event {
+                mode: NO_CONVERGENCE,
+                detail: "Newton stalled after the last converged increment while the load was still rising: the peak is a lower bound of the capacity, not a limit point".into(),
+                at: peak,
+            })
+        } else {
+            self.limit_point(&v, peak)
+        };
         // Failure modes in the order met (ties: yield, crushing, equilibrium).
         let mut modes: Vec<&Event> = [
             &self.tendon_yield,
@@ -330,7 +422,13 @@ impl UltimateWatch {
                 .iter()
                 .map(|e| (e.mode.to_string(), v[e.at]))
                 .collect(),
-            ended: if converged {
+            unfinished: self.unfinished.clone(),
+            ended: if converged && !self.unfinished.is_empty() {
+                format!(
+                    "completed, but {} arc-length step(s) used up their increments before stop_displacement",
+                    self.unfinished.len()
+                )
+            } else if converged {
                 "completed".into()
             } else {
                 "stopped: no convergence beyond the last increment".into()

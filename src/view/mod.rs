@@ -174,9 +174,30 @@ pub fn default_columns(h: &Table) -> Result<(String, Vec<String>), ViewError> {
         .or_else(|| h.monitors().next())
         .map(|c| c.name.clone())
         .unwrap_or_else(|| "increment".into());
-    let y = h
-        .monitors()
-        .find(|c| c.unit == "-")
+    // The load, never a strain: the force of a displacement control where one acts, else
+    // the load factor that varies most, else a reaction.
+    let range = |c: &data::Column| {
+        let f = c.values.iter().filter(|v| v.is_finite());
+        f.clone().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+            - f.fold(f64::INFINITY, |a, &b| a.min(b))
+    };
+    let control = h
+        .columns
+        .iter()
+        .find(|c| c.name == "control_force" && c.values.iter().any(|v| v.is_finite()));
+    let factor = h
+        .factors()
+        .filter(|c| range(c) > 0.0)
+        .max_by(|a, b| range(a).total_cmp(&range(b)));
+    // A load_factor monitor shows the same numbers under the user's name: prefer it.
+    let factor = factor.map(|f| {
+        h.monitors()
+            .find(|m| m.unit == "-" && m.values == f.values)
+            .unwrap_or(f)
+    });
+    let y = control
+        .or(factor)
+        .or_else(|| h.monitors().find(|c| c.unit == "N"))
         .or_else(|| h.factors().last())
         .or_else(|| h.monitors().find(|c| c.name != x))
         .map(|c| c.name.clone())

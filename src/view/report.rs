@@ -309,17 +309,34 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         key_numbers(&h)
     );
     html.push_str(&events(&h));
-    let peak = h
-        .factors()
-        .chain(h.monitors().filter(|c| c.unit == "-"))
-        .flat_map(|c| c.values.iter().map(move |v| (c.name.as_str(), *v)))
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    if let Some((name, v)) = peak {
+    // The peak of the load the curve shows (its first y column), by magnitude.
+    let load_name = match opts.y.as_ref() {
+        Some(y) => y.clone(),
+        None => super::default_columns(&h)?.1.remove(0),
+    };
+    let load = h.column(&load_name)?;
+    let peak = load
+        .values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .max_by(|a, b| a.abs().total_cmp(&b.abs()));
+    if let Some(v) = peak {
+        let what = if load.unit == "-" {
+            "Peak load factor"
+        } else {
+            "Peak load"
+        };
         let _ = writeln!(
             html,
-            "<p><b>Peak load factor:</b> {} = {}</p>",
-            esc(name),
-            num(v)
+            "<p><b>{what}:</b> {} = {}{}</p>",
+            esc(&load.name),
+            num(v),
+            if load.unit.is_empty() || load.unit == "-" {
+                String::new()
+            } else {
+                format!(" {}", esc(&load.unit))
+            }
         );
     }
     html.push_str("<h2>History</h2>\n<figure>");
