@@ -847,12 +847,7 @@ impl<'m> System<'m> {
         // Held crack branches and plastic routes last one increment only.
         let frozen = std::mem::take(&mut self.frozen);
         if std::mem::take(&mut self.held_plastic) || frozen {
-            for st in self.committed.iter_mut() {
-                if let PointState::Concrete(c) = st {
-                    c.frozen = [0; 2];
-                    c.hold_plastic = false;
-                }
-            }
+            self.committed.iter_mut().for_each(PointState::end_increment);
         }
     }
 

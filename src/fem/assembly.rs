@@ -3,7 +3,7 @@
 //! refilling values is a scatter with no search and no allocation.
 
 use super::dofs::{DofMap, CONSTRAINED};
-use crate::analysis::solver::LowerPattern;
+use super::pattern::LowerPattern;
 use rayon::prelude::*;
 
 /// Position marker for an element matrix entry that is not assembled (constrained dof or

@@ -1,6 +1,7 @@
-//! Finite-element building blocks: quadrature, shape functions, dof numbering and assembly.
+//! Finite-element building blocks: quadrature, shape functions, dof numbering, sparse pattern and assembly.
 
 pub mod assembly;
 pub mod dofs;
+pub mod pattern;
 pub mod quadrature;
 pub mod shape;
