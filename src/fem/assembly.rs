@@ -189,6 +189,12 @@ impl Assembler {
     #[inline]
     pub fn add_matrix(&self, e: usize, k: &[f64], values: &mut [f64]) {
         let s = &self.scatter[self.scatter_ptr[e]..self.scatter_ptr[e + 1]];
+        // A matrix of another size belongs to another element: a numbering error.
+        assert_eq!(
+            s.len(),
+            k.len(),
+            "element {e}: matrix size and scatter map differ"
+        );
         for (p, v) in s.iter().zip(k) {
             if *p != SKIP {
                 values[*p as usize] += v;

@@ -2,6 +2,7 @@
 
 pub mod assembly;
 pub mod dofs;
+pub mod numbering;
 pub mod pattern;
 pub mod quadrature;
 pub mod shape;
