@@ -397,13 +397,20 @@ impl Observer for Reach {
         {
             self.deflection = sys.u[2 * n + 1];
         }
-        self.tendon_stress = sys.tendon_committed[0]
+        self.tendon_stress = sys.families.tendons.states.committed[0]
             .as_ref()
             .map_or(0.0, |t| t.stresses().into_iter().fold(0.0, f64::max));
         self.max_opening = (0..m.joints.len())
             .map(|j| crate::results::joints::summarise(sys, j).max_opening)
             .fold(0.0, f64::max);
-        self.crushed = sys.committed.iter().filter(|p| p.is_crushed()).count();
+        self.crushed = sys
+            .families
+            .continuum
+            .points
+            .committed
+            .iter()
+            .filter(|p| p.is_crushed())
+            .count();
         Ok(())
     }
 }

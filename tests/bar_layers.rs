@@ -18,7 +18,13 @@ impl Observer for Trace {
         self.rows.push((
             snap.control_force.unwrap_or(f64::NAN),
             sys.u[self.uy_dof],
-            sys.bar_out.iter().map(|o| o.stress).collect(),
+            sys.families
+                .bars
+                .out
+                .committed
+                .iter()
+                .map(|o| o.stress)
+                .collect(),
         ));
         Ok(())
     }

@@ -31,13 +31,29 @@ impl Observer for Trace {
             snap.negative_pivots,
             snap.arc_length_factor.unwrap_or(f64::NAN),
         ));
-        self.bar_stress = sys.bar_out.iter().map(|o| o.stress).collect();
+        self.bar_stress = sys
+            .families
+            .bars
+            .out
+            .committed
+            .iter()
+            .map(|o| o.stress)
+            .collect();
         self.last_states = (
-            sys.committed
+            sys.families
+                .continuum
+                .points
+                .committed
                 .iter()
                 .map(|p| p.crack_strain())
                 .fold(0.0, f64::max),
-            sys.committed.iter().filter(|p| p.is_crushed()).count(),
+            sys.families
+                .continuum
+                .points
+                .committed
+                .iter()
+                .filter(|p| p.is_crushed())
+                .count(),
         );
         Ok(())
     }
@@ -487,7 +503,7 @@ impl Observer for BeamTrace {
             let y = el.nodes.iter().map(|&k| m.nodes[k][1]).sum::<f64>() / n;
             if (1.2..=1.6).contains(&x) && y < 0.1 {
                 flexural |= (sys.gp_offset[e]..sys.gp_offset[e + 1])
-                    .any(|g| sys.committed[g].n_cracks() > 0);
+                    .any(|g| sys.families.continuum.points.committed[g].n_cracks() > 0);
             }
         }
         // Moment in the constant-moment zone from statics of the left part: the nodal loads
@@ -506,7 +522,7 @@ impl Observer for BeamTrace {
         let steel = sys
             .bar_gps
             .iter()
-            .zip(&sys.bar_out)
+            .zip(&sys.families.bars.out.committed)
             .filter(|((b, _), _)| *b == bottom)
             .map(|(_, o)| o.stress)
             .fold(0.0, f64::max);
@@ -834,11 +850,24 @@ increments = 3000
         fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
             let sys = s.system;
             let v = 1e6 * s.factors[0];
-            let cracked = sys.committed.iter().filter(|p| p.n_cracks() > 0).count();
+            let cracked = sys
+                .families
+                .continuum
+                .points
+                .committed
+                .iter()
+                .filter(|p| p.n_cracks() > 0)
+                .count();
             self.0.push((
                 v,
                 sys.u[2 * 2],
-                sys.bar_out.iter().map(|o| o.stress).collect(),
+                sys.families
+                    .bars
+                    .out
+                    .committed
+                    .iter()
+                    .map(|o| o.stress)
+                    .collect(),
                 cracked,
             ));
             Ok(())

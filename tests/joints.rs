@@ -72,7 +72,15 @@ impl Observer for Keep {
         let j = summarise(s.system, 0);
         self.max_opening = j.max_opening;
         self.max_slip = j.max_slip;
-        self.sliding = s.system.iface_committed.iter().flatten().any(|p| p.sliding);
+        self.sliding = s
+            .system
+            .families
+            .joints
+            .points
+            .committed
+            .iter()
+            .flatten()
+            .any(|p| p.sliding);
         Ok(())
     }
 }

@@ -74,12 +74,15 @@ impl Observer for Ends {
         let m = sys.model;
         let mut bs: Vec<Vec<f64>> = m.bars.iter().map(|b| vec![0.0; b.points.len()]).collect();
         for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
-            bs[b][p] = sys.bar_out[i].stress;
+            bs[b][p] = sys.families.bars.out.committed[i].stress;
         }
         self.u.push(sys.u.clone());
         self.bar_stress.push(bs);
         self.tendon_force.push(
-            sys.tendon_committed
+            sys.families
+                .tendons
+                .states
+                .committed
                 .iter()
                 .map(|t| {
                     t.as_ref()

@@ -30,7 +30,7 @@ impl Observer for Rows {
             .iter()
             .position(|p| (p[0] - 3.6).abs() < 1e-9 && p[1].abs() < 1e-9)
             .expect("midspan soffit node");
-        let stress = s.system.tendon_committed[0]
+        let stress = s.system.families.tendons.states.committed[0]
             .as_ref()
             .map(|t| t.stresses()[1])
             .unwrap_or(0.0);

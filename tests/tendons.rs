@@ -69,7 +69,10 @@ impl Observer for Keep {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         let m = s.system.model;
         let t = &m.tendons[0];
-        self.forces = s.system.tendon_committed[0].as_ref().unwrap().forces();
+        self.forces = s.system.families.tendons.states.committed[0]
+            .as_ref()
+            .unwrap()
+            .forces();
         self.x0 = t.nodes.iter().map(|&n| m.nodes[n]).collect();
         self.x = t
             .nodes
@@ -288,7 +291,7 @@ impl Observer for Push {
             xs[0][1] + w * (xs[1][1] - xs[0][1])
         };
         let ecc = 0.3 + sys.u[2 * centroid + 1] - yt;
-        let stress = sys.tendon_committed[0]
+        let stress = sys.families.tendons.states.committed[0]
             .as_ref()
             .unwrap()
             .stresses()
@@ -441,8 +444,14 @@ kind = "load"
             let m = sys.model;
             let n = &m.tendons[0].nodes;
             let x = |k: usize| m.nodes[n[k]][0] + sys.u[2 * n[k]];
-            self.0 = sys.tendon_committed[0].as_ref().unwrap().stresses()[0];
-            self.1 = sys.tendon_time[0].as_ref().unwrap().loss(LossPart::Elastic);
+            self.0 = sys.families.tendons.states.committed[0]
+                .as_ref()
+                .unwrap()
+                .stresses()[0];
+            self.1 = sys.families.tendons.time[0]
+                .as_ref()
+                .unwrap()
+                .loss(LossPart::Elastic);
             self.2 = x(1) - x(0);
             Ok(())
         }
@@ -716,7 +725,11 @@ fn tendon_eps_uk_hardens_to_fptk() {
     struct Spans(Push, Vec<(f64, f64)>);
     impl Observer for Spans {
         fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-            for sp in &s.system.tendon_committed[0].as_ref().unwrap().spans {
+            for sp in &s.system.families.tendons.states.committed[0]
+                .as_ref()
+                .unwrap()
+                .spans
+            {
                 self.1.push((sp.stress, sp.law.plastic_strain));
             }
             self.0.increment(s)

@@ -33,16 +33,21 @@ impl Observer for Keep {
         ];
         self.0.push(Rec {
             time: sys.time.t_to,
-            strain: sys.gauss[0].strain,
-            stress: sys.gauss[0].stress,
+            strain: sys.families.continuum.gauss.committed[0].strain,
+            stress: sys.families.continuum.gauss.committed[0].stress,
             u: sys.u.clone(),
             forces: sys
-                .tendon_committed
+                .families
+                .tendons
+                .states
+                .committed
                 .iter()
                 .map(|t| t.as_ref().map(|t| t.forces()[0]).unwrap_or(0.0))
                 .collect(),
             losses: sys
-                .tendon_time
+                .families
+                .tendons
+                .time
                 .iter()
                 .map(|t| {
                     t.as_ref()
@@ -272,7 +277,7 @@ fn younger_segment_creeps_more() {
     struct Strains(Vec<(f64, f64, f64)>, usize, usize);
     impl Observer for Strains {
         fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-            let g = &s.system.gauss;
+            let g = &s.system.families.continuum.gauss.committed;
             self.0
                 .push((s.system.time.t_to, g[self.1].strain[0], g[self.2].strain[0]));
             Ok(())
@@ -750,13 +755,13 @@ struct Cracks(Vec<CrackRec>);
 impl Observer for Cracks {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         let sys = s.system;
-        let p = &sys.committed[0];
+        let p = &sys.families.continuum.points.committed[0];
         self.0.push((
             sys.time.t_to,
             p.n_cracks(),
             p.crack_strain(),
-            sys.gauss[0].strain,
-            sys.gauss[0].stress,
+            sys.families.continuum.gauss.committed[0].strain,
+            sys.families.continuum.gauss.committed[0].stress,
         ));
         Ok(())
     }

@@ -22,7 +22,15 @@ impl Observer for Last {
         self.u = s.system.u.clone();
         self.f_int = s.f_int.to_vec();
         self.f_ext = s.f_ext.to_vec();
-        self.stress = s.system.gauss.iter().map(|g| g.stress).collect();
+        self.stress = s
+            .system
+            .families
+            .continuum
+            .gauss
+            .committed
+            .iter()
+            .map(|g| g.stress)
+            .collect();
         Ok(())
     }
 }

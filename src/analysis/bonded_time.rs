@@ -99,11 +99,11 @@ impl System<'_> {
         let model = self.model;
         for (i, &(b, p)) in self.bar_gps.iter().enumerate() {
             let bar = &model.bars[b];
-            if self.bar_time[i].is_none()
-                && self.bar_phase[b] != BarPhase::Inactive
+            if self.families.bars.time[i].is_none()
+                && self.families.bars.phase[b] != BarPhase::Inactive
                 && is_tendon(bar)
             {
-                self.bar_time[i] = Some(BarPointTime::new(bar, bar.bonding_stress(p)));
+                self.families.bars.time[i] = Some(BarPointTime::new(bar, bar.bonding_stress(p)));
             }
         }
     }
@@ -112,7 +112,7 @@ impl System<'_> {
     /// (from the committed chain states, so a cut increment calls this again).
     pub(crate) fn begin_bonded_time(&mut self, dt: f64) {
         self.ensure_bar_records();
-        for rec in self.bar_time.iter_mut().flatten() {
+        for rec in self.families.bars.time.iter_mut().flatten() {
             rec.relax_drop = 0.0;
             rec.relax_strain_trial = rec.relax_strain;
             let (Some(c), true) = (&rec.chain, dt > 0.0) else {
@@ -134,7 +134,13 @@ impl System<'_> {
     /// committed ones): the loss split and the relaxation chains.
     pub(crate) fn commit_bonded_time(&mut self, dt: f64) {
         self.ensure_bar_records();
-        for (rec, out) in self.bar_time.iter_mut().zip(&self.bar_out_trial) {
+        for (rec, out) in self
+            .families
+            .bars
+            .time
+            .iter_mut()
+            .zip(&self.families.bars.out.trial)
+        {
             let Some(rec) = rec else { continue };
             let d_sigma = out.stress - rec.stress;
             if dt > 0.0 {
@@ -163,7 +169,9 @@ impl System<'_> {
             if b != bar {
                 continue;
             }
-            let v = self.bar_time[i].as_ref().map_or(0.0, |r| r.loss(part));
+            let v = self.families.bars.time[i]
+                .as_ref()
+                .map_or(0.0, |r| r.loss(part));
             match point {
                 Some(q) if q == p => return v,
                 Some(_) => {}

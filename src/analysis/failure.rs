@@ -162,12 +162,26 @@ pub(crate) fn report(sys: &System, at: FailedAt, failure: &NewtonFailure) -> Fai
         .map(|t| t.name.clone())
         .collect();
     let (mut new_cracks, mut new_crushed) = (0, 0);
-    for (c, t) in sys.committed.iter().zip(&sys.trial) {
+    for (c, t) in sys
+        .families
+        .continuum
+        .points
+        .committed
+        .iter()
+        .zip(&sys.families.continuum.points.trial)
+    {
         new_cracks += usize::from(t.n_cracks() > c.n_cracks());
         new_crushed += usize::from(t.is_crushed() && !c.is_crushed());
     }
     let (mut switched, mut sliding) = (0, 0);
-    for (c, t) in sys.iface_committed.iter().zip(&sys.iface_trial) {
+    for (c, t) in sys
+        .families
+        .joints
+        .points
+        .committed
+        .iter()
+        .zip(&sys.families.joints.points.trial)
+    {
         for (a, b) in c.iter().zip(t) {
             switched += usize::from(a.closed != b.closed);
             sliding += usize::from(b.sliding && !a.sliding);
@@ -313,7 +327,14 @@ impl fmt::Display for FailureReport {
 /// many are latched for the rest of the increment.
 pub(crate) fn census(sys: &System, residual: &[f64]) -> String {
     let (mut cracked, mut crushed, mut plastic) = (0, 0, 0);
-    for (c, t) in sys.committed.iter().zip(&sys.trial) {
+    for (c, t) in sys
+        .families
+        .continuum
+        .points
+        .committed
+        .iter()
+        .zip(&sys.families.continuum.points.trial)
+    {
         cracked += usize::from(t.n_cracks() > c.n_cracks());
         crushed += usize::from(t.is_crushed() && !c.is_crushed());
         if let (Some(c), Some(t)) = (c.concrete(), t.concrete()) {
@@ -332,6 +353,6 @@ pub(crate) fn census(sys: &System, residual: &[f64]) -> String {
         .unwrap_or_default();
     format!(
         "{cracked} newly cracked, {crushed} newly crushed, {plastic} flowing, {} latched{worst}",
-        sys.latched.len()
+        sys.families.continuum.holds.latched.len()
     )
 }

@@ -2,10 +2,12 @@
 
 pub mod bonded_time;
 pub mod failure;
+pub mod families;
 pub mod loads;
 pub mod ordering;
 pub mod path;
 pub mod solver;
+pub mod staged;
 pub mod state;
 pub mod steps;
 pub mod system;

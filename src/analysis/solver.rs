@@ -13,6 +13,13 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
+pub use crate::fem::pattern::LowerPattern;
+
+/// faer's view of a lower-triangle pattern.
+fn symbolic(p: &LowerPattern) -> SymbolicSparseColMatRef<'_, usize> {
+    SymbolicSparseColMatRef::new_checked(p.n, p.n, &p.col_ptr, None, &p.row_idx)
+}
+
 /// Why a factorisation or solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolverError {
@@ -29,48 +36,6 @@ pub enum SolverError {
     /// point, or a mechanism).
     #[error("stiffness matrix is singular (zero pivot in LDLᵀ)")]
     Singular,
-}
-
-/// Compressed sparse column pattern of the lower triangle of a symmetric matrix.
-#[derive(Debug, Clone)]
-pub struct LowerPattern {
-    /// Matrix order.
-    pub n: usize,
-    /// Column pointers (length n + 1).
-    pub col_ptr: Vec<usize>,
-    /// Row indices, sorted within each column, all ≥ the column index.
-    pub row_idx: Vec<usize>,
-}
-
-impl LowerPattern {
-    /// Number of stored entries.
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
-    /// Position of entry (i, j) with i ≥ j in the value array, if stored.
-    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
-        let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
-        self.row_idx[a..b].binary_search(&i).ok().map(|p| a + p)
-    }
-
-    fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
-        SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
-    }
-
-    /// y = A x for the symmetric matrix whose lower triangle has `values`.
-    pub fn sym_mul(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
-        y.iter_mut().for_each(|v| *v = 0.0);
-        for j in 0..self.n {
-            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
-                let i = self.row_idx[p];
-                y[i] += values[p] * x[j];
-                if i != j {
-                    y[j] += values[p] * x[i];
-                }
-            }
-        }
-    }
 }
 
 /// Timing and size figures of the solver, for summaries and benchmarks.
@@ -283,7 +248,7 @@ impl SparseCholesky {
             None => SymmetricOrdering::Amd,
         };
         let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(),
+            symbolic(pattern),
             Side::Lower,
             ordering,
             CholeskySymbolicParams {
@@ -357,7 +322,7 @@ impl SparseCholesky {
                 p.fill(values);
                 SparseColMatRef::new(p.pattern.as_ref(), &p.values)
             }
-            None => SparseColMatRef::new(pattern.symbolic(), values),
+            None => SparseColMatRef::new(symbolic(pattern), values),
         };
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_llt(
@@ -478,7 +443,7 @@ impl SparseCholesky {
         self.factor = Factor::None;
         let a = match self.pre.as_ref() {
             Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
-            None => SparseColMatRef::new(pattern.symbolic(), values),
+            None => SparseColMatRef::new(symbolic(pattern), values),
         };
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_ldlt(

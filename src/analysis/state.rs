@@ -7,14 +7,9 @@
 //! states equal the committed ones, no crack is latched, and every factorisation is
 //! recomputed from the same matrix.
 
-use super::bonded_time::BarPointTime;
-use super::system::{BarOutput, BarPhase, System};
-use super::time::TendonTime;
-use crate::elements::continuum::GaussOutput;
-use crate::elements::interface::InterfacePointState;
-use crate::elements::tendon::TendonState;
-use crate::materials::point::{PointState, TimeContext};
-use crate::materials::steel::SteelState;
+use super::families::Families;
+use super::system::System;
+use crate::materials::point::TimeContext;
 use serde::{Deserialize, Serialize};
 
 /// Where the step driver stands between two steps.
@@ -38,66 +33,28 @@ pub struct DriverState {
     pub limit_points: Vec<String>,
 }
 
-/// A stressed tendon: its nodes' displacements when stressed [m], current initial strains
-/// (after relaxation) [-], committed state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SavedTendon {
-    /// Displacements of the tendon nodes at stressing [m].
-    pub u0: Vec<[f64; 2]>,
-    /// Initial span strains ε0 in force [-].
-    pub initial_strains: Vec<f64>,
-    /// Committed state.
-    pub state: TendonState,
-}
-
-/// The committed state of a [`System`] (owned; read from a checkpoint).
+/// The committed state of a [`System`] (owned; read from a checkpoint): the displacements,
+/// the clock of the last increment and the family blocks as they are ([`Families`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct SystemState {
     /// Displacements (all dofs) [m].
     pub u: Vec<f64>,
-    /// Material point states.
-    pub committed: Vec<PointState>,
-    /// Gauss-point outputs.
-    pub gauss: Vec<GaussOutput>,
-    /// Joint point states per interface element.
-    pub iface: Vec<Vec<InterfacePointState>>,
-    /// Tendons (None: not stressed yet).
-    pub tendons: Vec<Option<SavedTendon>>,
-    /// Relaxation and loss records of the tendons.
-    pub tendon_time: Vec<Option<TendonTime>>,
-    /// Steel states of the bar points.
-    pub bar_committed: Vec<SteelState>,
-    /// Bar outputs.
-    pub bar_out: Vec<BarOutput>,
-    /// Stage of each bar or bonded tendon.
-    pub bar_phase: Vec<BarPhase>,
-    /// Bar-point strain at grouting (bonded post-tensioned tendons) [-].
-    pub bar_eps_ref: Vec<f64>,
-    /// Time interval of the last increment [d].
-    pub time: TimeContext,
     /// Displacements before the last committed increment [m].
     pub u_prev: Vec<f64>,
-    /// Relaxation and loss records of the bonded-tendon points.
-    pub bar_time: Vec<Option<BarPointTime>>,
+    /// Time interval of the last increment [d].
+    pub time: TimeContext,
+    /// The element families' states.
+    pub families: Families,
 }
 
-/// The committed state of a [`System`], borrowed for writing. Same fields in the same order
-/// as [`SystemState`], so the encodings agree.
+/// The committed state of a [`System`], borrowed for writing: the fields of
+/// [`SystemState`] in the same order (a test reads one back as the other).
 #[derive(Serialize)]
 pub struct SystemStateRef<'a> {
     u: &'a [f64],
-    committed: &'a [PointState],
-    gauss: &'a [GaussOutput],
-    iface: &'a [Vec<InterfacePointState>],
-    tendons: Vec<Option<SavedTendon>>,
-    tendon_time: &'a [Option<TendonTime>],
-    bar_committed: &'a [SteelState],
-    bar_out: &'a [BarOutput],
-    bar_phase: &'a [BarPhase],
-    bar_eps_ref: &'a [f64],
-    time: TimeContext,
     u_prev: &'a [f64],
-    bar_time: &'a [Option<BarPointTime>],
+    time: TimeContext,
+    families: &'a Families,
 }
 
 impl System<'_> {
@@ -105,31 +62,9 @@ impl System<'_> {
     pub fn state(&self) -> SystemStateRef<'_> {
         SystemStateRef {
             u: &self.u,
-            committed: &self.committed,
-            gauss: &self.gauss,
-            iface: &self.iface_committed,
-            tendons: self
-                .tendons
-                .iter()
-                .zip(&self.tendon_u0)
-                .zip(&self.tendon_committed)
-                .map(|((el, u0), st)| match (el, st) {
-                    (Some(el), Some(st)) => Some(SavedTendon {
-                        u0: u0.clone(),
-                        initial_strains: el.initial_strains().to_vec(),
-                        state: st.clone(),
-                    }),
-                    _ => None,
-                })
-                .collect(),
-            tendon_time: &self.tendon_time,
-            bar_committed: &self.bar_committed,
-            bar_out: &self.bar_out,
-            bar_phase: &self.bar_phase,
-            bar_eps_ref: &self.bar_eps_ref,
-            time: self.time,
             u_prev: &self.u_prev,
-            bar_time: &self.bar_time,
+            time: self.time,
+            families: &self.families,
         }
     }
 
@@ -145,32 +80,57 @@ impl System<'_> {
                 ))
             }
         };
+        let (new, old) = (&s.families, &self.families);
         check("dofs", s.u.len(), self.u.len())?;
-        check("material points", s.committed.len(), self.committed.len())?;
-        check("Gauss outputs", s.gauss.len(), self.gauss.len())?;
-        check("joint elements", s.iface.len(), self.iface_committed.len())?;
-        for (a, b) in s.iface.iter().zip(&self.iface_committed) {
+        check("dofs (previous)", s.u_prev.len(), self.u_prev.len())?;
+        let (nc, oc) = (&new.continuum, &old.continuum);
+        check(
+            "material points",
+            nc.points.committed.len(),
+            oc.points.committed.len(),
+        )?;
+        check(
+            "Gauss outputs",
+            nc.gauss.committed.len(),
+            oc.gauss.committed.len(),
+        )?;
+        let (nj, oj) = (&new.joints.points.committed, &old.joints.points.committed);
+        check("joint elements", nj.len(), oj.len())?;
+        for (a, b) in nj.iter().zip(oj) {
             check("joint points in an element", a.len(), b.len())?;
         }
-        check("tendons", s.tendons.len(), self.tendons.len())?;
+        let (nt, ot) = (&new.tendons, &old.tendons);
         check(
-            "tendon records",
-            s.tendon_time.len(),
-            self.tendon_time.len(),
+            "tendons",
+            nt.states.committed.len(),
+            ot.states.committed.len(),
         )?;
+        check("tendon displacements", nt.u0.len(), ot.u0.len())?;
+        check(
+            "tendon strains",
+            nt.initial_strains.len(),
+            ot.initial_strains.len(),
+        )?;
+        check("tendon records", nt.time.len(), ot.time.len())?;
+        let (nb, ob) = (&new.bars, &old.bars);
         check(
             "bar points",
-            s.bar_committed.len(),
-            self.bar_committed.len(),
+            nb.steel.committed.len(),
+            ob.steel.committed.len(),
         )?;
-        check("bar outputs", s.bar_out.len(), self.bar_out.len())?;
-        check("bars", s.bar_phase.len(), self.bar_phase.len())?;
-        check("bar strains", s.bar_eps_ref.len(), self.bar_eps_ref.len())?;
-        check("bar records", s.bar_time.len(), self.bar_time.len())?;
-        if let Some(p) = s
+        check(
+            "bar outputs",
+            nb.out.committed.len(),
+            ob.out.committed.len(),
+        )?;
+        check("bars", nb.phase.len(), ob.phase.len())?;
+        check("bar strains", nb.eps_ref.len(), ob.eps_ref.len())?;
+        check("bar records", nb.time.len(), ob.time.len())?;
+        if let Some(p) = nc
+            .points
             .committed
             .iter()
-            .zip(&self.committed)
+            .zip(&oc.points.committed)
             .position(|(a, b)| std::mem::discriminant(a) != std::mem::discriminant(b))
         {
             return Err(format!(
@@ -178,49 +138,168 @@ impl System<'_> {
                 p + 1
             ));
         }
-        for (t, saved) in s.tendons.iter().enumerate() {
+        for (t, saved) in nt.states.committed.iter().enumerate() {
             let Some(saved) = saved else { continue };
             let n = self.model.tendons[t].nodes.len();
-            check("tendon nodes", saved.u0.len(), n)?;
-            check("tendon spans", saved.initial_strains.len(), n - 1)?;
-            check("tendon span states", saved.state.spans.len(), n - 1)?;
+            check("tendon nodes", nt.u0[t].len(), n)?;
+            check("tendon spans", nt.initial_strains[t].len(), n - 1)?;
+            check("tendon span states", saved.spans.len(), n - 1)?;
+        }
+        // The tendon elements are rebuilt on the geometry they were stressed on, with the
+        // initial strains they had.
+        for t in 0..self.tendons.len() {
+            self.tendons[t] = s.families.tendons.states.committed[t].as_ref().map(|_| {
+                let tb = &s.families.tendons;
+                let mut el = self.build_tendon(t, &tb.u0[t]);
+                el.set_initial_strains(&tb.initial_strains[t]);
+                el
+            });
         }
         self.u = s.u;
         self.u_prev = s.u_prev;
-        self.trial.clone_from(&s.committed);
-        self.committed = s.committed;
-        self.gauss_trial.clone_from(&s.gauss);
-        self.gauss = s.gauss;
-        self.iface_trial.clone_from(&s.iface);
-        self.iface_committed = s.iface;
-        for (t, saved) in s.tendons.into_iter().enumerate() {
-            match saved {
-                Some(saved) => {
-                    let mut el = self.build_tendon(t, &saved.u0);
-                    el.set_initial_strains(&saved.initial_strains);
-                    self.tendons[t] = Some(el);
-                    self.tendon_u0[t] = saved.u0;
-                    self.tendon_trial[t] = Some(saved.state.clone());
-                    self.tendon_committed[t] = Some(saved.state);
-                }
-                None => {
-                    self.tendons[t] = None;
-                    self.tendon_u0[t] = Vec::new();
-                    self.tendon_trial[t] = None;
-                    self.tendon_committed[t] = None;
-                }
-            }
-        }
-        self.tendon_time = s.tendon_time;
-        self.bar_trial.clone_from(&s.bar_committed);
-        self.bar_committed = s.bar_committed;
-        self.bar_out_trial.clone_from(&s.bar_out);
-        self.bar_out = s.bar_out;
-        self.bar_phase = s.bar_phase;
-        self.bar_eps_ref = s.bar_eps_ref;
-        self.bar_time = s.bar_time;
         self.time = s.time;
-        self.latched.clear();
+        self.families = s.families;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod layout {
+    //! A state with one of everything (every family, every point-state kind, every optional
+    //! record present), for the checkpoint layout test: its encoding changes whenever a
+    //! saved type gains, loses or reorders a field.
+
+    use super::*;
+    use crate::analysis::bonded_time::BarPointTime;
+    use crate::analysis::families::*;
+    use crate::analysis::staged::Staged;
+    use crate::analysis::time::{SpanTime, TendonTime};
+    use crate::elements::continuum::GaussOutput;
+    use crate::elements::interface::InterfacePointState;
+    use crate::elements::tendon::{LawState, SpanState, TendonState};
+    use crate::materials::chain::{ChainState, SteelRelaxationChain};
+    use crate::materials::point::PointState;
+    use crate::materials::steel::SteelState;
+
+    /// The sample state.
+    pub(crate) fn sample() -> SystemState {
+        let chain = SteelRelaxationChain {
+            ep: 1.95e11,
+            taus: vec![1.0, f64::INFINITY],
+            fractions: vec![0.25, 0.75],
+        };
+        let joint = InterfacePointState {
+            plastic_slip: 1.0,
+            bonded: true,
+            closed: true,
+            sliding: false,
+            lambda: 2.0,
+            slip: 3.0,
+            normal_stress: 4.0,
+            shear_stress: 5.0,
+            position: [6.0, 7.0],
+            arc: 8.0,
+        };
+        let span = SpanState {
+            strain: 1.0,
+            stress: 2.0,
+            force: 3.0,
+            length: 4.0,
+            law: LawState::default(),
+        };
+        let span_time = SpanTime {
+            sigma_initial: 1.0,
+            eps0: 2.0,
+            relax_strain: 3.0,
+            relax_strain_trial: 4.0,
+            steel_strain: 5.0,
+            hidden: vec![6.0],
+            relax_drop: 7.0,
+            loss_elastic: 8.0,
+            loss_creep: 9.0,
+            loss_relax: 10.0,
+        };
+        let bar_time = BarPointTime {
+            sigma_initial: 1.0,
+            stress: 2.0,
+            relax_strain: 3.0,
+            relax_strain_trial: 4.0,
+            steel_strain: 5.0,
+            chain: Some(chain.clone()),
+            hidden: vec![6.0],
+            relax_drop: 7.0,
+            loss_elastic: 8.0,
+            loss_creep: 9.0,
+            loss_relax: 10.0,
+        };
+        SystemState {
+            u: vec![1.0, 2.0],
+            u_prev: vec![3.0, 4.0],
+            time: TimeContext {
+                t_from: 1.0,
+                t_to: 2.0,
+                extrapolation: 0.5,
+            },
+            families: Families {
+                continuum: ContinuumBlock {
+                    points: Staged::new(vec![
+                        PointState::Elastic,
+                        PointState::Concrete(Box::default()),
+                        PointState::Ageing {
+                            chain: ChainState {
+                                hidden: vec![[1.0, 2.0, 3.0]],
+                            },
+                            strain: [4.0, 5.0, 6.0],
+                        },
+                    ]),
+                    gauss: Staged::new(vec![GaussOutput::default(); 3]),
+                    holds: Holds::default(),
+                },
+                joints: JointBlock {
+                    points: Staged::new(vec![vec![joint]]),
+                },
+                tendons: TendonBlock {
+                    u0: vec![vec![[1.0, 2.0], [3.0, 4.0]]],
+                    initial_strains: vec![vec![5.0]],
+                    states: Staged::new(vec![Some(TendonState {
+                        spans: vec![span],
+                        slips: vec![1.0],
+                        slipping: vec![-1],
+                    })]),
+                    time: vec![Some(TendonTime {
+                        spans: vec![span_time],
+                        chains: vec![Some(chain)],
+                        lengths: vec![1.0],
+                    })],
+                },
+                bars: BarBlock {
+                    steel: Staged::new(vec![SteelState::default()]),
+                    out: Staged::new(vec![BarOutput::default()]),
+                    phase: vec![BarPhase::Inactive, BarPhase::Locked, BarPhase::Bonded],
+                    eps_ref: vec![1.0],
+                    time: vec![Some(bar_time)],
+                },
+            },
+        }
+    }
+
+    /// The writer's view of `s`.
+    pub(crate) fn as_ref(s: &SystemState) -> SystemStateRef<'_> {
+        SystemStateRef {
+            u: &s.u,
+            u_prev: &s.u_prev,
+            time: s.time,
+            families: &s.families,
+        }
+    }
+
+    /// What is written can be read back, equal: the borrowed writer and the owned reader
+    /// agree field for field.
+    #[test]
+    fn writer_and_reader_agree() {
+        let s = sample();
+        let bytes = postcard::to_stdvec(&as_ref(&s)).unwrap();
+        let back: SystemState = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(back, s);
     }
 }

@@ -4,13 +4,18 @@
 use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState};
-use crate::elements::tendon::{ExternalTendon, TendonLaw, TendonState};
+use crate::elements::tendon::{ExternalTendon, TendonLaw};
 use crate::elements::total_lagrangian;
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
 use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext, UpdateError};
 use crate::materials::steel::{update_uniaxial, SteelState};
 use crate::model::{Geometry, Model};
+
+use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBlock};
+pub use super::families::{BarOutput, BarPhase};
+use super::staged::Staged;
+use crate::fem::numbering::{ElementNumbers, Family};
 use rayon::prelude::*;
 
 /// Elements per parallel chunk: large enough to amortise scheduling, small enough to keep the
@@ -32,101 +37,35 @@ pub struct System<'m> {
     pub ordering_s: f64,
     /// Offset of each element's first Gauss point in the state arrays.
     pub gp_offset: Vec<usize>,
+    /// Assembler numbers of the elements, one block per family.
+    pub numbers: ElementNumbers,
     /// Committed displacements (all dofs) [m].
     pub u: Vec<f64>,
     /// Displacements before the last committed increment [m] (its size sets the history
     /// extrapolation of the next increment).
     pub u_prev: Vec<f64>,
-    /// Committed point states.
-    pub committed: Vec<PointState>,
-    /// Trial point states (of the last assembly).
-    pub trial: Vec<PointState>,
-    /// Committed Gauss outputs (strain, stress).
-    pub gauss: Vec<GaussOutput>,
-    /// Trial Gauss outputs.
-    pub gauss_trial: Vec<GaussOutput>,
+    /// Time interval of the current increment on the analysis clock [d].
+    pub time: TimeContext,
+    /// The state of every element family (committed and trial).
+    pub families: Families,
     /// True if every material is linear, the geometry is linear and there are no joints
     /// (tangent constant).
     pub linear: bool,
     /// Joint contact elements (geometry from the contact search, done once).
     pub interfaces: Vec<InterfaceElement>,
-    /// Committed joint integration-point states.
-    pub iface_committed: Vec<Vec<InterfacePointState>>,
-    /// Trial joint states (of the last assembly).
-    pub iface_trial: Vec<Vec<InterfacePointState>>,
     /// True if the last assembled tangent was made symmetric (friction slip).
     pub symmetrised: bool,
     /// External tendons, built when stressed (None before).
     pub tendons: Vec<Option<ExternalTendon>>,
-    /// Displacements of each tendon's nodes when it was stressed [m].
-    pub tendon_u0: Vec<Vec<[f64; 2]>>,
-    /// Committed tendon states.
-    pub tendon_committed: Vec<Option<TendonState>>,
-    /// Trial tendon states.
-    pub tendon_trial: Vec<Option<TendonState>>,
     /// Embedded-bar integration points sorted by host element: (bar index, point index in
     /// the bar). Element e owns `bar_gps[bar_offset[e]..bar_offset[e + 1]]`.
     pub bar_gps: Vec<(usize, usize)>,
     /// Offsets of each element's bar points in `bar_gps` and the bar state arrays.
     pub bar_offset: Vec<usize>,
-    /// Committed steel states of the bar points (order of `bar_gps`).
-    pub bar_committed: Vec<SteelState>,
-    /// Trial steel states (of the last assembly).
-    pub bar_trial: Vec<SteelState>,
-    /// Committed bar outputs (order of `bar_gps`).
-    pub bar_out: Vec<BarOutput>,
-    /// Trial bar outputs.
-    pub bar_out_trial: Vec<BarOutput>,
-    /// Points whose crack formed during the current increment, with the state their
-    /// updates start from until the increment ends (sorted by point index; see
-    /// [`crate::materials::point::crack_base`]).
-    pub latched: Vec<(usize, PointState)>,
-    /// True once the crack branches were frozen in the current increment.
-    pub frozen: bool,
-    /// Some point was held on the plastic route in this increment (commit clears the holds).
-    pub held_plastic: bool,
-    /// Time interval of the current increment on the analysis clock [d].
-    pub time: TimeContext,
-    /// Relaxation and loss records of the stressed tendons (see `analysis::time`).
-    pub tendon_time: Vec<Option<super::time::TendonTime>>,
-    /// Stage of each bar (index = bar): bars and pre-tensioned tendons are bonded from the
-    /// start, post-tensioned tendons go through the stages at their steps.
-    pub bar_phase: Vec<BarPhase>,
-    /// Bond strain T B u_e of each bar point when it became bonded [-] (order of `bar_gps`;
-    /// 0 for bars bonded from the start): the bar strain is measured from it.
-    pub bar_eps_ref: Vec<f64>,
-    /// Relaxation and loss records of the bonded-tendon points (order of `bar_gps`; None
-    /// for plain bars and tendons not yet stressed; see `analysis::bonded_time`).
-    pub bar_time: Vec<Option<super::bonded_time::BarPointTime>>,
     /// Element force vectors and matrices of one chunk, kept between assemblies (every
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
     elem_buf: (Vec<f64>, Vec<f64>),
-}
-
-/// Stage of an embedded bar or bonded tendon.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum BarPhase {
-    /// Post-tensioned tendon not yet stressed: absent.
-    Inactive,
-    /// Post-tensioned tendon stressed and locked off, duct not grouted: it loads the concrete
-    /// with its lock-off stresses (the equivalent prestressing forces, seed eq. 24–26) and
-    /// has no stiffness; its stress is held (changes of an ungrouted tendon are neglected).
-    Locked,
-    /// Bonded (perfect bond): stress from the bond strain measured since bonding plus the
-    /// bonding stress.
-    Bonded,
-}
-
-/// Values at one bar integration point for output.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BarOutput {
-    /// Total bar strain including the prestrain σ_b,0/E_s [-].
-    pub strain: f64,
-    /// Bar stress [Pa].
-    pub stress: f64,
-    /// Plastic strain [-].
-    pub plastic_strain: f64,
 }
 
 /// One embedded-bar point of a host element under the total Lagrangian kinematics.
@@ -243,13 +182,24 @@ impl<'m> System<'m> {
             .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
             .collect();
         let dofs = DofMap::new(model.nodes.len(), &constrained);
-        let elem_nodes: Vec<Vec<usize>> = model
-            .elements
+        // The node lists in family order: the assembler's element numbers are the blocks of
+        // `numbers`, which `assemble` uses to add the element matrices.
+        let numbers = ElementNumbers::new([
+            model.elements.len(),
+            model.interfaces.len(),
+            model.tendons.len(),
+        ]);
+        let elem_nodes: Vec<Vec<usize>> = Family::ALL
             .iter()
-            .map(|e| e.nodes.clone())
-            .chain(model.interfaces.iter().map(|i| i.nodes.clone()))
-            .chain(model.tendons.iter().map(|t| t.nodes.clone()))
+            .flat_map(|f| -> Box<dyn Iterator<Item = Vec<usize>>> {
+                match f {
+                    Family::Continuum => Box::new(model.elements.iter().map(|e| e.nodes.clone())),
+                    Family::Joint => Box::new(model.interfaces.iter().map(|i| i.nodes.clone())),
+                    Family::Tendon => Box::new(model.tendons.iter().map(|t| t.nodes.clone())),
+                }
+            })
             .collect();
+        assert_eq!(elem_nodes.len(), numbers.total());
         let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
         let t_order = std::time::Instant::now();
         // Nested dissection only on meshes of 4-node elements: with the mid-side nodes of
@@ -315,6 +265,37 @@ impl<'m> System<'m> {
             bar_offset[e + 1] += bar_offset[e];
         }
         let n_bp = bar_gps.len();
+        let n_tendons = model.tendons.len();
+        let families = Families {
+            continuum: ContinuumBlock {
+                points: Staged::new(committed),
+                gauss: Staged::new(vec![GaussOutput::default(); n_gp]),
+                holds: Default::default(),
+            },
+            joints: JointBlock {
+                points: Staged::new(iface_committed),
+            },
+            tendons: TendonBlock {
+                u0: vec![Vec::new(); n_tendons],
+                initial_strains: vec![Vec::new(); n_tendons],
+                states: Staged::new(vec![None; n_tendons]),
+                time: vec![None; n_tendons],
+            },
+            bars: BarBlock {
+                steel: Staged::new(vec![SteelState::new(); n_bp]),
+                out: Staged::new(vec![BarOutput::default(); n_bp]),
+                phase: model
+                    .bars
+                    .iter()
+                    .map(|b| match b.post_tension {
+                        Some(_) => BarPhase::Inactive,
+                        None => BarPhase::Bonded,
+                    })
+                    .collect(),
+                eps_ref: vec![0.0; n_bp],
+                time: vec![None; n_bp],
+            },
+        };
         Self {
             model,
             dofs,
@@ -322,42 +303,17 @@ impl<'m> System<'m> {
             ordering,
             ordering_s,
             gp_offset,
+            numbers,
             u: vec![0.0; model.n_dofs()],
             u_prev: vec![0.0; model.n_dofs()],
-            trial: committed.clone(),
-            committed,
-            gauss: vec![GaussOutput::default(); n_gp],
-            gauss_trial: vec![GaussOutput::default(); n_gp],
+            time: TimeContext::default(),
+            families,
             linear,
-            iface_trial: iface_committed.clone(),
-            iface_committed,
             interfaces,
             symmetrised: false,
-            tendons: vec![None; model.tendons.len()],
-            tendon_u0: vec![Vec::new(); model.tendons.len()],
-            tendon_committed: vec![None; model.tendons.len()],
-            tendon_trial: vec![None; model.tendons.len()],
+            tendons: vec![None; n_tendons],
             bar_gps,
             bar_offset,
-            bar_committed: vec![SteelState::new(); n_bp],
-            bar_trial: vec![SteelState::new(); n_bp],
-            bar_out: vec![BarOutput::default(); n_bp],
-            bar_out_trial: vec![BarOutput::default(); n_bp],
-            latched: Vec::new(),
-            frozen: false,
-            held_plastic: false,
-            time: TimeContext::default(),
-            tendon_time: vec![None; model.tendons.len()],
-            bar_phase: model
-                .bars
-                .iter()
-                .map(|b| match b.post_tension {
-                    Some(_) => BarPhase::Inactive,
-                    None => BarPhase::Bonded,
-                })
-                .collect(),
-            bar_eps_ref: vec![0.0; n_bp],
-            bar_time: vec![None; n_bp],
             elem_buf: (Vec::new(), Vec::new()),
         }
     }
@@ -366,6 +322,7 @@ impl<'m> System<'m> {
     /// `unlatch`). Returns the number of newly latched points.
     pub fn latch_cracks(&mut self) -> usize {
         let model = self.model;
+        let c = &mut self.families.continuum;
         let mut new = Vec::new();
         for (e, el) in model.elements.iter().enumerate() {
             let mat = &model.materials[model.regions[el.region].material].law;
@@ -373,29 +330,31 @@ impl<'m> System<'m> {
                 continue;
             }
             for g in self.gp_offset[e]..self.gp_offset[e + 1] {
-                if self.latched.binary_search_by_key(&g, |x| x.0).is_ok() {
+                if c.holds.latched.binary_search_by_key(&g, |x| x.0).is_ok() {
                     continue;
                 }
-                if let Some(b) = crack_base(mat, &self.committed[g], &self.trial[g]) {
+                let (committed, trial) = (&c.points.committed[g], &c.points.trial[g]);
+                if let Some(b) = crack_base(mat, committed, trial) {
                     new.push((g, b));
-                } else if let Some(b) = plastic_base(&self.committed[g], &self.trial[g]) {
-                    self.held_plastic = true;
+                } else if let Some(b) = plastic_base(committed, trial) {
+                    c.holds.held_plastic = true;
                     new.push((g, b));
                 }
             }
         }
         let n = new.len();
         if n > 0 {
-            self.latched.extend(new);
-            self.latched.sort_by_key(|x| x.0);
+            c.holds.latched.extend(new);
+            c.holds.latched.sort_by_key(|x| x.0);
         }
         n
     }
 
     /// Forget latched cracks (the increment is thrown away).
     pub fn unlatch(&mut self) {
-        self.latched.clear();
-        self.frozen = false;
+        let holds = &mut self.families.continuum.holds;
+        holds.latched.clear();
+        holds.frozen = false;
     }
 
     /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
@@ -403,25 +362,27 @@ impl<'m> System<'m> {
     /// drivers call it when their iterations cycle (`path::cycling`). At most once per
     /// increment. Returns the number of points held.
     pub fn freeze_cracks(&mut self) -> usize {
-        if self.frozen {
+        let c = &mut self.families.continuum;
+        if c.holds.frozen {
             return 0;
         }
-        self.frozen = true;
+        c.holds.frozen = true;
+        let latched = &mut c.holds.latched;
         let mut held = Vec::new();
-        for g in 0..self.trial.len() {
-            let base = match self.latched.binary_search_by_key(&g, |x| x.0) {
-                Ok(i) => &self.latched[i].1,
-                Err(_) => &self.committed[g],
+        for g in 0..c.points.trial.len() {
+            let base = match latched.binary_search_by_key(&g, |x| x.0) {
+                Ok(i) => &latched[i].1,
+                Err(_) => &c.points.committed[g],
             };
-            if let Some(f) = crate::materials::point::freeze_cracks(base, &self.trial[g]) {
+            if let Some(f) = crate::materials::point::freeze_cracks(base, &c.points.trial[g]) {
                 held.push((g, f));
             }
         }
         let count = held.len();
         for (g, f) in held {
-            match self.latched.binary_search_by_key(&g, |x| x.0) {
-                Ok(i) => self.latched[i].1 = f,
-                Err(i) => self.latched.insert(i, (g, f)),
+            match latched.binary_search_by_key(&g, |x| x.0) {
+                Ok(i) => latched[i].1 = f,
+                Err(i) => latched.insert(i, (g, f)),
             }
         }
         count
@@ -461,20 +422,21 @@ impl<'m> System<'m> {
             let end = (start + CHUNK).min(n_el);
             let g0 = self.gp_offset[start];
             let g1 = self.gp_offset[end];
-            let trial = &mut self.trial[g0..g1];
-            let gout = &mut self.gauss_trial[g0..g1];
-            let committed = &self.committed[g0..g1];
+            let (cont, bars) = (&mut self.families.continuum, &mut self.families.bars);
+            let trial = &mut cont.points.trial[g0..g1];
+            let gout = &mut cont.gauss.trial[g0..g1];
+            let committed = &cont.points.committed[g0..g1];
             let gp_offset = &self.gp_offset;
             let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
-            let bar_committed = &self.bar_committed[b0..b1];
+            let bar_committed = &bars.steel.committed[b0..b1];
             let bar_gps = &self.bar_gps;
-            let bar_phase = &self.bar_phase;
-            let bar_eps_ref = &self.bar_eps_ref[b0..b1];
-            let bar_time = &self.bar_time[b0..b1];
-            let latched = &self.latched;
+            let bar_phase = &bars.phase;
+            let bar_eps_ref = &bars.eps_ref[b0..b1];
+            let bar_time = &bars.time[b0..b1];
+            let latched = &cont.holds.latched;
             let bar_offset = &self.bar_offset;
             let (mut bt_rest, mut bo_rest) =
-                (&mut self.bar_trial[b0..b1], &mut self.bar_out_trial[b0..b1]);
+                (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
             // Per-element slices.
             let mut pieces = Vec::with_capacity(end - start);
             let (mut t_rest, mut o_rest) = (trial, gout);
@@ -662,19 +624,19 @@ impl<'m> System<'m> {
                     f_abs[2 * n + 1] += fe[2 * a + 1].abs();
                 }
                 if let Some(k) = k_values.as_mut() {
-                    self.asm.add_matrix(e, ke, k);
+                    self.asm
+                        .add_matrix(self.numbers.number(Family::Continuum, e), ke, k);
                 }
             }
             start = end;
         }
         self.elem_buf = (fbuf, kbuf);
         // Joint contact elements.
-        let n_cont = n_el;
         let results: Vec<_> = self
             .interfaces
             .par_iter()
             .zip(&model.interfaces)
-            .zip(&self.iface_committed)
+            .zip(&self.families.joints.points.committed)
             .map(|((el, data), committed)| {
                 let ue: Vec<f64> = data
                     .nodes
@@ -701,20 +663,21 @@ impl<'m> System<'m> {
                     symmetrise(&mut ke, 2 * nodes.len());
                     symmetrised = true;
                 }
-                self.asm.add_matrix(n_cont + i, &ke, k);
+                self.asm
+                    .add_matrix(self.numbers.number(Family::Joint, i), &ke, k);
             }
-            self.iface_trial[i] = r.states;
+            self.families.joints.points.trial[i] = r.states;
         }
         // External tendons (corotational: their forces follow the deformed geometry).
-        let n_before = n_cont + self.interfaces.len();
+        let tb = &mut self.families.tendons;
         for (t, tendon) in self.tendons.iter().enumerate() {
-            let (Some(el), Some(committed)) = (tendon, &self.tendon_committed[t]) else {
+            let (Some(el), Some(committed)) = (tendon, &tb.states.committed[t]) else {
                 continue;
             };
             let nodes = &model.tendons[t].nodes;
             let ut: Vec<[f64; 2]> = nodes
                 .iter()
-                .zip(&self.tendon_u0[t])
+                .zip(&tb.u0[t])
                 .map(|(&n, u0)| [u[2 * n] - u0[0], u[2 * n + 1] - u0[1]])
                 .collect();
             let r = el.response(&ut, committed);
@@ -730,9 +693,10 @@ impl<'m> System<'m> {
                     symmetrise(&mut ke, 2 * nodes.len());
                     symmetrised = true;
                 }
-                self.asm.add_matrix(n_before + t, &ke, k);
+                self.asm
+                    .add_matrix(self.numbers.number(Family::Tendon, t), &ke, k);
             }
-            self.tendon_trial[t] = Some(r.state);
+            tb.states.trial[t] = Some(r.state);
         }
         self.symmetrised = symmetrised;
         let force_scale = f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -759,11 +723,12 @@ impl<'m> System<'m> {
                 .map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
                 .collect();
             let el = self.build_tendon(t, &u0);
-            let st = el.initial_state();
-            self.tendon_committed[t] = Some(st.clone());
-            self.tendon_trial[t] = Some(st);
+            let tb = &mut self.families.tendons;
+            tb.states.committed[t] = Some(el.initial_state());
+            tb.states.trial[t] = Some(el.initial_state());
+            tb.initial_strains[t] = el.initial_strains().to_vec();
+            tb.u0[t] = u0;
             self.tendons[t] = Some(el);
-            self.tendon_u0[t] = u0;
         }
     }
 
@@ -774,10 +739,11 @@ impl<'m> System<'m> {
             let Some(pt) = &bar.post_tension else {
                 continue;
             };
-            if pt.stressed_in_step == step && self.bar_phase[b] == BarPhase::Inactive {
-                self.bar_phase[b] = BarPhase::Locked;
+            let bars = &mut self.families.bars;
+            if pt.stressed_in_step == step && bars.phase[b] == BarPhase::Inactive {
+                bars.phase[b] = BarPhase::Locked;
             }
-            if pt.grouted_in_step == Some(step) && self.bar_phase[b] == BarPhase::Locked {
+            if pt.grouted_in_step == Some(step) && bars.phase[b] == BarPhase::Locked {
                 // The grout bonds the tendon to the concrete as it now stands: strain
                 // increments from here on, starting from the locked-off stress.
                 for (i, &(bb, p)) in self.bar_gps.iter().enumerate() {
@@ -787,7 +753,7 @@ impl<'m> System<'m> {
                     let gp = &bar.points[p];
                     let el = &model.elements[gp.element];
                     let coords = model.element_coords(el);
-                    self.bar_eps_ref[i] = if model.geometry == Geometry::Nonlinear {
+                    bars.eps_ref[i] = if model.geometry == Geometry::Nonlinear {
                         let ue: Vec<f64> = el
                             .nodes
                             .iter()
@@ -805,7 +771,7 @@ impl<'m> System<'m> {
                             .sum()
                     };
                 }
-                self.bar_phase[b] = BarPhase::Bonded;
+                bars.phase[b] = BarPhase::Bonded;
             }
         }
     }
@@ -836,24 +802,7 @@ impl<'m> System<'m> {
         self.commit_time_dependent();
         std::mem::swap(&mut self.u, &mut self.u_prev);
         self.u.copy_from_slice(u);
-        std::mem::swap(&mut self.committed, &mut self.trial);
-        self.trial.clone_from(&self.committed);
-        std::mem::swap(&mut self.gauss, &mut self.gauss_trial);
-        self.iface_committed.clone_from(&self.iface_trial);
-        self.tendon_committed.clone_from(&self.tendon_trial);
-        self.bar_committed.clone_from(&self.bar_trial);
-        self.bar_out.clone_from(&self.bar_out_trial);
-        self.latched.clear();
-        // Held crack branches and plastic routes last one increment only.
-        let frozen = std::mem::take(&mut self.frozen);
-        if std::mem::take(&mut self.held_plastic) || frozen {
-            for st in self.committed.iter_mut() {
-                if let PointState::Concrete(c) = st {
-                    c.frozen = [0; 2];
-                    c.hold_plastic = false;
-                }
-            }
-        }
+        self.families.commit();
     }
 
     /// Gather the free-equation part of a full dof vector.

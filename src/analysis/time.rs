@@ -86,7 +86,7 @@ impl System<'_> {
             let Some(el) = self.tendons[t].as_ref() else {
                 continue;
             };
-            if self.tendon_time[t].is_none() {
+            if self.families.tendons.time[t].is_none() {
                 let data = &self.model.tendons[t];
                 let ep = el.modulus();
                 let chains: Vec<Option<SteelRelaxationChain>> = el
@@ -121,15 +121,15 @@ impl System<'_> {
                         loss_relax: 0.0,
                     })
                     .collect();
-                self.tendon_time[t] = Some(TendonTime {
+                self.families.tendons.time[t] = Some(TendonTime {
                     spans,
                     chains,
                     lengths: el.reference_lengths().to_vec(),
                 });
             }
             let (Some(tt), Some(committed)) = (
-                self.tendon_time[t].as_mut(),
-                self.tendon_committed[t].as_ref(),
+                self.families.tendons.time[t].as_mut(),
+                self.families.tendons.states.committed[t].as_ref(),
             ) else {
                 continue;
             };
@@ -155,9 +155,12 @@ impl System<'_> {
                 }
                 eps0.push(sp.eps0 - sp.relax_strain_trial);
             }
+            // The element computes with its copy; the family block keeps the one saved in
+            // checkpoints.
             if let Some(el) = self.tendons[t].as_mut() {
                 el.set_initial_strains(&eps0);
             }
+            self.families.tendons.initial_strains[t] = eps0;
         }
     }
 
@@ -166,11 +169,11 @@ impl System<'_> {
     pub(crate) fn commit_time_dependent(&mut self) {
         let dt = self.time.dt();
         self.commit_bonded_time(dt);
-        for t in 0..self.tendon_time.len() {
+        for t in 0..self.families.tendons.time.len() {
             let (Some(tt), Some(old), Some(new)) = (
-                self.tendon_time[t].as_mut(),
-                self.tendon_committed[t].as_ref(),
-                self.tendon_trial[t].as_ref(),
+                self.families.tendons.time[t].as_mut(),
+                self.families.tendons.states.committed[t].as_ref(),
+                self.families.tendons.states.trial[t].as_ref(),
             ) else {
                 continue;
             };

@@ -3,7 +3,7 @@
 //! refilling values is a scatter with no search and no allocation.
 
 use super::dofs::{DofMap, CONSTRAINED};
-use crate::analysis::solver::LowerPattern;
+use super::pattern::LowerPattern;
 use rayon::prelude::*;
 
 /// Position marker for an element matrix entry that is not assembled (constrained dof or
@@ -189,6 +189,12 @@ impl Assembler {
     #[inline]
     pub fn add_matrix(&self, e: usize, k: &[f64], values: &mut [f64]) {
         let s = &self.scatter[self.scatter_ptr[e]..self.scatter_ptr[e + 1]];
+        // A matrix of another size belongs to another element: a numbering error.
+        assert_eq!(
+            s.len(),
+            k.len(),
+            "element {e}: matrix size and scatter map differ"
+        );
         for (p, v) in s.iter().zip(k) {
             if *p != SKIP {
                 values[*p as usize] += v;

@@ -1,6 +1,8 @@
-//! Finite-element building blocks: quadrature, shape functions, dof numbering and assembly.
+//! Finite-element building blocks: quadrature, shape functions, dof numbering, sparse pattern and assembly.
 
 pub mod assembly;
 pub mod dofs;
+pub mod numbering;
+pub mod pattern;
 pub mod quadrature;
 pub mod shape;

@@ -82,6 +82,15 @@ impl Material {
         // Concrete is never linear.
         matches!(self, Material::Elastic { .. })
     }
+
+    /// Name of the kind, for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Material::Elastic { .. } => "elastic",
+            Material::Concrete { .. } => "concrete",
+            Material::AgeingViscoelastic { .. } => "ageing viscoelastic",
+        }
+    }
 }
 
 /// State of one integration point; committed and trial copies are kept by the caller.
@@ -101,6 +110,25 @@ pub enum PointState {
 }
 
 impl PointState {
+    /// Name of the kind, for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            PointState::Elastic => "elastic",
+            PointState::Concrete(_) => "concrete",
+            PointState::Ageing { .. } => "ageing viscoelastic",
+        }
+    }
+
+    /// End of an increment, on a committed state: the crack branches and plastic route held
+    /// within the increment (see [`freeze_cracks`] and [`plastic_base`]) are released, so
+    /// that the next increment starts free.
+    pub fn end_increment(&mut self) {
+        if let PointState::Concrete(c) = self {
+            c.frozen = [0; 2];
+            c.hold_plastic = false;
+        }
+    }
+
     /// The concrete state, if this is a concrete point.
     pub fn concrete(&self) -> Option<&ConcreteState> {
         match self {
@@ -285,11 +313,14 @@ pub fn update_with_time(
                 d,
             ))
         }
-        // States are created by `Material::initial_state`, so a mismatch is a programming
-        // error; report it as a failed update rather than panicking.
-        _ => Err(UpdateError::NotConverged(
-            "material and point state do not match".into(),
-        )),
+        // States come from `Material::initial_state` and a restored checkpoint is checked
+        // kind by kind (`System::restore`): a mismatch is a bug in segfem, not a reason to
+        // cut the step, so it must not come back as `NotConverged`.
+        (mat, st) => unreachable!(
+            "internal error: material {} met a point state of another kind ({}); please report",
+            mat.kind_name(),
+            st.kind_name()
+        ),
     }
 }
 

@@ -20,10 +20,18 @@ use std::path::Path;
 /// File name of the checkpoint in the output directory.
 pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &str = "segfem checkpoint";
-/// Format version; bumped whenever a saved structure changes (2: trailing checksum).
-const VERSION: u32 = 2;
+/// Format version; bumped whenever a saved structure changes (the test `layout_has_a_version`
+/// fails until it is). 2: trailing checksum; 3: state saved by element family.
+const VERSION: u32 = 3;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
+
+/// Every format version with the digest of its encoding of the layout sample
+/// (`analysis::state::layout::sample`), oldest first. A change of the saved state types
+/// changes the digest: append a line with the next version and the new digest, and set
+/// [`VERSION`] to it.
+#[cfg(test)]
+const LAYOUTS: &[(u32, u64)] = &[(3, 16_113_229_074_358_229_730)];
 
 #[derive(Serialize, Deserialize)]
 struct Header {
@@ -148,4 +156,31 @@ pub fn read(dir: &Path) -> Result<(Origin, Checkpoint), String> {
         },
         cp,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::state::layout;
+
+    /// The saved state's layout is the one recorded for the current format version: a change
+    /// of a saved type without a new version (and a new line in `LAYOUTS`) fails here.
+    #[test]
+    fn layout_has_a_version() {
+        let bytes = postcard::to_stdvec(&layout::as_ref(&layout::sample())).unwrap();
+        let now = digest(&bytes);
+        let &(last, recorded) = LAYOUTS.last().unwrap();
+        assert!(
+            LAYOUTS
+                .windows(2)
+                .all(|w| w[0].0 < w[1].0 && w[0].1 != w[1].1),
+            "LAYOUTS: versions must increase and each must have its own layout"
+        );
+        assert_eq!(last, VERSION, "the last line of LAYOUTS must be VERSION");
+        assert_eq!(
+            now, recorded,
+            "the checkpoint layout changed (digest {now}): bump VERSION and append ({}, {now}) to LAYOUTS",
+            VERSION + 1
+        );
+    }
 }

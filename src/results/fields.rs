@@ -37,7 +37,7 @@ pub fn recover(sys: &System) -> Fields {
         .par_iter()
         .enumerate()
         .map(|(e, el)| {
-            let g = &sys.gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+            let g = &sys.families.continuum.gauss.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
             let len = g.len() as f64;
             let (mut cs, mut ce) = ([0.0; 3], [0.0; 3]);
             for o in g {

@@ -43,7 +43,11 @@ pub fn summarise(sys: &System, j: usize) -> JointSummary {
     };
     for &i in &sys.model.joints[j].interfaces {
         let el = &sys.interfaces[i];
-        for (p, st) in el.points().iter().zip(&sys.iface_committed[i]) {
+        for (p, st) in el
+            .points()
+            .iter()
+            .zip(&sys.families.joints.points.committed[i])
+        {
             let closed = st.closed || st.bonded;
             if closed {
                 s.contact_depth += p.weight;

@@ -97,7 +97,7 @@ impl Plausibility {
                     for (p, st) in sys.interfaces[i]
                         .points()
                         .iter()
-                        .zip(&sys.iface_committed[i])
+                        .zip(&sys.families.joints.points.committed[i])
                     {
                         if !(st.closed || st.bonded) {
                             fn_ += st.normal_stress() * p.weight * t;

@@ -268,15 +268,20 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
-                MonitorKind::TendonStress { tendon, span } => snap.system.tendon_committed[*tendon]
-                    .as_ref()
-                    .map(|st| pick_span(st.stresses(), *span))
-                    .unwrap_or(0.0),
-                MonitorKind::TendonForce { tendon, span } => snap.system.tendon_committed[*tendon]
-                    .as_ref()
-                    .map(|st| pick_span(st.forces(), *span))
-                    .unwrap_or(0.0),
-                MonitorKind::TendonLoss { tendon, part } => snap.system.tendon_time[*tendon]
+                MonitorKind::TendonStress { tendon, span } => {
+                    snap.system.families.tendons.states.committed[*tendon]
+                        .as_ref()
+                        .map(|st| pick_span(st.stresses(), *span))
+                        .unwrap_or(0.0)
+                }
+                MonitorKind::TendonForce { tendon, span } => {
+                    snap.system.families.tendons.states.committed[*tendon]
+                        .as_ref()
+                        .map(|st| pick_span(st.forces(), *span))
+                        .unwrap_or(0.0)
+                }
+                MonitorKind::TendonLoss { tendon, part } => snap.system.families.tendons.time
+                    [*tendon]
                     .as_ref()
                     .map(|tt| tt.loss(*part))
                     .unwrap_or(0.0),
@@ -537,7 +542,7 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
         types.push(if face.len() == 3 { 21u8 } else { 3u8 });
         cells.push(face);
         kind.push(1);
-        let st = &sys.iface_committed[i];
+        let st = &sys.families.joints.points.committed[i];
         let n = st.len().max(1) as f64;
         opening.push(st.iter().map(|p| p.opening()).fold(0.0, f64::max));
         sn.push(st.iter().map(|p| p.normal_stress()).sum::<f64>() / n);
@@ -546,7 +551,7 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
         t_force.push(0.0);
     }
     for (t, data) in model.tendons.iter().enumerate() {
-        let state = sys.tendon_committed[t].as_ref();
+        let state = sys.families.tendons.states.committed[t].as_ref();
         for (k, w) in data.nodes.windows(2).enumerate() {
             cells.push(w.to_vec());
             types.push(3);
@@ -619,7 +624,7 @@ fn bar_stress(snap: &Snapshot, bar: usize, point: Option<usize>) -> f64 {
         if b != bar {
             continue;
         }
-        let s = sys.bar_out[i].stress;
+        let s = sys.families.bars.out.committed[i].stress;
         match point {
             Some(q) if q == p => return s,
             Some(_) => {}
@@ -644,7 +649,9 @@ fn region_points<'a>(
         .iter()
         .enumerate()
         .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
-        .flat_map(move |(i, _)| &sys.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]])
+        .flat_map(move |(i, _)| {
+            &sys.families.continuum.points.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]]
+        })
 }
 
 fn point_extreme(
@@ -704,7 +711,7 @@ fn cell_states(snap: &Snapshot) -> CellStates {
         crushed: Vec::with_capacity(n),
     };
     for e in 0..n {
-        let pts = &sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+        let pts = &sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
         c.cracks
             .push(pts.iter().map(|p| p.n_cracks()).max().unwrap_or(0) as i32);
         let widest = pts
@@ -740,7 +747,7 @@ fn bars_vtu(snap: &Snapshot) -> String {
         .map(|b| vec![Default::default(); b.points.len()])
         .collect();
     for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
-        vals[b][p] = sys.bar_out[i];
+        vals[b][p] = sys.families.bars.out.committed[i];
     }
     let mut points: Vec<[f64; 2]> = Vec::new();
     let mut cells: Vec<Vec<usize>> = Vec::new();

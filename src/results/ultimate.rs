@@ -159,7 +159,11 @@ impl UltimateWatch {
             negative_pivots: snap.negative_pivots,
         });
         if self.tendon_yield.is_none() {
-            for (t, st) in model.tendons.iter().zip(&sys.tendon_committed) {
+            for (t, st) in model
+                .tendons
+                .iter()
+                .zip(&sys.families.tendons.states.committed)
+            {
                 let Some(st) = st else { continue };
                 if let Some(s) = st
                     .spans
@@ -182,7 +186,7 @@ impl UltimateWatch {
         }
         if self.first_crack.is_none() {
             if let Some(e) = (0..model.elements.len()).find(|&e| {
-                sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
+                sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
                     .iter()
                     .any(|p| p.n_cracks() > 0)
             }) {
@@ -251,7 +255,7 @@ impl UltimateWatch {
     fn bar_events(&mut self, snap: &Snapshot, k: usize) {
         let sys = snap.system;
         let model = sys.model;
-        for (&(b, _), out) in sys.bar_gps.iter().zip(&sys.bar_out) {
+        for (&(b, _), out) in sys.bar_gps.iter().zip(&sys.families.bars.out.committed) {
             if out.plastic_strain == 0.0 {
                 continue;
             }
@@ -443,7 +447,7 @@ impl UltimateWatch {
 fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Vec<Event> {
     let sys = snap.system;
     let crushed_points = |e: usize| {
-        sys.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
+        sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
             .iter()
             .filter(|p| p.is_crushed())
             .count()

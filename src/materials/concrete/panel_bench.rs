@@ -198,7 +198,15 @@ impl Observer for Trace {
         // Uniform strain: ε_x from the roller corner (L, 0), ε_y from the corner (0, L).
         let ex = u[2 * self.n] / self.l;
         let ey = u[2 * self.n * (self.n + 1) + 1] / self.l;
-        let crushed = s.system.committed.iter().filter(|p| p.is_crushed()).count();
+        let crushed = s
+            .system
+            .families
+            .continuum
+            .points
+            .committed
+            .iter()
+            .filter(|p| p.is_crushed())
+            .count();
         self.rows.push((1e6 * s.factors[0], [ex, ey], crushed));
         Ok(())
     }

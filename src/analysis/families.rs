@@ -1,0 +1,160 @@
+//! The analysis state, one block per element family. Each block keeps its committed/trial
+//! pairs in [`Staged`] values and its other state (stages, reference strains, time records)
+//! beside them; [`Families::commit`] and [`Families::revert`] act on all of them. The
+//! checkpoint saves these blocks as they are (serde), so adding a state field to a block
+//! adds it to the checkpoint; the layout test of `results::checkpoint` then asks for a new
+//! format version.
+//!
+//! Not in the blocks: the model's topology (Gauss-point and bar-point offsets, element
+//! numbers), which `System::new` derives from the model.
+
+use super::bonded_time::BarPointTime;
+use super::staged::Staged;
+use super::time::TendonTime;
+use crate::elements::continuum::GaussOutput;
+use crate::elements::interface::InterfacePointState;
+use crate::elements::tendon::TendonState;
+use crate::materials::point::PointState;
+use crate::materials::steel::SteelState;
+use serde::{Deserialize, Serialize};
+
+/// The state of every element family.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Families {
+    /// Continuum material points.
+    pub continuum: ContinuumBlock,
+    /// Joint integration points.
+    pub joints: JointBlock,
+    /// External tendons.
+    pub tendons: TendonBlock,
+    /// Embedded bars, bar layers and bonded tendons (points in host-element order).
+    pub bars: BarBlock,
+}
+
+impl Families {
+    /// Accept the trial states of every family.
+    pub fn commit(&mut self) {
+        self.continuum.commit();
+        self.joints.points.commit();
+        self.tendons.states.commit();
+        self.bars.steel.commit();
+        self.bars.out.commit();
+    }
+
+    /// Throw away the trial states of every family.
+    pub fn revert(&mut self) {
+        self.continuum.points.revert();
+        self.continuum.gauss.revert();
+        self.continuum.holds = Holds::default();
+        self.joints.points.revert();
+        self.tendons.states.revert();
+        self.bars.steel.revert();
+        self.bars.out.revert();
+    }
+}
+
+/// Continuum material points (order: element by element, Gauss points within).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContinuumBlock {
+    /// Material point states.
+    pub points: Staged<Vec<PointState>>,
+    /// Gauss-point outputs (strain, stress).
+    pub gauss: Staged<Vec<GaussOutput>>,
+    /// Branch holds of the increment under way (empty between increments: not saved).
+    #[serde(skip)]
+    pub holds: Holds,
+}
+
+impl ContinuumBlock {
+    /// Accept the trial states; the holds last one increment only, so the committed points
+    /// end their increment ([`PointState::end_increment`]) when any was held.
+    pub fn commit(&mut self) {
+        self.points.commit();
+        self.gauss.commit();
+        self.holds.latched.clear();
+        let frozen = std::mem::take(&mut self.holds.frozen);
+        if std::mem::take(&mut self.holds.held_plastic) || frozen {
+            self.points
+                .committed
+                .iter_mut()
+                .for_each(PointState::end_increment);
+        }
+    }
+}
+
+/// Crack and plastic-route holds within one increment.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Holds {
+    /// Points whose crack formed during the current increment, with the state their updates
+    /// start from until the increment ends (sorted by point index; see
+    /// [`crate::materials::point::crack_base`]).
+    pub latched: Vec<(usize, PointState)>,
+    /// True once the crack branches were frozen in the current increment.
+    pub frozen: bool,
+    /// Some point was held on the plastic route in this increment.
+    pub held_plastic: bool,
+}
+
+/// Joint integration points, per joint element.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointBlock {
+    /// Point states.
+    pub points: Staged<Vec<Vec<InterfacePointState>>>,
+}
+
+/// External tendons (one entry per tendon of the model; None until stressed).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TendonBlock {
+    /// Displacements of each tendon's nodes when it was stressed [m].
+    pub u0: Vec<Vec<[f64; 2]>>,
+    /// Initial span strains in force (after relaxation) [-]: the tendon elements are
+    /// rebuilt from `u0` and these when a checkpoint is read.
+    pub initial_strains: Vec<Vec<f64>>,
+    /// Span states.
+    pub states: Staged<Vec<Option<TendonState>>>,
+    /// Relaxation and loss records (see `analysis::time`).
+    pub time: Vec<Option<TendonTime>>,
+}
+
+/// Embedded bar points (order of `System::bar_gps`) and bar stages (order of the bars).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BarBlock {
+    /// Steel states of the points.
+    pub steel: Staged<Vec<SteelState>>,
+    /// Point outputs.
+    pub out: Staged<Vec<BarOutput>>,
+    /// Stage of each bar: bars and pre-tensioned tendons are bonded from the start,
+    /// post-tensioned tendons go through the stages at their steps.
+    pub phase: Vec<BarPhase>,
+    /// Bond strain of each point when it became bonded [-] (0 for bars bonded from the
+    /// start): the bar strain is measured from it.
+    pub eps_ref: Vec<f64>,
+    /// Relaxation and loss records of the bonded-tendon points (None for plain bars and
+    /// tendons not yet stressed; see `analysis::bonded_time`).
+    pub time: Vec<Option<BarPointTime>>,
+}
+
+/// Stage of an embedded bar or bonded tendon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BarPhase {
+    /// Post-tensioned tendon not yet stressed: absent.
+    Inactive,
+    /// Post-tensioned tendon stressed and locked off, duct not grouted: it loads the concrete
+    /// with its lock-off stresses (the equivalent prestressing forces, seed eq. 24–26) and
+    /// has no stiffness; its stress is held (changes of an ungrouted tendon are neglected).
+    Locked,
+    /// Bonded (perfect bond): stress from the bond strain measured since bonding plus the
+    /// bonding stress.
+    Bonded,
+}
+
+/// Values at one bar integration point for output.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct BarOutput {
+    /// Total bar strain including the prestrain σ_b,0/E_s [-].
+    pub strain: f64,
+    /// Bar stress [Pa].
+    pub stress: f64,
+    /// Plastic strain [-].
+    pub plastic_strain: f64,
+}
