@@ -5,7 +5,7 @@
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::analysis::system::System;
-use segfem::elements::bar::inverse_map;
+use segfem::mesh::embed::inverse_map;
 use segfem::model::Model;
 
 const EC: f64 = 30e9;

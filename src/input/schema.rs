@@ -35,76 +35,8 @@ pub struct File {
     pub analysis: Option<AnalysisIn>,
 }
 
-/// `viscoplastic = { ... }` of a concrete material (Owen–Hinton option).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ViscoplasticIn {
-    pub fluidity: Option<f64>,
-    pub overstress: Option<String>,
-    pub exponent: Option<f64>,
-    pub theta: Option<f64>,
-    pub safety: Option<f64>,
-    pub tau: Option<f64>,
-    pub load_steps: Option<String>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialIn {
-    pub name: String,
-    pub kind: String,
-    #[serde(rename = "E")]
-    pub e: Option<f64>,
-    pub nu: Option<f64>,
-    pub density: Option<f64>,
-    // concrete
-    pub fcm: Option<f64>,
-    pub ftm: Option<f64>,
-    #[serde(rename = "C")]
-    pub c: Option<f64>,
-    pub tensile_reference: Option<String>,
-    pub tension_softening: Option<String>,
-    pub alpha: Option<f64>,
-    #[serde(rename = "Gf")]
-    pub gf: Option<f64>,
-    pub eps_c1: Option<f64>,
-    pub eps_cu: Option<f64>,
-    pub compression_softening: Option<String>,
-    #[serde(rename = "Gc")]
-    pub gc: Option<f64>,
-    pub initial_yield_ratio: Option<f64>,
-    pub softening_limit: Option<f64>,
-    pub crack_ratio: Option<f64>,
-    pub shear_k1: Option<f64>,
-    pub shear_eps_ref: Option<f64>,
-    pub shear_beta_min: Option<f64>,
-    pub residual_stiffness: Option<f64>,
-    pub secant_crack_tangent: Option<bool>,
-    pub double_crack: Option<String>,
-    pub crack_integration: Option<String>,
-    pub normalize_equivalent_stress: Option<bool>,
-    pub viscoplastic: Option<ViscoplasticIn>,
-    pub crack_model: Option<String>,
-    pub compression_reduction: Option<String>,
-    pub compression_reduction_min: Option<f64>,
-    pub shear_retention: Option<String>,
-    pub aggregate_size: Option<f64>,
-    // steel
-    pub fy: Option<f64>,
-    #[serde(rename = "Et")]
-    pub et: Option<f64>,
-    #[serde(rename = "Ep")]
-    pub ep: Option<f64>,
-    pub fptk: Option<f64>,
-    pub eps_uk: Option<f64>,
-    // elastic_creep (MC90 creep and shrinkage)
-    pub rh: Option<f64>,
-    pub h0: Option<f64>,
-    pub cement: Option<String>,
-    pub n_units: Option<usize>,
-    pub shrinkage: Option<bool>,
-    pub drying_start: Option<f64>,
-}
+// The material table lives with its kinds and builders (one file per material law's input).
+pub use super::build::{MaterialIn, ViscoplasticIn};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

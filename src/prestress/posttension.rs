@@ -2,7 +2,7 @@
 //! losses at stressing (seed eq. 27) and the anchorage set (draw-in) with its reverse-friction
 //! zone. The tendon is sampled at its integration points (arc length s from the path start
 //! and cumulative deviation α(s) = ∫|dθ| from the start, exact for polylines, parabolas and
-//! arcs: [`crate::elements::bar::TurnTable`]).
+//! arcs: [`crate::mesh::embed::TurnTable`]).
 //!
 //! Friction, at each sample, from the jack(s):
 //!

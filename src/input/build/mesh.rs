@@ -1,0 +1,451 @@
+//! `[mesh]`: banded, segmental and explicit meshes generated or checked here (gmsh meshes
+//! in `input::gmsh_mesh`), element types and integration rules.
+
+use super::fields::{index_by_name, positive};
+use super::R;
+use crate::elements::continuum::{min_jacobian, Integration};
+use crate::fem::shape::QuadKind;
+use crate::input::error::Ctx;
+use crate::input::schema::MeshIn;
+use crate::input::{gmsh_mesh, limits, locate};
+use crate::mesh::banded::{self, Band};
+use crate::mesh::segmental;
+use crate::model::{Element, Model, Region};
+
+/// A generated or read mesh: nodes [m], elements, the joints between segments and the gmsh
+/// physical groups (empty for the other mesh types).
+pub(super) struct Generated {
+    pub(super) nodes: Vec<[f64; 2]>,
+    pub(super) elements: Vec<Element>,
+    pub(super) joints: Vec<segmental::Joint>,
+    pub(super) groups: gmsh_mesh::Groups,
+}
+
+/// The `[mesh]` of type banded, segmental, gmsh or explicit; elements refer to `regions`.
+pub(super) fn generate(ctx: &Ctx, mesh: &MeshIn, regions: &[Region]) -> R<Generated> {
+    let region_names = || regions.iter().map(|r| r.name.as_str());
+    let mut groups = gmsh_mesh::Groups::default();
+    let (nodes, elements, joints) = if mesh.kind == "segmental" {
+        build_segmental(mesh, ctx, &region_names)?
+    } else if mesh.kind == "gmsh" {
+        let names: Vec<&str> = region_names().collect();
+        let g = gmsh_mesh::build_gmsh(mesh, ctx, &names)?;
+        groups = g.groups;
+        (g.nodes, g.elements, g.joints)
+    } else {
+        let (n, e) = build_mesh(mesh, ctx, &region_names)?;
+        (n, e, Vec::new())
+    };
+    Ok(Generated {
+        nodes,
+        elements,
+        joints,
+        groups,
+    })
+}
+
+/// Nodes in use by an element (the others are held); warnings for loose coincident nodes
+/// (parts not connected) and unused nodes.
+pub(super) fn used_nodes(ctx: &Ctx, model: &Model, warnings: &mut Vec<String>) -> Vec<bool> {
+    let mut used = vec![false; model.nodes.len()];
+    for e in &model.elements {
+        for &n in &e.nodes {
+            used[n] = true;
+        }
+    }
+    let mut tied = vec![false; model.nodes.len()];
+    for i in &model.interfaces {
+        i.nodes.iter().for_each(|&n| tied[n] = true);
+    }
+    let size = locate::model_size(model);
+    if let (k, Some((a, b))) = limits::loose_coincident(&model.nodes, &used, &tied, size) {
+        warnings.push(format!(
+            "{}: mesh: nodes {} and {} coincide at {:?} but no element or joint connects them ({k} such pair(s)): the parts of the mesh there are not connected; a joint missing from [[mesh.joints]]?",
+            ctx.file,
+            a + 1,
+            b + 1,
+            model.nodes[a]
+        ));
+    }
+    let unused = used.iter().filter(|u| !**u).count();
+    if unused > 0 {
+        warnings.push(format!(
+            "{}: mesh.nodes: {unused} node(s) belong to no element and are ignored (fixed)",
+            ctx.file
+        ));
+    }
+    used
+}
+
+pub(super) fn quad_kind(ctx: &Ctx, key: &str, s: &str) -> R<QuadKind> {
+    match s {
+        "Q4" | "q4" => Ok(QuadKind::Q4),
+        "Q8" | "q8" => Ok(QuadKind::Q8),
+        "Q9" | "q9" => Ok(QuadKind::Q9),
+        _ => Err(ctx.err(
+            key,
+            format!("unknown element type '{s}' (expected Q4, Q8 or Q9)"),
+        )),
+    }
+}
+
+/// The `integration` of elements of `kind`: `incompatible` (incompatible bending modes) is
+/// a Q4 formulation.
+pub(in crate::input) fn integration(
+    ctx: &Ctx,
+    key: &str,
+    s: Option<&str>,
+    kind: QuadKind,
+) -> R<Integration> {
+    match s {
+        None | Some("full") => Ok(Integration::Full),
+        Some("reduced") => Ok(Integration::Reduced),
+        Some("incompatible") if kind == QuadKind::Q4 => Ok(Integration::Incompatible),
+        Some("incompatible") => Err(ctx.err(
+            key,
+            format!("'incompatible' (bending modes) is for Q4 elements only, not {kind:?}: Q8 and Q9 bend well with full or reduced integration"),
+        )),
+        Some(o) => Err(ctx.err(
+            key,
+            format!("unknown integration '{o}' (expected full, reduced or incompatible)"),
+        )),
+    }
+}
+
+pub(super) type Mesh = (Vec<[f64; 2]>, Vec<Element>);
+
+/// Nodes, elements and joints of a segmental mesh.
+pub(super) type SegMesh = (Vec<[f64; 2]>, Vec<Element>, Vec<segmental::Joint>);
+
+pub(super) fn build_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Mesh> {
+    match mesh.kind.as_str() {
+        "banded" => banded_mesh(mesh, ctx, region_names),
+        "explicit" => explicit_mesh(mesh, ctx, region_names),
+        o => Err(ctx.err(
+            "mesh.type",
+            format!("unknown mesh type '{o}' (expected banded, segmental, gmsh or explicit)"),
+        )),
+    }
+}
+
+/// A banded mesh: horizontal bands of given depths, `nx` columns over `length`.
+fn banded_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Mesh> {
+    let length = positive(
+        ctx,
+        "mesh.length",
+        mesh.length
+            .ok_or_else(|| ctx.err("mesh.length", "missing"))?,
+    )?;
+    let nx = mesh.nx.ok_or_else(|| ctx.err("mesh.nx", "missing"))?;
+    if nx == 0 {
+        return Err(ctx.err("mesh.nx", "must be at least 1"));
+    }
+    let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q4"))?;
+    let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
+    if mesh.bands.is_empty() {
+        return Err(ctx.err(
+            "mesh.bands",
+            "a banded mesh needs at least one [[mesh.bands]]",
+        ));
+    }
+    if !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
+        return Err(ctx.err("mesh", "a banded mesh takes no nodes or blocks"));
+    }
+    let bands = bands_of(mesh, ctx, region_names)?;
+    let origin = origin_of(mesh, ctx)?;
+    let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
+    limits::check_size(
+        ctx,
+        "mesh.nx",
+        limits::grid_nodes(kind, nx as f64, ny),
+        nx as f64 * ny,
+        limits::available_memory(),
+    )?;
+    let g = banded::generate(origin, length, nx, &bands, kind);
+    check_generated(ctx, &g.nodes, &g.elements)?;
+    let elements = g
+        .elements
+        .into_iter()
+        .map(|(nodes, region)| Element {
+            kind,
+            nodes,
+            region,
+            integration: integ,
+        })
+        .collect();
+    Ok((g.nodes, elements))
+}
+
+/// An explicit mesh: nodes and blocks of elements of one type and region each, checked for
+/// repeated nodes and inverted or degenerate elements.
+fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Mesh> {
+    let banded_keys = [
+        ("length", mesh.length.is_some()),
+        ("origin", mesh.origin.is_some()),
+        ("nx", mesh.nx.is_some()),
+        ("element", mesh.element.is_some()),
+        ("integration", mesh.integration.is_some()),
+        ("bands", !mesh.bands.is_empty()),
+        ("segments", mesh.segments.is_some()),
+        ("n_segments", mesh.n_segments.is_some()),
+        ("nx_per_segment", mesh.nx_per_segment.is_some()),
+        ("joint_material", mesh.joint_material.is_some()),
+    ];
+    if let Some((k, _)) = banded_keys.iter().find(|(_, given)| *given) {
+        return Err(ctx.err(
+            format!("mesh.{k}"),
+            "not used by an explicit mesh (element types and integration go in each block)",
+        ));
+    }
+    if mesh.nodes.is_empty() {
+        return Err(ctx.err("mesh.nodes", "an explicit mesh needs nodes"));
+    }
+    if mesh.blocks.is_empty() {
+        return Err(ctx.err(
+            "mesh.blocks",
+            "an explicit mesh needs at least one [[mesh.blocks]]",
+        ));
+    }
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return Err(ctx.err(format!("mesh.nodes[{i}]"), "coordinates must be finite"));
+        }
+    }
+    let nn = mesh.nodes.len();
+    let n_el: usize = mesh.blocks.iter().map(|b| b.elements.len()).sum();
+    limits::check_size(
+        ctx,
+        "mesh.nodes",
+        nn as f64,
+        n_el as f64,
+        limits::available_memory(),
+    )?;
+    let size = limits::extent(&mesh.nodes);
+    let ids_of = |c: &[i64]| c.iter().map(|&i| i as u64).collect::<Vec<u64>>();
+    let mut elements = Vec::new();
+    for (b, blk) in mesh.blocks.iter().enumerate() {
+        let region = index_by_name(
+            ctx,
+            &format!("mesh.blocks[{b}].region"),
+            "region",
+            region_names(),
+            &blk.region,
+        )?;
+        let kind = quad_kind(ctx, &format!("mesh.blocks[{b}].element"), &blk.element)?;
+        let integ = integration(
+            ctx,
+            &format!("mesh.blocks[{b}].integration"),
+            blk.integration.as_deref(),
+            kind,
+        )?;
+        for (j, conn) in blk.elements.iter().enumerate() {
+            let key = format!("mesh.blocks[{b}].elements[{j}]");
+            if conn.len() != kind.n_nodes() {
+                return Err(ctx.err(
+                    &key,
+                    format!(
+                        "a {kind:?} element needs {} nodes, got {}",
+                        kind.n_nodes(),
+                        conn.len()
+                    ),
+                ));
+            }
+            let mut nodes = Vec::with_capacity(conn.len());
+            for &id in conn {
+                if id < 1 || id as usize > nn {
+                    return Err(ctx.err(
+                        &key,
+                        format!("unknown node {id} (nodes are numbered 1..={nn})"),
+                    ));
+                }
+                let n = id as usize - 1;
+                if nodes.contains(&n) {
+                    return Err(ctx.err(&key, format!("node {id} is repeated")));
+                }
+                nodes.push(n);
+            }
+            let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.nodes[n]).collect();
+            if let Some(m) = limits::degenerate(&coords, &ids_of(conn), size) {
+                return Err(ctx.err(&key, m));
+            }
+            let detj = min_jacobian(kind, &coords, integ);
+            if detj.is_nan() || detj <= 0.0 {
+                return Err(ctx.err(
+                    &key,
+                    format!("element is inverted or degenerate (smallest det J = {detj:.3e}); list nodes counter-clockwise, corners first"),
+                ));
+            }
+            elements.push(Element {
+                kind,
+                nodes,
+                region,
+                integration: integ,
+            });
+        }
+    }
+    Ok((mesh.nodes.clone(), elements))
+}
+
+/// Segmental mesh: segments of given lengths (or equal ones), each a banded block.
+pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<SegMesh> {
+    let lengths: Vec<f64> = match (&mesh.segments, mesh.n_segments, mesh.length) {
+        (Some(l), None, None) => {
+            if l.is_empty() {
+                return Err(ctx.err("mesh.segments", "give at least one segment length"));
+            }
+            for (i, v) in l.iter().enumerate() {
+                positive(ctx, &format!("mesh.segments[{i}]"), *v)?;
+            }
+            l.clone()
+        }
+        (None, Some(n), Some(len)) => {
+            if n == 0 {
+                return Err(ctx.err("mesh.n_segments", "must be at least 1"));
+            }
+            let len = positive(ctx, "mesh.length", len)?;
+            vec![len / n as f64; n]
+        }
+        _ => {
+            return Err(ctx.err(
+                "mesh",
+                "a segmental mesh needs either segments = [lengths] or length and n_segments",
+            ))
+        }
+    };
+    let nx = mesh
+        .nx_per_segment
+        .ok_or_else(|| ctx.err("mesh.nx_per_segment", "missing"))?;
+    if nx == 0 {
+        return Err(ctx.err("mesh.nx_per_segment", "must be at least 1"));
+    }
+    if mesh.nx.is_some() || !mesh.nodes.is_empty() || !mesh.blocks.is_empty() {
+        return Err(ctx.err(
+            "mesh",
+            "a segmental mesh takes nx_per_segment, not nx, nodes or blocks",
+        ));
+    }
+    let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
+    let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
+    let bands = bands_of(mesh, ctx, region_names)?;
+    let origin = origin_of(mesh, ctx)?;
+    let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
+    let n_seg = lengths.len() as f64;
+    limits::check_size(
+        ctx,
+        "mesh.nx_per_segment",
+        n_seg * limits::grid_nodes(kind, nx as f64, ny),
+        n_seg * nx as f64 * ny,
+        limits::available_memory(),
+    )?;
+    let g = segmental::generate_segments(
+        origin[0],
+        origin[1],
+        &lengths,
+        &vec![nx; lengths.len()],
+        &bands,
+        kind,
+    );
+    let elements = g
+        .elements
+        .into_iter()
+        .map(|(nodes, region, _segment)| (nodes, region))
+        .collect::<Vec<_>>();
+    check_generated(ctx, &g.nodes, &elements)?;
+    let elements = elements
+        .into_iter()
+        .map(|(nodes, region)| Element {
+            kind,
+            nodes,
+            region,
+            integration: integ,
+        })
+        .collect();
+    Ok((g.nodes, elements, g.joints))
+}
+
+/// Degenerate elements of a generated mesh: tiny lengths or depths next to large ones give
+/// zero-length edges.
+pub(super) fn check_generated(
+    ctx: &Ctx,
+    nodes: &[[f64; 2]],
+    elements: &[(Vec<usize>, usize)],
+) -> R<()> {
+    if let Some(p) = nodes
+        .iter()
+        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(ctx.err(
+            "mesh",
+            format!("generated node coordinates overflow ({p:?}): the lengths, depths or origin are too large (metres)"),
+        ));
+    }
+    let size = limits::extent(nodes);
+    for (i, (conn, _)) in elements.iter().enumerate() {
+        let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();
+        let ids: Vec<u64> = conn.iter().map(|&n| n as u64 + 1).collect();
+        if let Some(m) = limits::degenerate(&c, &ids, size) {
+            return Err(ctx.err(
+                "mesh",
+                format!(
+                    "generated element {}: {m}; check the lengths, depths and divisions",
+                    i + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn bands_of<'a, I: Iterator<Item = &'a str> + Clone>(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    region_names: &dyn Fn() -> I,
+) -> R<Vec<Band>> {
+    if mesh.bands.is_empty() {
+        return Err(ctx.err("mesh.bands", "needs at least one [[mesh.bands]]"));
+    }
+    let mut bands = Vec::new();
+    for (i, b) in mesh.bands.iter().enumerate() {
+        let region = index_by_name(
+            ctx,
+            &format!("mesh.bands[{i}].region"),
+            "region",
+            region_names(),
+            &b.region,
+        )?;
+        let depth = positive(ctx, &format!("mesh.bands[{i}].depth"), b.depth)?;
+        if b.rows == 0 {
+            return Err(ctx.err(format!("mesh.bands[{i}].rows"), "must be at least 1"));
+        }
+        bands.push(Band {
+            depth,
+            rows: b.rows,
+            region,
+        });
+    }
+    Ok(bands)
+}
+
+pub(super) fn origin_of(mesh: &MeshIn, ctx: &Ctx) -> R<[f64; 2]> {
+    let o = mesh.origin.unwrap_or([0.0, 0.0]);
+    if o.iter().any(|v| !v.is_finite()) {
+        return Err(ctx.err("mesh.origin", "must be finite numbers [m]"));
+    }
+    Ok(o)
+}

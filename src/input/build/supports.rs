@@ -1,0 +1,168 @@
+//! `[[supports]]`: restrained displacements; the check that every part of the mesh is held
+//! against rigid-body motion.
+
+use super::fields::{locate_nodes, unique_names};
+use super::R;
+use crate::input::error::Ctx;
+use crate::input::gmsh_mesh;
+use crate::input::locate;
+use crate::input::schema::SupportIn;
+use crate::model::{Dir, Model, Support};
+use std::collections::HashMap;
+
+/// The `[[supports]]`: restrained dofs at a node, a point, along a line or a gmsh group.
+pub(super) fn build(
+    ctx: &Ctx,
+    list: &[SupportIn],
+    groups: &gmsh_mesh::Groups,
+    model: &mut Model,
+    used: &[bool],
+) -> R<()> {
+    unique_names(ctx, "supports", list.iter().map(|s| s.name.as_str()))?;
+    if list.is_empty() {
+        return Err(ctx.err(
+            "supports",
+            "no supports given: the structure would be a mechanism",
+        ));
+    }
+    for (i, s) in list.iter().enumerate() {
+        let key = format!("supports[{i}]");
+        for (name, v) in [("ux", s.ux), ("uy", s.uy)] {
+            if v.is_some_and(|v| !v.is_finite()) {
+                return Err(ctx.err(format!("{key}.{name}"), "must be a finite number [m]"));
+            }
+        }
+        let nodes = match &s.group {
+            Some(g) => {
+                if s.node.is_some() || s.point.is_some() || s.line.is_some() {
+                    return Err(ctx.err(&key, "give exactly one of node, point, line or group"));
+                }
+                groups.nodes.get(g).cloned().ok_or_else(|| {
+                    ctx.err(
+                        format!("{key}.group"),
+                        format!("no physical group named '{g}' (groups come from a gmsh mesh)"),
+                    )
+                })?
+            }
+            None => locate_nodes(ctx, &key, model, used, s.node, s.point, s.line)?,
+        };
+        let mut dofs = Vec::new();
+        for n in nodes {
+            if let Some(v) = s.ux {
+                dofs.push((n, Dir::X, v));
+            }
+            if let Some(v) = s.uy {
+                dofs.push((n, Dir::Y, v));
+            }
+        }
+        if s.ux.is_none() && s.uy.is_none() {
+            return Err(ctx.err(&key, "restrains nothing: give ux and/or uy (0.0 = fixed)"));
+        }
+        model.supports.push(Support {
+            name: s.name.clone(),
+            dofs,
+        });
+    }
+    Ok(())
+}
+
+/// Hold the nodes no element uses, so that they add no zero pivots.
+pub(super) fn hold_unused(model: &mut Model, used: &[bool]) {
+    let held: Vec<(usize, Dir, f64)> = (0..model.nodes.len())
+        .filter(|&n| !used[n])
+        .flat_map(|n| [(n, Dir::X, 0.0), (n, Dir::Y, 0.0)])
+        .collect();
+    if !held.is_empty() {
+        model.supports.push(Support {
+            name: "(unused nodes)".into(),
+            dofs: held,
+        });
+    }
+}
+
+/// Each connected part of the mesh must be held against its three rigid-body motions: the
+/// constrained dofs must give rank 3 on the modes (1,0), (0,1), (−y, x).
+pub(super) fn check_rigid_body(ctx: &Ctx, model: &Model, used: &[bool]) -> R<()> {
+    // Union–find over nodes through elements.
+    let mut parent: Vec<usize> = (0..model.nodes.len()).collect();
+    fn find(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    // Joints and tendons tie parts together too (a joint can only hold a part while closed;
+    // the check is about supports, not about whether the joints stay closed).
+    let groups = model
+        .elements
+        .iter()
+        .map(|e| &e.nodes)
+        .chain(model.interfaces.iter().map(|i| &i.nodes))
+        .chain(model.tendons.iter().map(|t| &t.nodes));
+    for nodes in groups {
+        let r0 = find(&mut parent, nodes[0]);
+        for &n in &nodes[1..] {
+            let r = find(&mut parent, n);
+            parent[r] = r0;
+        }
+    }
+    let mut rows: HashMap<usize, Vec<[f64; 3]>> = HashMap::new();
+    for s in &model.supports {
+        for &(n, d, _) in &s.dofs {
+            if !used[n] {
+                continue;
+            }
+            let [x, y] = model.nodes[n];
+            let row = match d {
+                Dir::X => [1.0, 0.0, -y],
+                Dir::Y => [0.0, 1.0, x],
+            };
+            rows.entry(find(&mut parent, n)).or_default().push(row);
+        }
+    }
+    let size = locate::model_size(model);
+    let mut checked = HashMap::new();
+    for e in &model.elements {
+        let root = find(&mut parent, e.nodes[0]);
+        if checked.contains_key(&root) {
+            continue;
+        }
+        let r = rows.get(&root).map(|v| rank3(v, size)).unwrap_or(0);
+        checked.insert(root, r);
+        if r < 3 {
+            let region = &model.regions[e.region].name;
+            return Err(ctx.err(
+                "supports",
+                format!(
+                    "the part of the mesh containing region '{region}' can move as a rigid body (supports restrain {r} of its 3 rigid-body motions)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Numerical rank of a set of 3-vectors (rotation column scaled by the model size).
+pub(super) fn rank3(rows: &[[f64; 3]], size: f64) -> usize {
+    let mut m: Vec<[f64; 3]> = rows.iter().map(|r| [r[0], r[1], r[2] / size]).collect();
+    let mut rank = 0;
+    for c in 0..3 {
+        let piv = (rank..m.len()).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()));
+        let Some(p) = piv else { break };
+        if m[p][c].abs() < 1e-9 {
+            continue;
+        }
+        m.swap(rank, p);
+        for i in 0..m.len() {
+            if i != rank {
+                let f = m[i][c] / m[rank][c];
+                for k in 0..3 {
+                    m[i][k] -= f * m[rank][k];
+                }
+            }
+        }
+        rank += 1;
+    }
+    rank
+}
