@@ -311,8 +311,8 @@ fn span_stresses(
         }
         (None, Some(s)) => {
             let (friction, jacking, draw_in) = friction_of(ctx, i, t)?;
-            let path = TendonPath::from_points(coords)
-                .map_err(|e| ctx.err(k("points"), e.to_string()))?;
+            let path =
+                TendonPath::from_points(coords).map_err(|e| ctx.err(k("points"), e.to_string()))?;
             let mut profile = jacking_profile(&path, s, &friction, jacking);
             if draw_in > 0.0 {
                 let ends: &[AnchorEnd] = match jacking {
