@@ -334,7 +334,18 @@ pub fn update_cracked(
             dl[2][imax] = dbeta * g * el[2];
         }
     }
-    // σ = Tᵀ σ', D = Tᵀ D' T
+    let (s, d) = to_global(&t, &sl, &dl);
+    st.stress = s;
+    Ok((st, s, d))
+}
+
+/// Stress and tangent from the local (crack or principal) axes back to x, y: σ = Tᵀ σ',
+/// D = Tᵀ D' T, with `t` the strain transformation of the local axes.
+pub(super) fn to_global(
+    t: &[[f64; 3]; 3],
+    sl: &[f64; 3],
+    dl: &[[f64; 3]; 3],
+) -> ([f64; 3], [[f64; 3]; 3]) {
     let s: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| t[k][i] * sl[k]).sum());
     let mut dt = [[0.0; 3]; 3];
     for a in 0..3 {
@@ -348,6 +359,5 @@ pub fn update_cracked(
             d[a][b] = (0..3).map(|k| t[k][a] * dt[k][b]).sum();
         }
     }
-    st.stress = s;
-    Ok((st, s, d))
+    (s, d)
 }

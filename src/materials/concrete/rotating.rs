@@ -155,19 +155,7 @@ pub fn update(
     ];
     let sl = [d[0].sigma, d[1].sigma, 0.0];
     let t = strain_transform(theta);
-    let s: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| t[k][i] * sl[k]).sum());
-    let mut dt = [[0.0; 3]; 3];
-    for a in 0..3 {
-        for b in 0..3 {
-            dt[a][b] = (0..3).map(|k| dl[a][k] * t[k][b]).sum();
-        }
-    }
-    let mut tan = [[0.0; 3]; 3];
-    for a in 0..3 {
-        for b in 0..3 {
-            tan[a][b] = (0..3).map(|k| t[k][a] * dt[k][b]).sum();
-        }
-    }
+    let (s, tan) = super::cracking::to_global(&t, &sl, &dl);
     st.stress = s;
     Ok((st, s, tan))
 }
