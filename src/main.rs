@@ -170,7 +170,8 @@ enum Command {
         /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations) or
         /// "material-point" (concrete material-point updates per second) or "panels" (the
         /// membrane-panel series of validation/panels/panels.csv, or of --model, under each
-        /// concrete model option: test/predicted ratios, mean, COV).
+        /// concrete model option: test/predicted ratios, mean, COV) or "beams" (the
+        /// shear-beam series of validation/beams/beams.csv, or of --model, on 10 and 20 rows).
         #[arg(long, default_value = "linear")]
         case: String,
         /// Mesh refinement factors of the seed beam case (1 = the seed's coarse mesh).
@@ -298,7 +299,7 @@ fn main() -> ExitCode {
             refine,
             model,
         } => match case.as_str() {
-            _ if model.is_some() && case != "panels" => {
+            _ if model.is_some() && case != "panels" && case != "beams" => {
                 bench_bare(model.as_deref().expect("checked"))
             }
             "linear" => bench(dofs, element),
@@ -309,8 +310,9 @@ fn main() -> ExitCode {
             "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
             "panels" => bench_panels(model.as_deref()),
+            "beams" => bench_beams(model.as_deref()),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, material-point or panels)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, material-point, panels or beams)");
                 ExitCode::from(2)
             }
         },
@@ -763,6 +765,21 @@ fn bench_rc(refine: Vec<usize>) -> ExitCode {
 fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
     let path = file.unwrap_or(std::path::Path::new("validation/panels/panels.csv"));
     match segfem::materials::concrete::panel_bench::series(path) {
+        Ok((report, secs)) => {
+            outln!("{report}");
+            outln!("total time of the series: {secs:.1} s");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn bench_beams(file: Option<&std::path::Path>) -> ExitCode {
+    let path = file.unwrap_or(std::path::Path::new("validation/beams/beams.csv"));
+    match segfem::materials::concrete::beam_bench::series(path) {
         Ok((report, secs)) => {
             outln!("{report}");
             outln!("total time of the series: {secs:.1} s");

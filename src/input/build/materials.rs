@@ -478,10 +478,6 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
             ));
         }
         for (f, given) in [
-            (
-                "crack_integration",
-                m.crack_integration.as_deref() == Some("implex"),
-            ),
             ("viscoplastic", m.viscoplastic.is_some()),
             ("initial_yield_ratio", m.initial_yield_ratio.is_some()),
         ] {

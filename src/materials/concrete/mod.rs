@@ -15,6 +15,8 @@
 //! The update is a pure function of (committed state, total strain): calling it twice with
 //! the same arguments gives the same result, so a load step can be retried.
 
+pub mod beam_bench;
+pub mod biaxial;
 pub mod compression;
 pub mod cracking;
 pub mod ottosen;
@@ -319,11 +321,9 @@ impl ConcreteParams {
             }
         }
         if self.crack_model == CrackModel::Rotating
-            && (self.implex || self.viscoplastic.is_some() || self.initial_yield_ratio > 0.0)
+            && (self.viscoplastic.is_some() || self.initial_yield_ratio > 0.0)
         {
-            return bad(
-                "the rotating crack model has no IMPL-EX, viscoplastic or initial-yield option",
-            );
+            return bad("the rotating crack model has no viscoplastic or initial-yield option");
         }
         Ok(())
     }
@@ -640,7 +640,7 @@ pub fn update_full(
         return Ok(crushed(p, committed, strain));
     }
     if p.crack_model == CrackModel::Rotating {
-        return rotating::update(p, committed, strain, char_length);
+        return rotating::update(p, committed, strain, char_length, ratio);
     }
     if committed.n_cracks > 0 {
         return cracking::update_cracked(p, committed, strain, char_length, ratio);

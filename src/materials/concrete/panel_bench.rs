@@ -269,7 +269,7 @@ pub fn run_panel(p: &Panel, keys: &str, n: usize) -> Result<PanelRun, String> {
 }
 
 /// Split one CSV line (fields may be quoted and contain commas).
-fn csv_fields(line: &str) -> Vec<String> {
+pub(crate) fn csv_fields(line: &str) -> Vec<String> {
     let mut out = Vec::new();
     let mut cur = String::new();
     let mut quoted = false;

@@ -13,7 +13,10 @@
 //!   the crush band) scaled by the compression-softening factor β_d of the other
 //!   direction's tensile strain ([`super::reduction`]), σ = −β_d σ_c(−ε̃/β_d), on loading;
 //!   secant to the origin from the largest curve strain reached on unloading; the point
-//!   crushes (zero stress for ever) at curve strain ε_cu.
+//!   crushes (zero stress for ever) at curve strain ε_cu; when both directions are
+//!   compressed, both curves are stretched instead by the biaxial gain K(α) ≥ 1 of the
+//!   principal stress ratio ([`super::biaxial`], Kupfer & Gerstle 1973), found by
+//!   fixed-point iteration, its derivative in the tangent.
 //!
 //! Histories are kept per principal direction in the sorted order (1 = larger strain).
 //! Tangent: T(θ)ᵀ D'' T(θ), D'' = [[∂σ_i/∂ε'_j], G], with the coaxiality shear term
@@ -21,8 +24,10 @@
 //! consistent tangent of the rotating law (its limit 0.25 (D11 − D12 − D21 + D22) for
 //! ε1 = ε2).
 
-use super::cracking::{strain_transform, tension_envelope};
-use super::{compression, reduction, ConcreteParams, ConcreteState, MaterialError, UpdateResult};
+use super::cracking::{strain_transform, tension_envelope, IMPLEX_CAP_SLOPE};
+use super::{
+    biaxial, compression, reduction, ConcreteParams, ConcreteState, MaterialError, UpdateResult,
+};
 
 /// Principal strains ε1 ≥ ε2 [-] of (εx, εy, γxy) and the angle of ε1 from x [rad].
 pub fn principal_strains(e: &[f64; 3]) -> (f64, f64, f64) {
@@ -40,23 +45,28 @@ struct Dir {
     k: f64,
     /// ∂σ/∂ε̃_lat [Pa] (compression softening by the other direction's tensile strain).
     d_lateral: f64,
+    /// ∂σ/∂(scale of the curve) [Pa] at fixed strain (the biaxial gain's lever).
+    d_scale: f64,
     /// Largest tensile strain reached [-].
     emax: f64,
     /// Largest compressive curve strain reached [-].
     xmax: f64,
     /// The direction reached the crushing strain.
     crushed: bool,
+    /// IMPL-EX side of the kink at the extrapolated e_max: 1 past it, −1 below, 0 none.
+    side: i8,
 }
 
 /// Uniaxial law of one principal direction at equivalent strain `e` [-] with lateral
 /// strain `lat` [-] (the other direction's), histories `emax`, `xmax` and held branch
-/// `frozen` (1 envelope, −1 secant, 0 free; see [`super::ConcreteState`]).
+/// `frozen` (1 envelope, −1 secant, 0 free; see [`super::ConcreteState`]), the biaxial
+/// gain `gain` [-] and, with IMPL-EX, the extrapolated largest tensile strain `ex` [-].
 fn direction(
     p: &ConcreteParams,
     alpha: f64,
     (emax, xmax, frozen): (f64, f64, i8),
     e: f64,
-    lat: f64,
+    (lat, gain, ex): (f64, f64, Option<f64>),
 ) -> Dir {
     let mut r = Dir {
         emax,
@@ -64,7 +74,27 @@ fn direction(
         ..Dir::default()
     };
     if e >= 0.0 {
-        if frozen > 0 || (frozen == 0 && e >= emax) || emax <= 0.0 {
+        if let Some(ex) = ex {
+            // IMPL-EX (as the fixed cracks, cracking.rs): the secant at the extrapolated
+            // largest strain up to it, then a line of a tenth of that secant; e_max itself
+            // is updated implicitly for the next extrapolation.
+            let ex = ex.max(p.eps0());
+            let s_ex = tension_envelope(p, alpha, ex).0;
+            let k_cap = IMPLEX_CAP_SLOPE * s_ex / ex;
+            let cap = s_ex + k_cap * (e - ex);
+            r.side = if e > ex { 1 } else { -1 };
+            if frozen < 0 || (frozen == 0 && e <= ex) {
+                r.sigma = s_ex / ex * e;
+                r.k = s_ex / ex;
+            } else if frozen > 0 && p.ec * e < cap {
+                r.sigma = p.ec * e;
+                r.k = p.ec;
+            } else {
+                r.sigma = cap;
+                r.k = k_cap;
+            }
+            r.emax = e.max(emax);
+        } else if frozen > 0 || (frozen == 0 && e >= emax) || emax <= 0.0 {
             let (s, k) = tension_envelope(p, alpha, e);
             r.sigma = s;
             r.k = k;
@@ -76,14 +106,21 @@ fn direction(
         }
         return r;
     }
-    let (beta, dbeta) = reduction::factor(p, lat.max(0.0));
+    // Compression softening by a tensile lateral strain, or the biaxial gain K ≥ 1 when
+    // both directions are compressed (never both: K > 1 needs a compressed lateral).
+    let (beta, dbeta) = if lat > 0.0 {
+        reduction::factor(p, lat)
+    } else {
+        (gain, 0.0)
+    };
     let x = -e / beta;
     if x >= xmax {
         let (s0, ds0) = compression::hardening_curve(p, x);
         r.sigma = -beta * s0;
         r.k = ds0;
         // ∂(−β σ_c(−e/β))/∂β = −σ_c(x) + x σ_c'(x).
-        r.d_lateral = (-s0 + x * ds0) * dbeta;
+        r.d_scale = -s0 + x * ds0;
+        r.d_lateral = r.d_scale * dbeta;
         r.xmax = x;
         r.crushed = x >= p.eps_cu || (x > p.eps_c1 && s0 <= 0.0);
     } else {
@@ -100,11 +137,14 @@ fn direction(
 
 /// Stress update of a rotating-crack point from the committed state and the total strain
 /// (εx, εy, γxy) [-]; `char_length` [m] is the crack band width (crack band only).
+/// `ratio` [-] is the IMPL-EX extrapolation ratio (size of this increment over the
+/// previous one; only with `p.implex`).
 pub fn update(
     p: &ConcreteParams,
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
+    ratio: f64,
 ) -> UpdateResult {
     if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
         && !(char_length > 0.0 && char_length.is_finite())
@@ -116,12 +156,16 @@ pub fn update(
     let alpha = p.softening_alpha(char_length);
     let (e1, e2, theta) = principal_strains(strain);
     let mut cracked = committed.n_cracks > 0;
-    let mut out = evaluate(p, committed, alpha, [e1, e2], cracked);
-    if !cracked && out.0[0].max(out.0[1]) >= p.eps0() {
+    let mut out = evaluate(p, committed, alpha, [e1, e2], cracked, ratio);
+    // IMPL-EX decides cracking on the committed state (explicitly): in the increment the
+    // point cracks its law stays the uncracked one, capped past f_tm.
+    if p.implex && !cracked && out.0[0].max(out.0[1]) >= p.eps0() {
+        cracked = true;
+    } else if !cracked && out.0[0].max(out.0[1]) >= p.eps0() {
         // The point cracks: the Poisson coupling goes (as in the fixed model) and the laws
         // are re-evaluated at the same strain.
         cracked = true;
-        out = evaluate(p, committed, alpha, [e1, e2], cracked);
+        out = evaluate(p, committed, alpha, [e1, e2], cracked, ratio);
     }
     let (et, d, dp) = out;
     let mut st = committed.clone();
@@ -129,6 +173,11 @@ pub fn update(
     st.crack_angle = theta;
     st.crack_max = [d[0].emax, d[1].emax];
     st.crack_max_old = committed.crack_max;
+    if p.implex && committed.n_cracks == 0 && cracked {
+        // Formation: the strain reached is e_max with zero rate (as the fixed cracks).
+        st.crack_max_old = st.crack_max;
+    }
+    st.implex_side = [d[0].side, d[1].side];
     st.crack_strain = et;
     st.dir_ebar = [d[0].xmax, d[1].xmax];
     if d[0].crushed || d[1].crushed {
@@ -168,6 +217,7 @@ fn evaluate(
     alpha: f64,
     e: [f64; 2],
     cracked: bool,
+    ratio: f64,
 ) -> ([f64; 2], [Dir; 2], [[f64; 2]; 2]) {
     let nu = if cracked { 0.0 } else { p.nu };
     let f = 1.0 / (1.0 - nu * nu);
@@ -176,14 +226,63 @@ fn evaluate(
         a[0][0] * e[0] + a[0][1] * e[1],
         a[1][0] * e[0] + a[1][1] * e[1],
     ];
-    let d: [Dir; 2] = std::array::from_fn(|i| {
-        let h = (c.crack_max[i], c.dir_ebar[i], c.frozen[i]);
-        direction(p, alpha, h, et[i], et[1 - i])
-    });
-    let dp: [[f64; 2]; 2] = std::array::from_fn(|i| {
+    // IMPL-EX: e_max extrapolated linearly from the last two committed states (ε0 before
+    // the point has cracked: elastic up to f_tm, then the capped line).
+    let ex = |i: usize| {
+        p.implex.then(|| {
+            let (m, o) = (c.crack_max[i], c.crack_max_old[i]);
+            if c.n_cracks > 0 {
+                m + ratio.max(0.0) * (m - o).max(0.0)
+            } else {
+                p.eps0()
+            }
+        })
+    };
+    let dirs = |gain: f64| -> [Dir; 2] {
+        std::array::from_fn(|i| {
+            let h = (c.crack_max[i], c.dir_ebar[i], c.frozen[i]);
+            direction(p, alpha, h, et[i], (et[1 - i], gain, ex(i)))
+        })
+    };
+    let mut d = dirs(1.0);
+    // Biaxial compression: K(α) of the stresses it produces, by fixed-point iteration (a
+    // contraction: |dK/dα| ≤ 0.25 and α moves little with K).
+    let mut kg = None;
+    if et[0] < 0.0 && et[1] < 0.0 {
+        let mut k = 1.0;
+        for _ in 0..100 {
+            let Some((r, _)) = biaxial::ratio([d[0].sigma, d[1].sigma]) else {
+                break;
+            };
+            let k_new = biaxial::gain(r).0;
+            let done = (k_new - k).abs() <= 1e-13;
+            k = k_new;
+            d = dirs(k);
+            if done {
+                break;
+            }
+        }
+        kg = biaxial::ratio([d[0].sigma, d[1].sigma]).map(|(r, dr)| (biaxial::gain(r).1, dr));
+    }
+    let mut dp: [[f64; 2]; 2] = std::array::from_fn(|i| {
         let j = 1 - i;
         let lat_on = if et[j] > 0.0 { 1.0 } else { 0.0 };
         std::array::from_fn(|m| d[i].k * a[i][m] + d[i].d_lateral * lat_on * a[j][m])
     });
+    if let Some((dk, dr)) = kg {
+        // dσ = A dε + s dK, dK = gᵀ dσ (g = K'(α) ∂α/∂σ, s = ∂σ/∂K): dσ/dε = A +
+        // s (gᵀA)/(1 − gᵀs) (Sherman–Morrison).
+        let s = [d[0].d_scale, d[1].d_scale];
+        let g = [dk * dr[0], dk * dr[1]];
+        let den = 1.0 - (g[0] * s[0] + g[1] * s[1]);
+        if den.abs() > 1e-12 {
+            let ga: [f64; 2] = std::array::from_fn(|m| g[0] * dp[0][m] + g[1] * dp[1][m]);
+            for (i, row) in dp.iter_mut().enumerate() {
+                for (m, v) in row.iter_mut().enumerate() {
+                    *v += s[i] * ga[m] / den;
+                }
+            }
+        }
+    }
     (et, d, dp)
 }
