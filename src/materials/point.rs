@@ -77,6 +77,25 @@ impl Material {
         }
     }
 
+    /// The casting day [d] of a time-dependent material (creeping concrete of either
+    /// kind), to be set per region; None for materials without ageing.
+    pub fn cast_day_mut(&mut self) -> Option<&mut f64> {
+        match self {
+            Material::AgeingViscoelastic { cast_day, .. } => Some(cast_day),
+            Material::Concrete { params, .. } => params.creep.as_mut().map(|c| &mut c.cast_day),
+            Material::Elastic { .. } => None,
+        }
+    }
+
+    /// The casting day [d] of a time-dependent material; None for materials without ageing.
+    pub fn cast_day(&self) -> Option<f64> {
+        match self {
+            Material::AgeingViscoelastic { cast_day, .. } => Some(*cast_day),
+            Material::Concrete { params, .. } => params.creep.as_ref().map(|c| c.cast_day),
+            Material::Elastic { .. } => None,
+        }
+    }
+
     /// True if the tangent of this material is constant (the step can skip re-factorising).
     pub fn is_linear(&self) -> bool {
         // Concrete is never linear.
@@ -248,15 +267,28 @@ pub fn update_with_time(
             Ok((PointState::Elastic, mul3(&d, strain), d))
         }
         (Material::Concrete { params, .. }, PointState::Concrete(c)) => {
-            let (st, sig, mut d) = concrete::update_full(
-                params,
-                c,
-                strain,
-                char_length,
-                time.dt(),
-                time.extrapolation,
-            )
-            .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
+            let res = match &params.creep {
+                // Creep and shrinkage in series with the crack laws (concrete/creep.rs).
+                Some(cr) => concrete::creep::update(
+                    params,
+                    cr,
+                    c,
+                    strain,
+                    char_length,
+                    time.t_from,
+                    time.t_to,
+                    time.extrapolation,
+                ),
+                None => concrete::update_full(
+                    params,
+                    c,
+                    strain,
+                    char_length,
+                    time.dt(),
+                    time.extrapolation,
+                ),
+            };
+            let (st, sig, mut d) = res.map_err(|e| UpdateError::NotConverged(e.to_string()))?;
             // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
             // the symmetric solvers take its symmetric part (same converged answer, possibly
             // more iterations).
