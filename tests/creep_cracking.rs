@@ -61,8 +61,8 @@ nu = 0.2
 cement = "N"
 "#;
 
-/// The cracking concrete with the same creep keys; the initial yield at 0.4 f_cm keeps the
-/// compression plasticity out of the linear-creep range (MC90: creep is linear below it).
+/// The cracking concrete with the same creep keys (with creep its compression plasticity
+/// starts at 0.4 f_cm by default, the limit of MC90's linear creep).
 const CRACKING_CREEP: &str = r#"
 [[materials]]
 name = "c"
@@ -71,7 +71,6 @@ creep = "mc90"
 fcm = 45e6
 nu = 0.2
 cement = "N"
-initial_yield_ratio = 0.4
 "#;
 
 /// A 6 m simply supported beam, 0.3 × 0.6 m, under self weight from day 28, with creep and
@@ -312,4 +311,144 @@ fn restrained_shrinkage_cracks_when_the_stress_reaches_ftm() {
         t_cr > t_a - widen && t_cr <= t_b + widen,
         "onset {t_cr} not in ({t_a}, {t_b}] ± {widen}"
     );
+}
+
+/// A 0.1 m square Q4 specimen of creeping concrete (fcm 45 MPa, RH 70 %, h0 0.2 m, no
+/// shrinkage), held on its left edge in x and at a corner in y, loaded on day 28 by a
+/// uniform compression `stress` [Pa] and held for 1e4 days.
+fn specimen(stress: f64, nonlinear: bool) -> String {
+    format!(
+        r#"{CRACKING_CREEP}rh = 0.70
+h0 = 0.200
+shrinkage = false
+nonlinear_creep = {nonlinear}
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 0.1
+nx = 1
+element = "Q4"
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "P"
+line_loads = [{{ line = [[0.1, 0.0], [0.1, 0.1]], q = [{q}, 0.0] }}]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ P = 1.0 }}
+increments = 4
+[[steps]]
+name = "creep"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#,
+        q = stress * 0.1
+    )
+}
+
+#[test]
+fn nonlinear_creep_multiplies_creep_by_the_mc90_factor() {
+    // σ = −0.5 f_cm held from day 28: MC90 multiplies φ by exp[1.5 (0.5 − 0.4)] = 1.1618.
+    // With the stress held, the chain strain, the plastic strain (rate-independent) and the
+    // load-step strain are the same with and without the option, so the creep strain
+    // ε(t) − ε(t0) must scale by exactly that factor. 1e-6: the Newton tolerance of the
+    // substeps (the law is linear in the factor); a factor applied to the whole strain, or
+    // not at all, misses by > 5 %.
+    let sigma = -0.5 * 45e6;
+    let lin = run(&specimen(sigma, false));
+    let nl = run(&specimen(sigma, true));
+    assert_eq!(lin.len(), nl.len());
+    let k = (1.5_f64 * 0.1).exp();
+    let at_load = |r: &[Rec]| r.iter().rposition(|x| x.time == 28.0).unwrap();
+    let (i0, j0) = (at_load(&lin), at_load(&nl));
+    assert_eq!(i0, j0);
+    let e = |r: &Rec| r.u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    assert!((e(&lin[i0]) - e(&nl[j0])).abs() < 1e-12, "same load step");
+    for (a, b) in lin[i0 + 1..].iter().zip(&nl[j0 + 1..]) {
+        let (ca, cb) = (e(a) - e(&lin[i0]), e(b) - e(&nl[j0]));
+        if a.time - 28.0 >= 1.0 {
+            assert!(
+                (cb / ca / k - 1.0).abs() < 1e-6,
+                "t = {}: creep ratio {} vs {k}",
+                a.time,
+                cb / ca
+            );
+        }
+    }
+    // The linear run really crept: ≥ 1.5× the load-step shortening after 1e4 days.
+    assert!(e(lin.last().unwrap()) > 1.5 * e(&lin[i0]));
+}
+
+#[test]
+fn creep_option_bad_input_names_the_key() {
+    let base = |extra: &str| {
+        format!(
+            r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 45e6
+{extra}
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 1.0
+nx = 1
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "s"
+point = [0.0, 0.0]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "s2"
+point = [1.0, 0.0]
+uy = 0.0
+[[steps]]
+name = "t"
+kind = "time"
+from = 28.0
+duration = 10.0
+"#
+        )
+    };
+    for (extra, field, says) in [
+        ("rh = 0.7", "materials[0].rh", "creep = \"mc90\" only"),
+        ("creep = \"b3\"", "materials[0].creep", "expected mc90"),
+        ("creep = \"mc90\"\nh0 = 0.2", "materials[0].rh", "missing"),
+        (
+            "creep = \"mc90\"\nrh = 0.7\nh0 = 0.2\nE = 30e9",
+            "materials[0].E",
+            "remove E",
+        ),
+        (
+            "creep = \"mc90\"\nrh = 0.7\nh0 = 0.2\nviscoplastic = { fluidity = 1.0 }",
+            "materials[0].viscoplastic",
+            "two time laws",
+        ),
+    ] {
+        let err = match segfem::input::parse(&base(extra), "bad.toml") {
+            Ok(_) => panic!("accepted: {extra}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(field) && err.contains(says), "{extra}: {err}");
+    }
+    // The option itself is accepted.
+    segfem::input::parse(&base("creep = \"mc90\"\nrh = 0.7\nh0 = 0.2"), "ok.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
 }

@@ -370,20 +370,32 @@ pub fn crack_base(
     trial: &PointState,
 ) -> Option<PointState> {
     match (mat, committed, trial) {
-        (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t))
-            if !params.implex && c.n_cracks == 0 && t.n_cracks > 0 && !c.crushed && !t.crushed =>
-        {
-            let mut b = (**c).clone();
-            let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
-            b.n_cracks = 1;
-            b.crack_angle = t.crack_angle;
-            b.crack_max = [0.0; 2];
-            b.dir_ebar = [ebar_n; 2];
-            b.dir_plastic = [0.0; 2];
-            Some(PointState::Concrete(Box::new(b)))
+        (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t)) => {
+            crack_latch(params, c, t).map(|b| PointState::Concrete(Box::new(b)))
         }
         _ => None,
     }
+}
+
+/// [`crack_base`] for a concrete point: the committed state `c` with the first crack of the
+/// trial `t`, or None (IMPL-EX, no new crack, already cracked or crushed). Also used by the
+/// local solve of creeping concrete (concrete/creep.rs).
+pub(crate) fn crack_latch(
+    params: &ConcreteParams,
+    c: &ConcreteState,
+    t: &ConcreteState,
+) -> Option<ConcreteState> {
+    if params.implex || c.n_cracks != 0 || t.n_cracks == 0 || c.crushed || t.crushed {
+        return None;
+    }
+    let mut b = c.clone();
+    let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
+    b.n_cracks = 1;
+    b.crack_angle = t.crack_angle;
+    b.crack_max = [0.0; 2];
+    b.dir_ebar = [ebar_n; 2];
+    b.dir_plastic = [0.0; 2];
+    Some(b)
 }
 
 /// The state an update should start from for the rest of an increment once an uncracked

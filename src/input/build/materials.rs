@@ -407,6 +407,14 @@ pub(super) fn concrete_law(
     }
     shear_options(ctx, i, m, &mut p)?;
     p.creep = concrete_creep(ctx, i, m, fcm, warnings)?;
+    if p.creep.is_some()
+        && m.initial_yield_ratio.is_none()
+        && p.crack_model == crate::materials::concrete::CrackModel::Fixed
+    {
+        // MC90 creep is linear up to 0.4 f_cm and its compliance holds the whole strain
+        // there: the compression plasticity starts at that stress (docs/theory-time.md §9).
+        p.initial_yield_ratio = 0.4;
+    }
     p.validate()
         .map_err(|e| ctx.err(format!("materials[{i}]"), e.to_string()))?;
     Ok(Material::Concrete {

@@ -30,7 +30,32 @@ use super::{update_full, ConcreteParams, ConcreteState, MaterialError, UpdateRes
 use crate::materials::chain::{chain_predictor, plane_stress_d1, plane_stress_d1_inv};
 use crate::materials::chain::{ChainState, MaxwellChain};
 use crate::materials::mc90_time::{high_stress_creep_factor, shrinkage_strain};
+use crate::materials::point::{crack_latch, freeze_cracks, plastic_base, PointState};
 use std::sync::Arc;
+
+/// [`plastic_base`] on concrete states.
+fn plastic_latch(base: &ConcreteState, trial: &ConcreteState) -> Option<ConcreteState> {
+    let (b, t) = (
+        PointState::Concrete(Box::new(base.clone())),
+        PointState::Concrete(Box::new(trial.clone())),
+    );
+    match plastic_base(&b, &t)? {
+        PointState::Concrete(c) => Some(*c),
+        _ => None,
+    }
+}
+
+/// [`freeze_cracks`] on concrete states.
+fn freeze_latch(base: &ConcreteState, trial: &ConcreteState) -> Option<ConcreteState> {
+    let (b, t) = (
+        PointState::Concrete(Box::new(base.clone())),
+        PointState::Concrete(Box::new(trial.clone())),
+    );
+    match freeze_cracks(&b, &t)? {
+        PointState::Concrete(c) => Some(*c),
+        _ => None,
+    }
+}
 
 /// The MC90 creep and shrinkage of a concrete material (`creep = "mc90"`).
 #[derive(Debug, Clone)]
@@ -91,17 +116,18 @@ fn inv3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     }))
 }
 
-/// MC90's non-linear creep factor for the stress `s` [Pa] at concrete age `age` [d]: the
-/// largest compressive principal stress over f_cm(age) [-] (1 at and below 0.4 f_cm).
-pub fn nonlinear_factor(creep: &ConcreteCreep, s: &[f64; 3], age: f64) -> f64 {
+/// MC90's non-linear creep factor exp[1.5(|σ_c|/f_cm − 0.4)] for the stress `s` [Pa]
+/// (σ_c the largest compressive principal stress; 1 at and below 0.4 f_cm). f_cm is the
+/// 28-day strength, as in the crack and plasticity laws (strengths do not age): for loading
+/// at 28 days this is MC90's f_cm(t0).
+pub fn nonlinear_factor(creep: &ConcreteCreep, s: &[f64; 3]) -> f64 {
     let c = 0.5 * (s[0] + s[1]);
     let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
     let s2 = c - r;
     if s2 >= 0.0 {
         return 1.0;
     }
-    let p = creep.chain.params();
-    high_stress_creep_factor(-s2 / p.fcm_at(age.max(1.0)))
+    high_stress_creep_factor(-s2 / creep.chain.params().fcm)
 }
 
 /// Stress update of a creeping concrete point over the increment `t_from` → `t_to`
@@ -146,7 +172,7 @@ pub fn update(
     };
     // Extra creep of MC90's stress-dependent factor, explicit on the committed stress.
     let d_nl: [f64; 3] = if creep.nonlinear && a1 > a0 {
-        let k = nonlinear_factor(creep, &committed.stress, a0);
+        let k = nonlinear_factor(creep, &committed.stress);
         pred.d_creep_strain.map(|v| (k - 1.0) * v)
     } else {
         [0.0; 3]
@@ -162,9 +188,9 @@ pub fn update(
     // The concrete law must not see the creep state (its own update clones it through).
     let mut base = committed.clone();
     base.creep = None;
-    let eval = |x: &[f64; 3]| {
+    let eval = |base: &ConcreteState, x: &[f64; 3]| {
         let em: [f64; 3] = std::array::from_fn(|i| eps_mn[i] + x[i]);
-        let (st, s, d) = update_full(p, &base, &em, char_length, 0.0, ratio)?;
+        let (st, s, d) = update_full(p, base, &em, char_length, 0.0, ratio)?;
         let ds: [f64; 3] = std::array::from_fn(|i| s[i] - sig_n[i]);
         let g0 = matvec(&d1inv, &ds);
         let g: [f64; 3] = std::array::from_fn(|i| x[i] + cr * g0[i] - d_star[i]);
@@ -176,9 +202,26 @@ pub fn update(
         .fold(p.eps0(), |a, &v| a.max(v.abs()));
     let tol = 1e-12 * scale;
     let mut x: [f64; 3] = d_star.map(|v| v * (e2 / ec));
-    let (mut st, mut s, mut d, mut g) = eval(&x)?;
+    let (mut st, mut s, mut d, mut g) = eval(&base, &x)?;
     let mut it = 0;
+    let mut frozen = false;
     while g.iter().any(|v| v.abs() > tol) {
+        // Latching, as the global iterations do (point.rs): a crack formed or a plastic
+        // route taken in an iterate is kept for the rest of the solve, and crack branches
+        // are held once the iterates cycle; the law is then smooth in x.
+        let latched = crack_latch(p, &base, &st)
+            .or_else(|| plastic_latch(&base, &st))
+            .or_else(|| {
+                (it >= 12 && !frozen).then(|| {
+                    frozen = true;
+                    freeze_latch(&base, &st)
+                })?
+            });
+        if let Some(b) = latched {
+            base = b;
+            (st, s, d, g) = eval(&base, &x)?;
+            continue;
+        }
         if it == MAX_LOCAL {
             return Err(MaterialError::InvalidParams(format!(
                 "creeping concrete: the series of creep and cracking did not converge \
@@ -206,7 +249,7 @@ pub fn update(
         let mut step = 1.0;
         loop {
             let xt: [f64; 3] = std::array::from_fn(|i| x[i] - step * dx[i]);
-            let r = eval(&xt)?;
+            let r = eval(&base, &xt)?;
             let r_norm = r.3.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
             if r_norm < g_norm || step < 1e-3 {
                 x = xt;
@@ -244,6 +287,9 @@ pub fn update(
             std::array::from_fn(|c| pred.beta[mu] * old[c] + f * d1ve[c])
         })
         .collect();
+    // The local holds end with the update: the global iterations decide their own.
+    st.hold_plastic = committed.hold_plastic;
+    st.frozen = committed.frozen;
     st.creep = Some(Box::new(CreepState {
         chain: ChainState { hidden },
         strain: *strain,
