@@ -77,6 +77,25 @@ impl Material {
         }
     }
 
+    /// The casting day [d] of a time-dependent material (creeping concrete of either
+    /// kind), to be set per region; None for materials without ageing.
+    pub fn cast_day_mut(&mut self) -> Option<&mut f64> {
+        match self {
+            Material::AgeingViscoelastic { cast_day, .. } => Some(cast_day),
+            Material::Concrete { params, .. } => params.creep.as_mut().map(|c| &mut c.cast_day),
+            Material::Elastic { .. } => None,
+        }
+    }
+
+    /// The casting day [d] of a time-dependent material; None for materials without ageing.
+    pub fn cast_day(&self) -> Option<f64> {
+        match self {
+            Material::AgeingViscoelastic { cast_day, .. } => Some(*cast_day),
+            Material::Concrete { params, .. } => params.creep.as_ref().map(|c| c.cast_day),
+            Material::Elastic { .. } => None,
+        }
+    }
+
     /// True if the tangent of this material is constant (the step can skip re-factorising).
     pub fn is_linear(&self) -> bool {
         // Concrete is never linear.
@@ -248,15 +267,28 @@ pub fn update_with_time(
             Ok((PointState::Elastic, mul3(&d, strain), d))
         }
         (Material::Concrete { params, .. }, PointState::Concrete(c)) => {
-            let (st, sig, mut d) = concrete::update_full(
-                params,
-                c,
-                strain,
-                char_length,
-                time.dt(),
-                time.extrapolation,
-            )
-            .map_err(|e| UpdateError::NotConverged(e.to_string()))?;
+            let res = match &params.creep {
+                // Creep and shrinkage in series with the crack laws (concrete/creep.rs).
+                Some(cr) => concrete::creep::update(
+                    params,
+                    cr,
+                    c,
+                    strain,
+                    char_length,
+                    time.t_from,
+                    time.t_to,
+                    time.extrapolation,
+                ),
+                None => concrete::update_full(
+                    params,
+                    c,
+                    strain,
+                    char_length,
+                    time.dt(),
+                    time.extrapolation,
+                ),
+            };
+            let (st, sig, mut d) = res.map_err(|e| UpdateError::NotConverged(e.to_string()))?;
             // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
             // the symmetric solvers take its symmetric part (same converged answer, possibly
             // more iterations).
@@ -338,20 +370,32 @@ pub fn crack_base(
     trial: &PointState,
 ) -> Option<PointState> {
     match (mat, committed, trial) {
-        (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t))
-            if !params.implex && c.n_cracks == 0 && t.n_cracks > 0 && !c.crushed && !t.crushed =>
-        {
-            let mut b = (**c).clone();
-            let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
-            b.n_cracks = 1;
-            b.crack_angle = t.crack_angle;
-            b.crack_max = [0.0; 2];
-            b.dir_ebar = [ebar_n; 2];
-            b.dir_plastic = [0.0; 2];
-            Some(PointState::Concrete(Box::new(b)))
+        (Material::Concrete { params, .. }, PointState::Concrete(c), PointState::Concrete(t)) => {
+            crack_latch(params, c, t).map(|b| PointState::Concrete(Box::new(b)))
         }
         _ => None,
     }
+}
+
+/// [`crack_base`] for a concrete point: the committed state `c` with the first crack of the
+/// trial `t`, or None (IMPL-EX, no new crack, already cracked or crushed). Also used by the
+/// local solve of creeping concrete (concrete/creep.rs).
+pub(crate) fn crack_latch(
+    params: &ConcreteParams,
+    c: &ConcreteState,
+    t: &ConcreteState,
+) -> Option<ConcreteState> {
+    if params.implex || c.n_cracks != 0 || t.n_cracks == 0 || c.crushed || t.crushed {
+        return None;
+    }
+    let mut b = c.clone();
+    let ebar_n = c.ebar.max(concrete::compression::initial_yield(params).0);
+    b.n_cracks = 1;
+    b.crack_angle = t.crack_angle;
+    b.crack_max = [0.0; 2];
+    b.dir_ebar = [ebar_n; 2];
+    b.dir_plastic = [0.0; 2];
+    Some(b)
 }
 
 /// The state an update should start from for the rest of an increment once an uncracked

@@ -21,8 +21,9 @@ use std::path::Path;
 pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &str = "segfem checkpoint";
 /// Format version; bumped whenever a saved structure changes (the test `layout_has_a_version`
-/// fails until it is). 2: trailing checksum; 3: state saved by element family.
-const VERSION: u32 = 3;
+/// fails until it is). 2: trailing checksum; 3: state saved by element family; 4: creep state
+/// of creeping concrete points.
+const VERSION: u32 = 4;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -31,7 +32,10 @@ const CHECKSUM_BYTES: usize = 8;
 /// changes the digest: append a line with the next version and the new digest, and set
 /// [`VERSION`] to it.
 #[cfg(test)]
-const LAYOUTS: &[(u32, u64)] = &[(3, 16_113_229_074_358_229_730)];
+const LAYOUTS: &[(u32, u64)] = &[
+    (3, 16_113_229_074_358_229_730),
+    (4, 14_334_971_633_857_522_506),
+];
 
 #[derive(Serialize, Deserialize)]
 struct Header {

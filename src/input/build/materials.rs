@@ -5,6 +5,7 @@ use super::fields::{fraction, positive, unique_names};
 use super::R;
 use crate::input::error::Ctx;
 use crate::input::units;
+use crate::materials::concrete::creep::ConcreteCreep;
 use crate::materials::concrete::{
     CompressionSoftening, ConcreteParams, ShearRetention, TensionSoftening,
 };
@@ -87,6 +88,9 @@ pub struct MaterialIn {
     pub n_units: Option<usize>,
     pub shrinkage: Option<bool>,
     pub drying_start: Option<f64>,
+    // concrete: creep option (takes the elastic_creep keys above)
+    pub creep: Option<String>,
+    pub nonlinear_creep: Option<bool>,
 }
 
 /// The kinds of `[[materials]]` (`kind = "..."`), one per material law the model file offers.
@@ -174,6 +178,14 @@ impl MaterialKind {
                 "compression_reduction_min",
                 "shear_retention",
                 "aggregate_size",
+                "creep",
+                "rh",
+                "h0",
+                "cement",
+                "n_units",
+                "shrinkage",
+                "drying_start",
+                "nonlinear_creep",
             ],
             MaterialKind::Rebar => &["E", "fy", "Et"],
             MaterialKind::PrestressingSteel => &["Ep", "fptk", "eps_uk"],
@@ -394,6 +406,15 @@ pub(super) fn concrete_law(
         p.viscoplastic = Some(viscoplastic_option(ctx, i, v)?);
     }
     shear_options(ctx, i, m, &mut p)?;
+    p.creep = concrete_creep(ctx, i, m, fcm, warnings)?;
+    if p.creep.is_some()
+        && m.initial_yield_ratio.is_none()
+        && p.crack_model == crate::materials::concrete::CrackModel::Fixed
+    {
+        // MC90 creep is linear up to 0.4 f_cm and its compliance holds the whole strain
+        // there: the compression plasticity starts at that stress (docs/theory-time.md §9).
+        p.initial_yield_ratio = 0.4;
+    }
     p.validate()
         .map_err(|e| ctx.err(format!("materials[{i}]"), e.to_string()))?;
     Ok(Material::Concrete {
@@ -718,8 +739,6 @@ pub(super) fn creep_material(
     m: &MaterialIn,
     warnings: &mut Vec<String>,
 ) -> R<Material> {
-    use crate::materials::chain::{MaxwellChain, DEFAULT_UNITS};
-    use crate::materials::mc90_time::{CementClass, CreepShrinkageParams};
     let k = |f: &str| format!("materials[{i}].{f}");
     if m.e.is_some() {
         return Err(ctx.err(
@@ -733,6 +752,84 @@ pub(super) fn creep_material(
         &k("fcm"),
         m.fcm.ok_or_else(|| ctx.err(k("fcm"), "missing [Pa]"))?,
     )?;
+    let (chain, shrinkage) = mc90_creep_keys(ctx, i, m, fcm, warnings)?;
+    let (nu, density) = poisson_and_density(ctx, i, m)?;
+    Ok(Material::AgeingViscoelastic {
+        chain: std::sync::Arc::new(chain),
+        nu,
+        density,
+        cast_day: 0.0,
+        shrinkage,
+    })
+}
+
+/// `creep = "mc90"` of a concrete: the MC90 chain and shrinkage from the same keys as
+/// `elastic_creep` (docs/input.md), in series with the crack laws. None without the key; the
+/// creep keys are then an error.
+fn concrete_creep(
+    ctx: &Ctx,
+    i: usize,
+    m: &MaterialIn,
+    fcm: f64,
+    warnings: &mut Vec<String>,
+) -> R<Option<ConcreteCreep>> {
+    let k = |f: &str| format!("materials[{i}].{f}");
+    match m.creep.as_deref() {
+        None => {
+            for (f, given) in [
+                ("rh", m.rh.is_some()),
+                ("h0", m.h0.is_some()),
+                ("cement", m.cement.is_some()),
+                ("n_units", m.n_units.is_some()),
+                ("shrinkage", m.shrinkage.is_some()),
+                ("drying_start", m.drying_start.is_some()),
+                ("nonlinear_creep", m.nonlinear_creep.is_some()),
+            ] {
+                if given {
+                    return Err(ctx.err(k(f), "used by creep = \"mc90\" only"));
+                }
+            }
+            Ok(None)
+        }
+        Some("mc90") => {
+            if m.e.is_some() {
+                return Err(ctx.err(
+                    k("E"),
+                    "a creeping concrete takes its modulus from fcm (MC90 E_ci, ageing through \
+                     the creep chain); remove E",
+                ));
+            }
+            if m.viscoplastic.is_some() {
+                return Err(ctx.err(
+                    k("viscoplastic"),
+                    "creep and the viscoplastic option are two time laws: choose one",
+                ));
+            }
+            let (chain, shrinkage) = mc90_creep_keys(ctx, i, m, fcm, warnings)?;
+            Ok(Some(ConcreteCreep {
+                chain: std::sync::Arc::new(chain),
+                cast_day: 0.0,
+                shrinkage,
+                nonlinear: m.nonlinear_creep.unwrap_or(false),
+            }))
+        }
+        Some(o) => Err(ctx.err(k("creep"), format!("unknown value '{o}' (expected mc90)"))),
+    }
+}
+
+/// The MC90 creep and shrinkage keys shared by `elastic_creep` and the concrete's
+/// `creep = "mc90"` (fcm range, rh, h0, cement, n_units, drying_start, shrinkage): the fitted
+/// chain and whether shrinkage is on.
+fn mc90_creep_keys(
+    ctx: &Ctx,
+    i: usize,
+    m: &MaterialIn,
+    fcm: f64,
+    warnings: &mut Vec<String>,
+) -> R<(crate::materials::chain::MaxwellChain, bool)> {
+    use crate::materials::chain::{MaxwellChain, DEFAULT_UNITS};
+    use crate::materials::mc90_time::{CementClass, CreepShrinkageParams};
+    let k = |f: &str| format!("materials[{i}].{f}");
     if !(5e6..=200e6).contains(&fcm) {
         return Err(ctx.err(
             k("fcm"),
@@ -781,7 +878,6 @@ pub(super) fn creep_material(
             ))
         }
     };
-    let (nu, density) = poisson_and_density(ctx, i, m)?;
     let n_units = m.n_units.unwrap_or(DEFAULT_UNITS);
     if !(2..=12).contains(&n_units) {
         return Err(ctx.err(
@@ -803,13 +899,7 @@ pub(super) fn creep_material(
             format!("creep chain identification failed: {e}"),
         )
     })?;
-    Ok(Material::AgeingViscoelastic {
-        chain: std::sync::Arc::new(chain),
-        nu,
-        density,
-        cast_day: 0.0,
-        shrinkage: m.shrinkage.unwrap_or(true),
-    })
+    Ok((chain, m.shrinkage.unwrap_or(true)))
 }
 
 /// The Poisson ratio (required, in (−1, 0.5)) and density (default 0, ≥ 0 [kg/m³]) of a

@@ -6,7 +6,6 @@ use super::R;
 use crate::input::error::Ctx;
 use crate::input::schema::{MeshIn, RegionIn};
 use crate::input::units;
-use crate::materials::point::Material;
 use crate::materials::steel::SteelParams;
 use crate::mesh::segmental;
 use crate::model::{Element, Model, NamedMaterial, Region};
@@ -108,7 +107,7 @@ pub(super) fn assign_cast_days(
     let mut copies: HashMap<(usize, u64), usize> = HashMap::new();
     for (i, (r, region)) in input.iter().zip(regions.iter_mut()).enumerate() {
         let m = region.material;
-        let creep = matches!(materials[m].law, Material::AgeingViscoelastic { .. });
+        let creep = materials[m].law.cast_day().is_some();
         let day = r.unwrap_or(0.0);
         if !day.is_finite() {
             return Err(ctx.err(
@@ -138,7 +137,7 @@ pub(super) fn assign_cast_days(
             materials.push(copy);
             materials.len() - 1
         };
-        if let Material::AgeingViscoelastic { cast_day, .. } = &mut materials[idx].law {
+        if let Some(cast_day) = materials[idx].law.cast_day_mut() {
             *cast_day = day;
         }
         copies.insert(key, idx);
@@ -160,7 +159,7 @@ pub(super) fn check_ages(
         if !used[i] {
             continue;
         }
-        if let Material::AgeingViscoelastic { cast_day, .. } = &model.materials[r.material].law {
+        if let Some(cast_day) = model.materials[r.material].law.cast_day() {
             let age = start - cast_day;
             if age < 0.0 {
                 return Err(ctx.err(

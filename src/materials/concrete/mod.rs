@@ -19,6 +19,7 @@ pub mod beam_bench;
 pub mod biaxial;
 pub mod compression;
 pub mod cracking;
+pub mod creep;
 pub mod ottosen;
 pub mod panel_bench;
 pub mod reduction;
@@ -227,6 +228,10 @@ pub struct ConcreteParams {
     /// Shear retention law of fixed cracks (default the seed's β law).
     #[serde(default)]
     pub shear_retention: ShearRetentionLaw,
+    /// MC90 creep and shrinkage in series with cracking and plasticity (None: the
+    /// time-independent concrete, the default; see [`creep`]).
+    #[serde(skip)]
+    pub creep: Option<creep::ConcreteCreep>,
 }
 
 impl ConcreteParams {
@@ -267,6 +272,7 @@ impl ConcreteParams {
             crack_model: CrackModel::Fixed,
             compression_reduction: CompressionReduction::None,
             shear_retention: ShearRetentionLaw::Seed,
+            creep: None,
         }
     }
 
@@ -314,6 +320,9 @@ impl ConcreteParams {
             if !(beta_min > 0.0 && beta_min <= 1.0) {
                 return bad("the compression reduction floor must lie in (0, 1]");
             }
+        }
+        if self.creep.is_some() && self.viscoplastic.is_some() {
+            return bad("creep and the viscoplastic option are two time laws: choose one");
         }
         if let ShearRetentionLaw::Aggregate { d_agg } = self.shear_retention {
             if !(d_agg > 0.0 && d_agg.is_finite()) {
@@ -473,6 +482,11 @@ pub struct ConcreteState {
     /// [`crate::materials::point::freeze_cracks`] from trial states.
     #[serde(default)]
     pub(crate) implex_side: [i8; 2],
+    /// Creep state (chain, total strain, shrinkage) of a creeping concrete point (None
+    /// without the creep option or before its first update; see [`creep`]). With creep,
+    /// `strain` above is the concrete law's input ε_m, not the total strain.
+    #[serde(default)]
+    pub(crate) creep: Option<Box<creep::CreepState>>,
 }
 
 impl Default for ConcreteState {
@@ -501,6 +515,7 @@ impl ConcreteState {
             crack_max_old: [0.0; 2],
             hold_plastic: false,
             implex_side: [0; 2],
+            creep: None,
         }
     }
 

@@ -1,0 +1,638 @@
+//! Concrete that cracks and creeps: `kind = "concrete"` with `creep = "mc90"` (the MC90
+//! Maxwell chain and shrinkage in series with the crack laws, docs/theory-time.md §9).
+//! Run with `cargo nextest run --release -E 'binary(creep_cracking)'`.
+
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::materials::chain::relaxation_function;
+use segfem::materials::mc90_time::{
+    creep_coefficient, shrinkage_strain, CementClass, CreepShrinkageParams,
+};
+
+/// One record per converged increment: time, displacements, Gauss-point stresses and
+/// strains, number of cracked points.
+#[derive(Debug, Clone, Default)]
+struct Rec {
+    time: f64,
+    u: Vec<f64>,
+    stress: Vec<[f64; 3]>,
+    cracked: usize,
+}
+
+#[derive(Default)]
+struct Keep(Vec<Rec>);
+
+impl Observer for Keep {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        let sys = s.system;
+        let g = &sys.families.continuum.gauss.committed;
+        self.0.push(Rec {
+            time: sys.time.t_to,
+            u: sys.u.clone(),
+            stress: g.iter().map(|o| o.stress).collect(),
+            cracked: sys
+                .families
+                .continuum
+                .points
+                .committed
+                .iter()
+                .filter(|p| p.n_cracks() > 0)
+                .count(),
+        });
+        Ok(())
+    }
+}
+
+fn run(text: &str) -> Vec<Rec> {
+    let model = segfem::input::parse(text, "creep_cracking.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let mut k = Keep::default();
+    steps::run(&model, &mut k).unwrap_or_else(|e| panic!("{e}"));
+    k.0
+}
+
+/// MC90 keys shared by both concrete kinds: fcm 45 MPa, cement N, ν = 0.2.
+const ELASTIC_CREEP: &str = r#"
+[[materials]]
+name = "c"
+kind = "elastic_creep"
+fcm = 45e6
+nu = 0.2
+cement = "N"
+"#;
+
+/// The cracking concrete with the same creep keys (with creep its compression plasticity
+/// starts at 0.4 f_cm by default, the limit of MC90's linear creep).
+const CRACKING_CREEP: &str = r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+creep = "mc90"
+fcm = 45e6
+nu = 0.2
+cement = "N"
+"#;
+
+/// A 6 m simply supported beam, 0.3 × 0.6 m, under self weight from day 28, with creep and
+/// shrinkage for 1e4 days: extreme fibre stresses ≈ ±1.1 MPa, far from cracking and from
+/// 0.4 f_cm.
+fn uncracked_beam(material: &str) -> String {
+    format!(
+        r#"{material}rh = 0.70
+h0 = 0.200
+density = 2500.0
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.3
+[mesh]
+type = "banded"
+length = 6.0
+nx = 12
+element = "Q8"
+bands = [{{ region = "r", depth = 0.6, rows = 3 }}]
+[[supports]]
+name = "left"
+point = [0.0, 0.0]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "right"
+point = [6.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "g"
+gravity = [0.0, -9.81]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ g = 1.0 }}
+[[steps]]
+name = "creep"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#
+    )
+}
+
+#[test]
+fn uncracked_concrete_reproduces_elastic_creep() {
+    // Where nothing cracks or yields the series of chain and crack law is the chain alone:
+    // the local equation is solved by its first (elastic) evaluation and the stress is
+    // σ_n + E''D1(Δε − Δε'' − Δε_sh) computed in another order. Round-off: 1e-9 of the
+    // largest displacement and stress (the accumulated difference of the two orders over
+    // ~30 increments is ~1e-14; a missing creep or shrinkage term or a wrong age changes
+    // the deflection by tens of per cent).
+    let a = run(&uncracked_beam(ELASTIC_CREEP));
+    let b = run(&uncracked_beam(CRACKING_CREEP));
+    assert_eq!(a.len(), b.len(), "same increments");
+    assert!(a.len() > 20);
+    let umax = a
+        .iter()
+        .flat_map(|r| r.u.iter())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    let smax = a
+        .iter()
+        .flat_map(|r| r.stress.iter().flatten())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    let mut worst_u: f64 = 0.0;
+    let mut worst_s: f64 = 0.0;
+    for (ra, rb) in a.iter().zip(&b) {
+        assert_eq!(ra.time, rb.time);
+        assert_eq!(rb.cracked, 0, "nothing cracks");
+        for (x, y) in ra.u.iter().zip(&rb.u) {
+            worst_u = worst_u.max((x - y).abs() / umax);
+        }
+        for (x, y) in ra.stress.iter().flatten().zip(rb.stress.iter().flatten()) {
+            worst_s = worst_s.max((x - y).abs() / smax);
+        }
+    }
+    eprintln!("uncracked: worst |Δu|/umax = {worst_u:.2e}, |Δσ|/σmax = {worst_s:.2e}");
+    assert!(worst_u < 1e-9 && worst_s < 1e-9);
+    // And the beam really crept: the deflection grows by more than 1 + φ/2.
+    let first = a[0].u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let last = a
+        .last()
+        .unwrap()
+        .u
+        .iter()
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    assert!(last > 1.8 * first, "{first} → {last}");
+}
+
+/// Strip fcm 45 MPa, RH 50 %, h0 = 0.1 m, drying from day 7; 1 m long, 0.1 × 0.1 m, both ends
+/// held in x (free laterally): restrained shrinkage gives uniaxial tension σx.
+const STRIP_DATA: (f64, f64, f64, f64) = (45e6, 0.5, 0.1, 7.0);
+
+fn strip(to: f64) -> String {
+    format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+creep = "mc90"
+fcm = 45e6
+nu = 0.2
+cement = "N"
+rh = 0.5
+h0 = 0.1
+drying_start = 7.0
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 1.0
+nx = 4
+element = "Q4"
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "right"
+line = [[1.0, 0.0], [1.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[steps]]
+name = "shrink"
+kind = "time"
+from = 7.0
+to = {to}
+substeps = 60
+first_substep = 0.1
+"#
+    )
+}
+
+/// Stress of a fully restrained member under MC90 shrinkage from age t_s, by superposition
+/// of the MC90 relaxation function (step-by-step solution of ∫ J dR = 1, independent of the
+/// chain): σ(t) = −Σ_k R(t, t_k) Δε_sh,k with Δε_sh,k over [t_{k−1}, t_k] applied at the
+/// midpoint age. Ages in days, stress in Pa (tension positive).
+fn restrained_stress(p: &CreepShrinkageParams, t: f64, n: usize) -> f64 {
+    let ts = p.t_shrinkage_start;
+    // Geometric grid in t − ts from 0.01 d.
+    let times: Vec<f64> = std::iter::once(ts)
+        .chain((0..=n).map(|k| ts + 0.01 * ((t - ts) / 0.01).powf(k as f64 / n as f64)))
+        .collect();
+    let mut s = 0.0;
+    for w in times.windows(2) {
+        let d_sh = shrinkage_strain(p, w[1]) - shrinkage_strain(p, w[0]);
+        let tm = 0.5 * (w[0] + w[1]);
+        let r = if t - tm > 1e-3 {
+            *relaxation_function(p, tm, &geometric(1e-3, t - tm, 40))
+                .last()
+                .unwrap()
+        } else {
+            p.eci_at(tm)
+        };
+        s -= r * d_sh;
+    }
+    s
+}
+
+fn geometric(a: f64, b: f64, per_decade: usize) -> Vec<f64> {
+    let n = (((b / a).log10() * per_decade as f64).ceil() as usize).max(1);
+    (0..=n)
+        .map(|k| a * (b / a).powf(k as f64 / n as f64))
+        .collect()
+}
+
+#[test]
+fn restrained_shrinkage_cracks_when_the_stress_reaches_ftm() {
+    let (fcm, rh, h0, ts) = STRIP_DATA;
+    let p = CreepShrinkageParams::new(fcm, rh, h0, CementClass::N, ts);
+    // f_tm of the concrete (MC90 mean, 28 days; the crack criterion does not age).
+    let ftm = 1.4e6 * (fcm / 10e6).powf(2.0 / 3.0);
+    let rec = run(&strip(3000.0));
+    // Before cracking the FE stress follows the superposition integral: the chain
+    // reproduces MC90 relaxation within ~1 % and the 60 log-spaced substeps add < 1 %; 3 %
+    // of f_tm leaves room for both and fails without creep (the elastic stress
+    // −E ε_sh is ~2× larger) or with creep of the wrong age.
+    let onset = rec
+        .iter()
+        .position(|r| r.cracked > 0)
+        .expect("the strip cracks");
+    assert!(onset > 5, "cracks after some shrinkage ({onset})");
+    let mut worst: f64 = 0.0;
+    for r in &rec[1..onset] {
+        let want = restrained_stress(&p, r.time, 40);
+        let got = r.stress[0][0];
+        worst = worst.max((got - want).abs() / ftm);
+        assert!(r.stress[0][1].abs() < 1e-3 * ftm, "uniaxial");
+    }
+    eprintln!("restrained strip: worst |σ − σ_exact| = {worst:.4} f_tm before cracking");
+    assert!(worst < 0.03);
+    // Crack onset: the closed form's time where σ(t) = f_tm, found by bisection, lies in the
+    // FE's last uncracked substep interval (widened by the 3 % stress tolerance at the
+    // local slope of σ(t)).
+    let (mut lo, mut hi) = (ts + 1.0, 3000.0);
+    assert!(restrained_stress(&p, hi, 40) > ftm);
+    for _ in 0..40 {
+        let mid = (lo * hi).sqrt();
+        if restrained_stress(&p, mid, 40) >= ftm {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let t_cr = hi;
+    let (t_a, t_b) = (rec[onset - 1].time, rec[onset].time);
+    let slope = (restrained_stress(&p, t_b, 40) - restrained_stress(&p, t_a, 40)) / (t_b - t_a);
+    let widen = 0.03 * ftm / slope;
+    // Age-adjusted effective modulus (Trost–Bažant, χ = 0.8) for comparison only (printed):
+    // σ = −ε_sh(t)/J_χ with loading age t0 = the drying start. Shrinkage is not applied at
+    // t0 but grows as √t, mostly on older, less creeping concrete, so χ = 0.8 over-relaxes
+    // the stress and puts the onset late; the superposition above is exact for MC90.
+    let aaem = |t: f64| {
+        // MC90 defines φ against the 28-day modulus: J = 1/E_ci(t0) + φ/E_ci.
+        -shrinkage_strain(&p, t)
+            / (1.0 / p.eci_at(ts) + 0.8 * creep_coefficient(&p, t, ts) / p.eci())
+    };
+    let (mut lo2, mut hi2) = (ts + 1.0, 1e5);
+    for _ in 0..60 {
+        let mid = (lo2 * hi2).sqrt();
+        if aaem(mid) >= ftm {
+            hi2 = mid;
+        } else {
+            lo2 = mid;
+        }
+    }
+    eprintln!(
+        "crack onset: FE in ({t_a:.1}, {t_b:.1}] d, superposition {t_cr:.1} d (±{widen:.1} d), AAEM χ = 0.8: {hi2:.1} d"
+    );
+    assert!(
+        t_cr > t_a - widen && t_cr <= t_b + widen,
+        "onset {t_cr} not in ({t_a}, {t_b}] ± {widen}"
+    );
+}
+
+/// A 0.1 m square Q4 specimen of creeping concrete (fcm 45 MPa, RH 70 %, h0 0.2 m, no
+/// shrinkage), held on its left edge in x and at a corner in y, loaded on day 28 by a
+/// uniform compression `stress` [Pa] and held for 1e4 days.
+fn specimen(stress: f64, nonlinear: bool) -> String {
+    format!(
+        r#"{CRACKING_CREEP}rh = 0.70
+h0 = 0.200
+shrinkage = false
+nonlinear_creep = {nonlinear}
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 0.1
+nx = 1
+element = "Q4"
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.1]]
+ux = 0.0
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "P"
+line_loads = [{{ line = [[0.1, 0.0], [0.1, 0.1]], q = [{q}, 0.0] }}]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ P = 1.0 }}
+increments = 4
+[[steps]]
+name = "creep"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#,
+        q = stress * 0.1
+    )
+}
+
+#[test]
+fn nonlinear_creep_multiplies_creep_by_the_mc90_factor() {
+    // σ = −0.5 f_cm held from day 28: MC90 multiplies φ by exp[1.5 (0.5 − 0.4)] = 1.1618.
+    // With the stress held, the chain strain, the plastic strain (rate-independent) and the
+    // load-step strain are the same with and without the option, so the creep strain
+    // ε(t) − ε(t0) must scale by exactly that factor. 1e-6: the Newton tolerance of the
+    // substeps (the law is linear in the factor); a factor applied to the whole strain, or
+    // not at all, misses by > 5 %.
+    let sigma = -0.5 * 45e6;
+    let lin = run(&specimen(sigma, false));
+    let nl = run(&specimen(sigma, true));
+    assert_eq!(lin.len(), nl.len());
+    let k = (1.5_f64 * 0.1).exp();
+    let at_load = |r: &[Rec]| r.iter().rposition(|x| x.time == 28.0).unwrap();
+    let (i0, j0) = (at_load(&lin), at_load(&nl));
+    assert_eq!(i0, j0);
+    let e = |r: &Rec| r.u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    assert!((e(&lin[i0]) - e(&nl[j0])).abs() < 1e-12, "same load step");
+    for (a, b) in lin[i0 + 1..].iter().zip(&nl[j0 + 1..]) {
+        let (ca, cb) = (e(a) - e(&lin[i0]), e(b) - e(&nl[j0]));
+        if a.time - 28.0 >= 1.0 {
+            assert!(
+                (cb / ca / k - 1.0).abs() < 1e-6,
+                "t = {}: creep ratio {} vs {k}",
+                a.time,
+                cb / ca
+            );
+        }
+    }
+    // The linear run really crept: ≥ 1.5× the load-step shortening after 1e4 days.
+    assert!(e(lin.last().unwrap()) > 1.5 * e(&lin[i0]));
+}
+
+#[test]
+fn creep_option_bad_input_names_the_key() {
+    let base = |extra: &str| {
+        format!(
+            r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 45e6
+{extra}
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.1
+[mesh]
+type = "banded"
+length = 1.0
+nx = 1
+bands = [{{ region = "r", depth = 0.1, rows = 1 }}]
+[[supports]]
+name = "s"
+point = [0.0, 0.0]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "s2"
+point = [1.0, 0.0]
+uy = 0.0
+[[steps]]
+name = "t"
+kind = "time"
+from = 28.0
+duration = 10.0
+"#
+        )
+    };
+    for (extra, field, says) in [
+        ("rh = 0.7", "materials[0].rh", "creep = \"mc90\" only"),
+        ("creep = \"b3\"", "materials[0].creep", "expected mc90"),
+        ("creep = \"mc90\"\nh0 = 0.2", "materials[0].rh", "missing"),
+        (
+            "creep = \"mc90\"\nrh = 0.7\nh0 = 0.2\nE = 30e9",
+            "materials[0].E",
+            "remove E",
+        ),
+        (
+            "creep = \"mc90\"\nrh = 0.7\nh0 = 0.2\nviscoplastic = { fluidity = 1.0 }",
+            "materials[0].viscoplastic",
+            "two time laws",
+        ),
+    ] {
+        let err = match segfem::input::parse(&base(extra), "bad.toml") {
+            Ok(_) => panic!("accepted: {extra}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(field) && err.contains(says), "{extra}: {err}");
+    }
+    // The option itself is accepted.
+    segfem::input::parse(&base("creep = \"mc90\"\nrh = 0.7\nh0 = 0.2"), "ok.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// Simply supported RC beam, span 4.5 m, 0.25 × 0.5 m, 3 Ø20 (942 mm²) at d = 0.45 m,
+/// loaded at the thirds by 2 × `p` [N] on day 28 (M = 1.5 p in the middle third) and held
+/// for 1e4 days, creep without shrinkage. Elastic bearing blocks at the supports.
+fn rc_beam(p: f64) -> String {
+    let q = p / 0.25;
+    format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+creep = "mc90"
+fcm = 45e6
+nu = 0.2
+rh = 0.70
+h0 = 0.2
+shrinkage = false
+[[materials]]
+name = "bearing"
+kind = "elastic"
+E = 35e9
+nu = 0.2
+[[materials]]
+name = "steel"
+kind = "rebar"
+E = 200e9
+fy = 500e6
+[[regions]]
+name = "r"
+material = "c"
+thickness = 0.25
+[[regions]]
+name = "b"
+material = "bearing"
+thickness = 0.25
+boxes = [[[0.0, 0.0], [0.25, 0.1]], [[4.25, 0.0], [4.5, 0.1]]]
+[mesh]
+type = "banded"
+length = 4.5
+nx = 18
+element = "Q8"
+bands = [{{ region = "r", depth = 0.5, rows = 5 }}]
+[[bars]]
+name = "bottom"
+material = "steel"
+path = [[0.0, 0.05], [4.5, 0.05]]
+area = 9.42e-4
+[[supports]]
+name = "left"
+point = [0.125, 0.0]
+ux = 0.0
+uy = 0.0
+[[supports]]
+name = "right"
+point = [4.375, 0.0]
+uy = 0.0
+[[load_cases]]
+name = "P"
+line_loads = [
+  {{ line = [[1.375, 0.5], [1.625, 0.5]], q = [0.0, -{q}] }},
+  {{ line = [[2.875, 0.5], [3.125, 0.5]], q = [0.0, -{q}] }},
+]
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ P = 1.0 }}
+increments = 10
+[[steps]]
+name = "sustained"
+kind = "time"
+from = 28.0
+duration = 1e4
+"#
+    )
+}
+
+#[test]
+fn cracked_rc_beam_long_term_curvature_matches_the_aaem() {
+    let p = 66.7e3;
+    // Moment in the middle third: the reaction p times the shear span (supports at 0.125 m).
+    let m = p * 1.375;
+    let text = rc_beam(p);
+    let model = segfem::input::parse(&text, "rc.toml").unwrap().model;
+    let node = |x: f64, y: f64| {
+        model
+            .nodes
+            .iter()
+            .position(|n| (n[0] - x).abs() < 1e-9 && (n[1] - y).abs() < 1e-9)
+            .unwrap()
+    };
+    let (x1, x2) = (1.75, 2.75);
+    let ids = [node(x1, 0.0), node(x1, 0.5), node(x2, 0.0), node(x2, 0.5)];
+    let rec = run(&text);
+    // Mean curvature of the middle third from the section rotations θ = (u_bot − u_top)/h.
+    let kappa = |r: &Rec| {
+        let th = |b: usize, t: usize| (r.u[2 * b] - r.u[2 * t]) / 0.5;
+        (th(ids[2], ids[3]) - th(ids[0], ids[1])) / (x2 - x1)
+    };
+    let i0 = rec.iter().rposition(|r| r.time == 28.0).unwrap();
+    let (k0, k1) = (kappa(&rec[i0]), kappa(rec.last().unwrap()));
+    assert!(rec[i0].cracked > 0);
+    // AAEM on the cracked section (Gilbert & Ranzi): compression zone d_n from the
+    // short-term analysis, held in time; MC90 J with the chain's load-step compliance
+    // J0 = J(t0 + 0.1 d, t0) (docs/theory-time.md §2), χ = 0.8.
+    let cp = CreepShrinkageParams::new(45e6, 0.7, 0.2, CementClass::N, 7.0);
+    let t0 = 28.0;
+    let j0 = segfem::materials::mc90_time::compliance(&cp, t0 + 0.1, t0);
+    let jt = segfem::materials::mc90_time::compliance(&cp, t0 + 1e4, t0);
+    let (b, d, as_, es) = (0.25, 0.45, 9.42e-4, 200e9);
+    let e0 = 1.0 / j0;
+    let n0 = es / e0;
+    let rho_n = as_ * n0 / (b * d);
+    let dn = d * ((2.0 * rho_n + rho_n * rho_n).sqrt() - rho_n);
+    let (ac, bc, ic) = (b * dn, b * dn * dn / 2.0, b * dn.powi(3) / 3.0);
+    // Short-term: top strain ε0 and curvature κ0 (y down from the top, N = 0, M about top).
+    let solve = |a: [[f64; 2]; 2], r: [f64; 2]| {
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        [
+            (r[0] * a[1][1] - a[0][1] * r[1]) / det,
+            (a[0][0] * r[1] - a[1][0] * r[0]) / det,
+        ]
+    };
+    let sec = |e: f64| {
+        [
+            [e * ac + es * as_, e * bc + es * as_ * d],
+            [e * bc + es * as_ * d, e * ic + es * as_ * d * d],
+        ]
+    };
+    let [eps0, kap0] = solve(sec(e0), [0.0, m]);
+    // Long term: Δσ = Ē(Δε − (J(t) − J0) σ0), Ē = 1/(J0 + χ (J(t) − J0)).
+    let eb = 1.0 / (j0 + 0.8 * (jt - j0));
+    let c = eb * (jt - j0) * e0;
+    let [_, dkap] = solve(
+        sec(eb),
+        [c * (ac * eps0 + bc * kap0), c * (bc * eps0 + ic * kap0)],
+    );
+    // Uncracked section (full depth and the bar), same AAEM; cracking moment from f_tm at
+    // the bottom fibre of the short-term uncracked section.
+    let h = 0.5;
+    let secu = |e: f64| {
+        [
+            [e * b * h + es * as_, e * b * h * h / 2.0 + es * as_ * d],
+            [
+                e * b * h * h / 2.0 + es * as_ * d,
+                e * b * h.powi(3) / 3.0 + es * as_ * d * d,
+            ],
+        ]
+    };
+    let [eu0, ku0] = solve(secu(e0), [0.0, m]);
+    let cu = eb * (jt - j0) * e0;
+    let [_, dku] = solve(
+        secu(eb),
+        [
+            cu * (b * h * eu0 + b * h * h / 2.0 * ku0),
+            cu * (b * h * h / 2.0 * eu0 + b * h.powi(3) / 3.0 * ku0),
+        ],
+    );
+    let ftm = 1.4e6 * 4.5_f64.powf(2.0 / 3.0);
+    let mcr = m * ftm / (e0 * (eu0 + ku0 * h));
+    // Tension stiffening as Gilbert & Ranzi and EC2 7.4.3 interpolate it:
+    // κ = ζ κ_cr + (1 − ζ) κ_uncr, ζ = 1 − β (M_cr/M)², β = 1 short term, 0.5 sustained.
+    let zeta = |beta: f64| 1.0 - beta * (mcr / m).powi(2);
+    let ec2_0 = zeta(1.0) * kap0 + (1.0 - zeta(1.0)) * ku0;
+    let ec2_t = zeta(0.5) * (kap0 + dkap) + (1.0 - zeta(0.5)) * (ku0 + dku);
+    eprintln!(
+        "RC beam M = {m:.0} N m = {:.2} M_cr: FE κ0 = {k0:.4e}, κ(1e4 d) = {k1:.4e}; \
+         AAEM cracked {kap0:.4e} → {:.4e}, uncracked {ku0:.4e} → {:.4e}; \
+         with tension stiffening {ec2_0:.4e} → {ec2_t:.4e}",
+        m / mcr,
+        kap0 + dkap,
+        ku0 + dku
+    );
+    // 10 %: χ = 0.8 is fixed (the chain follows MC90's J, the AAEM only approximates its
+    // integral), β = 0.5 is a code estimate of how much tension stiffening survives under
+    // sustained load (the FE's smeared Hinton law relaxes by creep in series), and the FE
+    // curvature is the mean over the middle third. The short-term value is printed, not
+    // asserted: there the Hinton tail (α = 5e-4) stiffens more than β = 1 assumes.
+    assert!(
+        (k1 / ec2_t - 1.0).abs() < 0.10,
+        "long-term curvature {k1:.4e} vs AAEM with tension stiffening {ec2_t:.4e}"
+    );
+    // Creep really acted on the cracked member: the curvature grew by more than 30 %.
+    assert!(k1 > 1.3 * k0);
+}
