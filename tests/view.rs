@@ -638,3 +638,57 @@ fn every_example_report_has_headline_and_load_defaults() {
         );
     }
 }
+
+/// Joint diagrams come from the joints' integration points and reach the true extreme:
+/// the segmental-decompression example after its prestress step (P = 600 kN at e = 0.05 m
+/// on a 0.5 × 0.3 m section) has N/A + N e/W = 4.0 + 2.4 = 6.4 MPa of contact stress at
+/// the bottom fibre of each joint, where the Lobatto rule has a point; element means of
+/// the bottom joint element (0.0625 m deep) would show about 6.1 MPa.
+#[test]
+fn joint_diagrams_reach_the_extreme_contact_stress() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/segmental-decompression.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(1).unwrap().0;
+    let dir = tmp("joint-extreme");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let (_, output) = view::pick_output(&out, None).unwrap();
+    assert!(output.joint_points.is_some(), "no joint point file listed");
+    let g = output.grid().unwrap();
+    let joints = view::output_joint_profiles(&output, &g, &out).unwrap();
+    assert_eq!(joints.len(), 2);
+    assert!(joints[0].name.starts_with("joint J1"), "{}", joints[0].name);
+    let want = 600e3 / 0.15 + 600e3 * 0.05 / (0.3 * 0.25 / 6.0);
+    for j in &joints {
+        let (y, _, sn) = j
+            .points
+            .iter()
+            .copied()
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .unwrap();
+        // 1 %: the linear stress field is exact for the Q8 segments; the end load has
+        // decayed 4 depths away.
+        assert!(
+            (sn - want / 1e6).abs() <= 1e-2 * want / 1e6,
+            "{}: {sn} MPa vs {} MPa",
+            j.name,
+            want / 1e6
+        );
+        assert!(
+            y.abs() < 1e-9,
+            "the extreme sits at the bottom fibre, y = {y}"
+        );
+    }
+    // The report tables it.
+    report::report(&report::ReportOptions {
+        dir: out.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<h2>Joints</h2>"), "joints section");
+    assert!(html.contains("at the joints' integration points"));
+}
