@@ -390,6 +390,8 @@ struct Frame {
 }
 
 const TITLE_H: u32 = 40;
+/// Height of the legend strip under a mesh drawing [px].
+const LEGEND_H: u32 = 28;
 const MARGIN: u32 = 12;
 const XLAB: u32 = 45;
 const YLAB: u32 = 70;
@@ -496,14 +498,16 @@ pub struct MeshFigure<'g> {
 impl Figure for MeshFigure<'_> {
     fn size(&self) -> (u32, u32) {
         let (lo, hi) = self.grid.bounds();
-        frame(lo, hi, 0).size
+        frame(lo, hi, LEGEND_H).size
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let g = self.grid;
         let (lo, hi) = g.bounds();
-        let f = frame(lo, hi, 0);
+        let f = frame(lo, hi, LEGEND_H);
         let area = title_area(root, &self.title)?;
+        let (_, h) = area.dim_in_pixel();
+        let (area, strip) = area.split_vertically(h.saturating_sub(LEGEND_H));
         let mut chart = model_chart!(&area, f);
         let region = g.cell_array("region");
         let edge = RGBColor(90, 90, 90);
@@ -525,30 +529,42 @@ impl Figure for MeshFigure<'_> {
                 ])
                 .map_err(de)?;
         }
-        // The legend: one swatch per region present, and the joint/tendon lines.
-        for (r, name) in region_legend(g, &self.regions) {
-            let c = REGION_FILL[r % REGION_FILL.len()];
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), u32>>())
-                .map_err(de)?
-                .label(name)
-                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 18, y + 6)], c.filled()));
-        }
+        // The legend, in a strip below the drawing (never over the mesh): a swatch per
+        // region present, and the joint/tendon lines.
+        let mut entries: Vec<(String, RGBColor, bool)> = region_legend(g, &self.regions)
+            .into_iter()
+            .map(|(r, name)| (name, REGION_FILL[r % REGION_FILL.len()], false))
+            .collect();
         if (0..g.cells.len()).any(|i| g.is_line(i)) {
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), u32>>())
-                .map_err(de)?
-                .label("joints, tendons")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED.stroke_width(2)));
+            entries.push(("joints, tendons".into(), RED, true));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(RGBColor(160, 160, 160))
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(de)?;
+        let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        let mut x = (MARGIN + YLAB) as i32;
+        let y = (LEGEND_H / 2) as i32;
+        for (name, c, line) in entries {
+            if line {
+                strip
+                    .draw(&PathElement::new(
+                        vec![(x, y), (x + 18, y)],
+                        c.stroke_width(2),
+                    ))
+                    .map_err(de)?;
+            } else {
+                strip
+                    .draw(&Rectangle::new([(x, y - 6), (x + 18, y + 6)], c.filled()))
+                    .map_err(de)?;
+                strip
+                    .draw(&Rectangle::new(
+                        [(x, y - 6), (x + 18, y + 6)],
+                        RGBColor(90, 90, 90),
+                    ))
+                    .map_err(de)?;
+            }
+            strip
+                .draw(&Text::new(name.clone(), (x + 24, y), style.clone()))
+                .map_err(de)?;
+            x += 24 + 8 * name.chars().count() as i32 + 24;
+        }
         Ok(())
     }
 }
