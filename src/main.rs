@@ -222,6 +222,12 @@ struct PlotArgs {
     /// Further y columns, comma separated, each against --x in its own figure curves_COL.
     #[arg(long, value_delimiter = ',')]
     also: Vec<String>,
+    /// Units of the curves: display (mm, kN, MPa) or si (m, N, Pa as in history.csv).
+    #[arg(long, default_value = "display", value_parser = ["display", "si"])]
+    units: String,
+    /// Signs of the curves: engineering (deflection positive down, forces positive) or raw.
+    #[arg(long, default_value = "engineering", value_parser = ["engineering", "raw"])]
+    sign: String,
 }
 
 #[derive(clap::Args)]
@@ -243,6 +249,12 @@ struct ReportArgs {
     /// Output number for the drawings (1-based; default: the last).
     #[arg(long)]
     step: Option<usize>,
+    /// Units of the curve: display (mm, kN, MPa) or si (m, N, Pa as in history.csv).
+    #[arg(long, default_value = "display", value_parser = ["display", "si"])]
+    units: String,
+    /// Signs of the curve: engineering (deflection positive down, forces positive) or raw.
+    #[arg(long, default_value = "engineering", value_parser = ["engineering", "raw"])]
+    sign: String,
 }
 
 fn main() -> ExitCode {
@@ -343,6 +355,10 @@ fn view_plot(a: PlotArgs) -> ExitCode {
         cells: a.cells,
         scale: a.scale,
         out: a.output,
+        units: view::UnitOptions {
+            si: a.units == "si",
+            raw_sign: a.sign == "raw",
+        },
     };
     let extra = match view::extra_curves(&opts, &a.also) {
         Ok(f) => f,
@@ -368,6 +384,10 @@ fn view_report(a: ReportArgs) -> ExitCode {
         x: a.x,
         y: a.y,
         step: a.step,
+        units: segfem::view::UnitOptions {
+            si: a.units == "si",
+            raw_sign: a.sign == "raw",
+        },
     };
     match report::report(&opts) {
         Ok((path, notes)) => {
@@ -459,11 +479,12 @@ fn run(
                     s.timings.iterations,
                     s.wall_s
                 );
-                for (n, v) in &s.final_monitors {
-                    outln!("  {n} = {v:.6e}");
-                }
+                // The verdict is the headline: what failed and at what load.
                 if let Some(u) = &s.ultimate {
                     outln!("{u}");
+                }
+                for (n, v) in &s.final_monitors {
+                    outln!("  {n} = {v:.6e}");
                 }
                 outln!("results in {}", out.display());
             }

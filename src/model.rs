@@ -190,6 +190,30 @@ pub enum MonitorKind {
         /// Which part.
         part: LossPart,
     },
+    /// A stress component at the continuum integration (Gauss) point nearest a point [Pa]
+    /// (the point's own stress, not a recovered nodal value).
+    StressAtPoint {
+        /// Which component.
+        component: StressComponent,
+        /// Index of the Gauss point (element order, then the element's rule order).
+        gauss_point: usize,
+    },
+    /// The extreme of a stress component over the Gauss points of a region (all if None)
+    /// [Pa].
+    StressExtreme {
+        /// Which component.
+        component: StressComponent,
+        /// Region index.
+        region: Option<usize>,
+        /// Largest, smallest, or the value of largest magnitude (with its sign).
+        extreme: Extreme,
+    },
+    /// Largest contact (normal, compression positive) stress over the integration points of
+    /// a joint, or of all joints (None) [Pa].
+    JointContactStress {
+        /// Joint index, or None for the largest over all joints.
+        joint: Option<usize>,
+    },
     /// Prestress loss of a tendon since stressing, length-weighted mean over its spans
     /// [Pa] (positive = loss), total or one part of the split (docs/theory-time.md).
     TendonLoss {
@@ -211,6 +235,47 @@ pub enum LossPart {
     CreepShrinkage,
     /// Relaxation of the steel (stress drop of the chain at the current strain).
     Relaxation,
+}
+
+/// A plane stress component or principal stress (monitors).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum StressComponent {
+    /// σx [Pa].
+    Sx,
+    /// σy [Pa].
+    Sy,
+    /// τxy [Pa].
+    Txy,
+    /// Major principal stress σ1 [Pa].
+    S1,
+    /// Minor principal stress σ2 [Pa].
+    S2,
+}
+
+impl StressComponent {
+    /// The component of a stress (σx, σy, τxy) [Pa].
+    pub fn of(self, s: [f64; 3]) -> f64 {
+        let c = 0.5 * (s[0] + s[1]);
+        let r = (0.5 * (s[0] - s[1])).hypot(s[2]);
+        match self {
+            StressComponent::Sx => s[0],
+            StressComponent::Sy => s[1],
+            StressComponent::Txy => s[2],
+            StressComponent::S1 => c + r,
+            StressComponent::S2 => c - r,
+        }
+    }
+}
+
+/// Which extreme of a quantity over a set of points (monitors).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Extreme {
+    /// The largest value.
+    Max,
+    /// The smallest (most compressive) value.
+    Min,
+    /// The value of largest magnitude, with its sign.
+    Abs,
 }
 
 /// A named monitor: one column of `history.csv`.
@@ -240,6 +305,9 @@ impl Monitor {
             | MonitorKind::CrushedPoints { .. } => "-",
             MonitorKind::TendonLoss { .. } | MonitorKind::BarLoss { .. } => "Pa",
             MonitorKind::BarForce { .. } => "N",
+            MonitorKind::StressAtPoint { .. }
+            | MonitorKind::StressExtreme { .. }
+            | MonitorKind::JointContactStress { .. } => "Pa",
         }
     }
 }

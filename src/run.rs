@@ -132,6 +132,13 @@ pub struct Summary {
     pub peak_memory_bytes: Option<u64>,
     /// Final monitor values (name → value).
     pub final_monitors: Vec<(String, f64)>,
+    /// The monitors as history.csv holds them: name, input kind, component and unit (the
+    /// plots choose display units and signs by kind).
+    pub monitors: Vec<MonitorInfo>,
+    /// Region names, by the index the .vtu `region` cell array holds.
+    pub regions: Vec<String>,
+    /// Joint names, in model order (the .vtu `joint` arrays count from 1 in this order).
+    pub joints: Vec<String>,
     /// Runs to failure (a displacement or arc-length step, or a failure met): which
     /// failure was reached first and at what load, and the peak load.
     pub ultimate: Option<Ultimate>,
@@ -141,6 +148,102 @@ pub struct Summary {
     pub plausibility: Vec<String>,
     /// Warnings met in the input and in the results.
     pub warnings: Vec<String>,
+}
+
+/// One monitor column of history.csv, described (summary.json `monitors`).
+#[derive(Debug, Clone, Serialize)]
+pub struct MonitorInfo {
+    /// Monitor name (the column name).
+    pub name: String,
+    /// Input kind (`displacement`, `reaction`, `stress`, …).
+    pub kind: String,
+    /// Component where the kind has one: `x`/`y` (displacements, reactions) or
+    /// `sx`…`s2` (stresses).
+    pub component: Option<String>,
+    /// Unit of the column (SI).
+    pub unit: String,
+}
+
+/// The monitors of a model described for summary.json.
+pub fn monitor_info(model: &Model) -> Vec<MonitorInfo> {
+    use crate::model::{MonitorKind, StressComponent};
+    model
+        .monitors
+        .iter()
+        .map(|m| {
+            let stress = |c: &StressComponent| {
+                match c {
+                    StressComponent::Sx => "sx",
+                    StressComponent::Sy => "sy",
+                    StressComponent::Txy => "txy",
+                    StressComponent::S1 => "s1",
+                    StressComponent::S2 => "s2",
+                }
+                .to_string()
+            };
+            let component = match &m.kind {
+                MonitorKind::Displacement { dir, .. } | MonitorKind::Reaction { dir, .. } => {
+                    Some(if dir.index() == 0 { "x" } else { "y" }.to_string())
+                }
+                MonitorKind::StressAtPoint { component, .. }
+                | MonitorKind::StressExtreme { component, .. } => Some(stress(component)),
+                _ => None,
+            };
+            MonitorInfo {
+                name: m.name.clone(),
+                kind: crate::results::recorder::kind_name(&m.kind).into(),
+                component,
+                unit: m.unit().into(),
+            }
+        })
+        .collect()
+}
+
+/// Names of the files a run writes into its output directory: history.csv, results.pvd,
+/// summary.json, the checkpoint, report.html and the field files
+/// `[lines_|bars_|gauss_|joints_]stepNNN_incNNNN.vtu`.
+pub fn is_run_file(name: &str) -> bool {
+    if matches!(
+        name,
+        "history.csv" | "results.pvd" | "summary.json" | "report.html"
+    ) || name == crate::results::checkpoint::FILE
+    {
+        return true;
+    }
+    let Some(stem) = name.strip_suffix(".vtu") else {
+        return false;
+    };
+    let stem = ["lines_", "bars_", "gauss_", "joints_"]
+        .iter()
+        .find_map(|p| stem.strip_prefix(p))
+        .unwrap_or(stem);
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    stem.strip_prefix("step")
+        .and_then(|r| r.split_once("_inc"))
+        .is_some_and(|(a, b)| digits(a) && digits(b))
+}
+
+/// Remove the files an earlier run left in `out` (only the names of [`is_run_file`]; other
+/// files are kept), so that results.pvd and the .vtu files cannot mix two runs. Returns
+/// how many were removed.
+fn clear_stale(out: &Path) -> Result<usize, RunError> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(0);
+    };
+    let mut n = 0;
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if e.file_type().is_ok_and(|t| t.is_file()) && is_run_file(&name) {
+            std::fs::remove_file(e.path()).map_err(|err| {
+                RunError::Io(format!(
+                    "{}: cannot remove a file of an earlier run: {err}",
+                    e.path().display()
+                ))
+            })?;
+            n += 1;
+        }
+    }
+    Ok(n)
 }
 
 /// Peak resident set size of this process [bytes] (Linux: VmHWM), if known.
@@ -284,6 +387,15 @@ pub fn run_file_opts(
         }
     }
     let input_s = t0.elapsed().as_secs_f64();
+    if saved.is_none() {
+        let n = clear_stale(out)?;
+        if n > 0 {
+            built.warnings.push(format!(
+                "{}: removed {n} files of an earlier run (history.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
+                out.display()
+            ));
+        }
+    }
     let model = built.model;
     let mut rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
         RunError::Io(format!(
@@ -438,6 +550,9 @@ pub fn run_file_opts(
         timings,
         peak_memory_bytes: peak_memory(),
         final_monitors,
+        monitors: monitor_info(&model),
+        regions: model.regions.iter().map(|r| r.name.clone()).collect(),
+        joints: model.joints.iter().map(|j| j.name.clone()).collect(),
         ultimate,
         plausibility,
         warnings,

@@ -462,3 +462,122 @@ fn report_peak_is_the_load_not_a_crack_strain() {
         "crack strain as load"
     );
 }
+
+/// A fresh run into a used output directory removes the files an earlier run left there
+/// (a field file of a step the new run does not have, its report), keeps other files, and
+/// says so in a warning.
+#[test]
+fn used_output_directory_is_cleared_of_stale_files() {
+    let tmp = TempDir::new("probe-stale");
+    std::fs::write(tmp.join("m.toml"), example("cantilever")).unwrap();
+    let out = tmp.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    for f in [
+        "step009_inc0042.vtu",
+        "lines_step009_inc0042.vtu",
+        "report.html",
+    ] {
+        std::fs::write(out.join(f), "stale").unwrap();
+    }
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 0, "{err}");
+    assert!(
+        err.contains("warning: out: removed 3 files of an earlier run"),
+        "{err}"
+    );
+    assert!(!out.join("step009_inc0042.vtu").exists());
+    assert!(!out.join("report.html").exists());
+    assert_eq!(read(&out.join("notes.txt")), "mine");
+    assert!(out.join("step001_inc0001.vtu").is_file());
+}
+
+/// A band with too many rows is named by its `rows` key, and a count of the wrong type reads
+/// "a whole number", not a Rust type name.
+#[test]
+fn too_many_rows_names_rows_and_counts_are_whole_numbers() {
+    let tmp = TempDir::new("probe-rows");
+    let text = edit(&plain_beam(2, ""), "rows = 4", "rows = 100000000");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["check", "m.toml"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.contains("mesh.bands[0].rows: the mesh would have"),
+        "{err}"
+    );
+    let text = edit(&plain_beam(2, ""), "nx = 16", "nx = 2.5");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["check", "m.toml"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(err.contains("expected a whole number ≥ 0"), "{err}");
+    assert!(!err.contains("usize"), "{err}");
+}
+
+/// A tendon prestress given in MPa (876 instead of 876e6) warns of the unit slip.
+#[test]
+fn tendon_prestress_in_mpa_warns() {
+    let tmp = TempDir::new("probe-prestress-unit");
+    let text = edit(
+        &example("seed-beam"),
+        "initial_stress = 876e6",
+        "initial_stress = 876.0",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["check", "m.toml"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 0, "{err}");
+    assert!(
+        err.contains("tendons[0].initial_stress: 876 Pa looks like MPa"),
+        "{err}"
+    );
+}
+
+/// The report of a failed run leads with its status and counts its converged increments
+/// (the rows of history.csv), and the stress monitors are history columns in Pa.
+#[test]
+fn failed_run_report_counts_converged_increments() {
+    let tmp = TempDir::new("probe-failed-report");
+    let text = edit(
+        &plain_beam(20, ""),
+        "[[steps]]",
+        "[[monitors]]\nname = \"s2_min\"\nkind = \"stress\"\ncomponent = \"s2\"\n\n[[steps]]",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 3, "{}", stderr(&o));
+    let history = read(&tmp.join("out/history.csv"));
+    assert!(history.lines().next().unwrap().contains(",s2_min [Pa]"));
+    let rows = history_rows(&history).len();
+    let o = segfem(tmp.path(), &["report", "out"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let html = read(&tmp.join("out/report.html"));
+    assert!(
+        html.contains(&format!(
+            "Run failed: {rows} converged increments before the failure"
+        )),
+        "headline"
+    );
+}
+
+/// `plot --units` takes display or si only (exit 2 otherwise); `--units si --sign raw` draws
+/// the file's values.
+#[test]
+fn plot_units_option() {
+    let tmp = TempDir::new("probe-plot-units");
+    std::fs::write(tmp.join("m.toml"), example("cantilever")).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = segfem(tmp.path(), &["plot", "out", "--units", "imperial"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--units"), "{}", stderr(&o));
+    let o = segfem(
+        tmp.path(),
+        &["plot", "out", "--units", "si", "--sign", "raw"],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let svg = read(&tmp.join("out/figures/curves.svg"));
+    assert!(svg.contains("tip_uy [m]"), "SI label");
+}

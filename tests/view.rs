@@ -129,18 +129,20 @@ fn plot_writes_valid_figures_with_the_history_data() {
     assert_eq!(o.notes.len(), 2, "{:?}", o.notes);
     assert!(!out.join("cracks.png").exists() && !out.join("joints.png").exists());
 
-    // The plotted series is the history: Q against midspan_uy, row for row.
+    // The plotted series is the history: Q against midspan_uy, row for row, the deflection
+    // shown in mm and positive down (a vertical displacement monitor).
     let (header, rows) = history(dir);
     let (ix, iy) = (col(&header, "midspan_uy"), col(&header, "Q ["));
     let curves = o.curves.unwrap();
-    assert_eq!(curves.x_label, "midspan_uy [m]");
+    assert_eq!(curves.x_label, "midspan_uy, down [mm]");
     assert_eq!(curves.y_label, "Q [-]");
-    let expected: Vec<(f64, f64)> = rows.iter().map(|r| (r[ix], r[iy])).collect();
+    let expected: Vec<(f64, f64)> = rows.iter().map(|r| (-1e3 * r[ix], r[iy])).collect();
     assert_eq!(curves.series.len(), 1);
     assert_eq!(curves.series[0].points, expected);
+    // The reference, in the history's SI unit (m), is converted the same way.
     assert_eq!(
         curves.reference.unwrap().points,
-        vec![(-0.0012, 25.0), (-0.0021, 50.0)]
+        vec![(-1e3 * -0.0012, 25.0), (-1e3 * -0.0021, 50.0)]
     );
     // ...and the SVG has a polyline through exactly one point per row.
     let svg = std::fs::read_to_string(out.join("curves.svg")).unwrap();
@@ -192,7 +194,12 @@ fn several_runs_columns_step_and_field_options() {
     let c = o.curves.unwrap();
     assert_eq!(c.series.len(), 4, "2 runs × 2 columns");
     assert_eq!(c.x_label, "Q [-]");
-    assert!(c.y_label.contains("R_left [N]") && c.y_label.contains("midspan_uy [m]"));
+    // Two units, two panels: the reaction in kN, the deflection in mm.
+    assert_eq!(c.y_labels, vec!["R_left [kN]", "midspan_uy, down [mm]"]);
+    assert_eq!(
+        c.series.iter().map(|s| s.panel).collect::<Vec<_>>(),
+        vec![0, 1, 0, 1]
+    );
     assert_eq!(o.scale, Some(100.0));
     assert!(o.vtu.unwrap().ends_with("step001_inc0001.vtu"));
     assert!(out.join("field_s2.png").exists());
@@ -448,4 +455,240 @@ fn html_report_is_self_contained_and_renders() {
         pixel_variance(&shot) > 100.0,
         "the report screenshot is blank"
     );
+}
+
+/// Run the `segfem` binary in `dir`.
+fn segfem_bin(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Examples that take more than a few seconds run only their first step here (reduced
+/// run: rc-beam's 25-increment cracking step instead of its 145 increments to failure).
+const SLOW_EXAMPLES: &[&str] = &["rc-beam"];
+
+/// Every bundled example (`segfem example` lists them) is written out, run (reduced for
+/// [`SLOW_EXAMPLES`]) and reported; its report must have a headline counting the converged
+/// increments (the rows of history.csv), the `ultimate` verdict when summary.json has one,
+/// a default curve of the load against the main displacement monitor (the first vertical
+/// `displacement` monitor of the model file), and a "peak load" equal to the largest
+/// magnitude of that load column in history.csv (in kN for forces).
+#[test]
+fn every_example_report_has_headline_and_load_defaults() {
+    let dir = tmp("examples");
+    let list = segfem_bin(&dir, &["example"]);
+    assert!(list.status.success());
+    let names: Vec<String> = String::from_utf8_lossy(&list.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .collect();
+    assert!(names.len() >= 8, "examples listed: {names:?}");
+    for name in &names {
+        let file = format!("{name}.toml");
+        let o = segfem_bin(&dir, &["example", name, "-o", &file]);
+        assert!(o.status.success(), "{name}: example -o");
+        let out = format!("out-{name}");
+        let mut args = vec!["run", file.as_str(), "-o", out.as_str(), "-q"];
+        if SLOW_EXAMPLES.contains(&name.as_str()) {
+            args.extend(["--stop-after-step", "1"]);
+        }
+        let o = segfem_bin(&dir, &args);
+        let code = o.status.code();
+        assert!(
+            code == Some(0) || (code == Some(4) && args.len() > 5),
+            "{name}: run exit {code:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let o = segfem_bin(&dir, &["report", &out]);
+        assert!(o.status.success(), "{name}: report");
+        let run = dir.join(&out);
+        let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+        let (header, rows) = history(&run);
+
+        // Headline: the converged increments are the history's rows.
+        let head = html
+            .split("<p id=\"headline\"")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{name}: no headline"));
+        let head = &head[..head.find("</p>").unwrap()];
+        assert!(
+            head.contains(&format!(" {} converged increments", rows.len())),
+            "{name}: {head}"
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap())
+                .unwrap();
+        if let Some(mode) = summary["ultimate"]["mode"].as_str() {
+            let u = html
+                .split("<p id=\"ultimate\">")
+                .nth(1)
+                .unwrap_or_else(|| panic!("{name}: no ultimate headline"));
+            let shown = if mode == "none reached" { "no " } else { mode };
+            assert!(u[..u.find("</p>").unwrap()].contains(shown), "{name}: {u}");
+        }
+
+        // The main displacement monitor and the load, from the model file's kinds.
+        let model: toml::Value =
+            toml::from_str(&std::fs::read_to_string(dir.join(&file)).unwrap()).unwrap();
+        let monitors = model["monitors"].as_array().unwrap();
+        let of_kind = |k: &str| -> Vec<String> {
+            monitors
+                .iter()
+                .filter(|m| m["kind"].as_str() == Some(k))
+                .map(|m| m["name"].as_str().unwrap().to_string())
+                .collect()
+        };
+        let vertical = monitors
+            .iter()
+            .find(|m| {
+                m["kind"].as_str() == Some("displacement")
+                    && m.get("component").and_then(|c| c.as_str()) == Some("y")
+            })
+            .map(|m| m["name"].as_str().unwrap().to_string());
+        let main = vertical.unwrap_or_else(|| of_kind("displacement")[0].clone());
+        let fig = view::curve_figure(&run, None, &[], &[], None, Default::default()).unwrap();
+        assert!(
+            fig.x_label.starts_with(&format!("{main},"))
+                || fig.x_label.starts_with(&format!("{main} [")),
+            "{name}: x is {}, main displacement {main}",
+            fig.x_label
+        );
+        let y = fig.series[0].label.clone();
+        let column = |n: &str| -> Vec<f64> {
+            let i = header
+                .iter()
+                .position(|h| h == n || h.starts_with(&format!("{n} [")))
+                .unwrap_or_else(|| panic!("{name}: no column {n}"));
+            rows.iter().map(|r| r[i]).collect()
+        };
+        let range = |v: &[f64]| {
+            v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - v.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let control = header.iter().any(|h| h.starts_with("control_force"))
+            && column("control_force").iter().any(|v| v.is_finite());
+        let load_ok = if control {
+            y == "control_force"
+        } else if y.starts_with("factor:") {
+            range(&column(&y)) > 0.0
+        } else if let Some(case) = monitors
+            .iter()
+            .find(|m| {
+                m["name"].as_str() == Some(y.as_str()) && m["kind"].as_str() == Some("load_factor")
+            })
+            .and_then(|m| m["case"].as_str())
+        {
+            // A load_factor monitor stands for its case's factor column.
+            column(&y) == column(&format!("factor:{case}"))
+        } else {
+            of_kind("reaction").contains(&y)
+        };
+        assert!(
+            load_ok,
+            "{name}: the default curve's y is {y}, not the load"
+        );
+        // The largest varying factor is the load, unless a control force acts or no factor
+        // varies (a single linear increment: the reaction then).
+        let varying = header
+            .iter()
+            .filter(|h| h.starts_with("factor:"))
+            .any(|h| range(&column(h.split(' ').next().unwrap())) > 0.0);
+        if !control && varying {
+            let best = header
+                .iter()
+                .filter(|h| h.starts_with("factor:"))
+                .map(|h| h.split(' ').next().unwrap().to_string())
+                .max_by(|a, b| range(&column(a)).total_cmp(&range(&column(b))))
+                .unwrap();
+            assert_eq!(
+                column(&y),
+                column(&best),
+                "{name}: {y} is not the factor that varies most ({best})"
+            );
+        }
+
+        // Peak load: the largest magnitude of the load column, in kN for a force.
+        let peak = html
+            .split("<p id=\"peak\">")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{name}: no peak line"));
+        let peak = &peak[..peak.find("</p>").unwrap()];
+        let value: f64 = peak
+            .rsplit(" = ")
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        let unit = if control || !y.starts_with("factor:") && of_kind("reaction").contains(&y) {
+            1e-3
+        } else {
+            1.0
+        };
+        let expected = column(&y).iter().fold(0.0f64, |a, v| a.max(v.abs())) * unit;
+        // The report prints 4 significant digits: 1e-3 relative.
+        assert!(
+            (value.abs() - expected).abs() <= 1e-3 * expected,
+            "{name}: peak {value} vs {expected} ({peak})"
+        );
+    }
+}
+
+/// Joint diagrams come from the joints' integration points and reach the true extreme:
+/// the segmental-decompression example after its prestress step (P = 600 kN at e = 0.05 m
+/// on a 0.5 × 0.3 m section) has N/A + N e/W = 4.0 + 2.4 = 6.4 MPa of contact stress at
+/// the bottom fibre of each joint, where the Lobatto rule has a point; element means of
+/// the bottom joint element (0.0625 m deep) would show about 6.1 MPa.
+#[test]
+fn joint_diagrams_reach_the_extreme_contact_stress() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/segmental-decompression.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(1).unwrap().0;
+    let dir = tmp("joint-extreme");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let (_, output) = view::pick_output(&out, None).unwrap();
+    assert!(output.joint_points.is_some(), "no joint point file listed");
+    let g = output.grid().unwrap();
+    let joints = view::output_joint_profiles(&output, &g, &out).unwrap();
+    assert_eq!(joints.len(), 2);
+    assert!(joints[0].name.starts_with("joint J1"), "{}", joints[0].name);
+    let want = 600e3 / 0.15 + 600e3 * 0.05 / (0.3 * 0.25 / 6.0);
+    for j in &joints {
+        let (y, _, sn) = j
+            .points
+            .iter()
+            .copied()
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .unwrap();
+        // 1 %: the linear stress field is exact for the Q8 segments; the end load has
+        // decayed 4 depths away.
+        assert!(
+            (sn - want / 1e6).abs() <= 1e-2 * want / 1e6,
+            "{}: {sn} MPa vs {} MPa",
+            j.name,
+            want / 1e6
+        );
+        assert!(
+            y.abs() < 1e-9,
+            "the extreme sits at the bottom fibre, y = {y}"
+        );
+    }
+    // The report tables it.
+    report::report(&report::ReportOptions {
+        dir: out.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<h2>Joints</h2>"), "joints section");
+    assert!(html.contains("at the joints' integration points"));
 }

@@ -25,6 +25,25 @@ pub fn load(path: &Path) -> Result<Built, InputError> {
     parse(&text, &label)
 }
 
+/// Rust type names in a TOML error said as a user reads them: "expected usize" becomes
+/// "expected a whole number ≥ 0", "expected i64" "expected a whole number", "expected f64"
+/// "expected a number".
+fn plain_types(message: &str) -> String {
+    let mut m = message.to_string();
+    for (ty, plain) in [
+        ("usize", "a whole number ≥ 0"),
+        ("u64", "a whole number ≥ 0"),
+        ("u32", "a whole number ≥ 0"),
+        ("u8", "a whole number ≥ 0"),
+        ("i64", "a whole number"),
+        ("i32", "a whole number"),
+        ("f64", "a number"),
+    ] {
+        m = m.replace(&format!("expected {ty}"), &format!("expected {plain}"));
+    }
+    m
+}
+
 /// Parse and validate model-file text; `label` names the file in errors.
 pub fn parse(text: &str, label: &str) -> Result<Built, InputError> {
     let ctx = Ctx {
@@ -57,7 +76,7 @@ pub fn parse(text: &str, label: &str) -> Result<Built, InputError> {
             file: label.to_string(),
             line,
             key,
-            message: e.message().trim().replace('\n', " "),
+            message: plain_types(&e.message().trim().replace('\n', " ")),
         }
     })?;
     build::build(file, &ctx)

@@ -202,6 +202,7 @@ pub struct MonitorIn {
     pub since_step: Option<String>,
     pub bar: Option<String>,
     pub region: Option<String>,
+    pub extreme: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

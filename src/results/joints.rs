@@ -67,3 +67,52 @@ pub fn summarise(sys: &System, j: usize) -> JointSummary {
     s.profile.sort_by(|a, b| a.x[1].total_cmp(&b.x[1]));
     s
 }
+
+/// The joints' integration points as a .vtu of vertices (part 4 of `results.pvd`): per
+/// point the joint (1-based, model order), opening [m], normal stress (compression
+/// positive) [Pa], shear stress [Pa] and slip [m] — the diagrams along the joint depth
+/// and their true extremes, where the line cells of part 1 show element means. None when
+/// the model has no joints.
+pub fn render_joint_points(sys: &System) -> Option<String> {
+    use super::vtu::{render, Array, Grid};
+    if sys.model.joints.is_empty() {
+        return None;
+    }
+    let (mut points, mut joint, mut opening, mut sn, mut tau, mut slip) =
+        (vec![], vec![], vec![], vec![], vec![], vec![]);
+    for j in 0..sys.model.joints.len() {
+        for p in summarise(sys, j).profile {
+            points.push(p.x);
+            joint.push(j as i32 + 1);
+            opening.push(p.opening);
+            sn.push(p.normal_stress);
+            tau.push(p.shear_stress);
+            slip.push(p.slip);
+        }
+    }
+    let cells: Vec<Vec<usize>> = (0..points.len()).map(|i| vec![i]).collect();
+    let types = vec![1u8; points.len()]; // VTK_VERTEX
+    let scalar = |name, values| Array::F64 {
+        name,
+        components: 1,
+        values,
+    };
+    Some(render(
+        &Grid {
+            points: &points,
+            cells: &cells,
+            types: &types,
+        },
+        &[
+            Array::I32 {
+                name: "joint",
+                values: &joint,
+            },
+            scalar("opening", &opening),
+            scalar("normal_stress", &sn),
+            scalar("shear_stress", &tau),
+            scalar("slip", &slip),
+        ],
+        &[],
+    ))
+}

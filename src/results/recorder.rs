@@ -310,6 +310,20 @@ impl<'m> Recorder<'m> {
                 MonitorKind::CrushedPoints { region } => {
                     point_extreme_sum(snap, *region, |p| p.is_crushed() as u8 as f64)
                 }
+                MonitorKind::StressAtPoint {
+                    component,
+                    gauss_point,
+                } => component
+                    .of(snap.system.families.continuum.gauss.committed[*gauss_point].stress),
+                MonitorKind::StressExtreme {
+                    component,
+                    region,
+                    extreme,
+                } => stress_extreme(snap, *component, *region, *extreme),
+                MonitorKind::JointContactStress { joint } => joints_of(*joint)
+                    .flat_map(|j| summarise(snap.system, j).profile)
+                    .map(|p| p.normal_stress)
+                    .fold(0.0, f64::max),
             })
             .collect()
     }
@@ -471,6 +485,15 @@ impl<'m> Recorder<'m> {
             let doc = super::gauss_points::render_gauss_points(snap);
             write_atomic(&self.dir.join(&gname), doc.as_bytes())?;
             self.pvd.push((t, 3, gname));
+        }
+        if let Some(doc) = super::joints::render_joint_points(snap.system) {
+            let jname = format!(
+                "joints_step{:03}_inc{:04}.vtu",
+                snap.step + 1,
+                snap.increment
+            );
+            write_atomic(&self.dir.join(&jname), doc.as_bytes())?;
+            self.pvd.push((t, 4, jname));
         }
         write_atomic(
             &self.dir.join("results.pvd"),
@@ -660,6 +683,54 @@ fn point_extreme(
     f: impl Fn(&crate::materials::point::PointState) -> f64,
 ) -> f64 {
     region_points(snap, region).map(f).fold(0.0, f64::max)
+}
+
+/// The extreme of a stress component over the Gauss points of a region (all if None) [Pa].
+fn stress_extreme(
+    snap: &Snapshot,
+    component: crate::model::StressComponent,
+    region: Option<usize>,
+    extreme: crate::model::Extreme,
+) -> f64 {
+    use crate::model::Extreme;
+    let sys = snap.system;
+    let values = sys
+        .model
+        .elements
+        .iter()
+        .enumerate()
+        .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
+        .flat_map(move |(i, _)| {
+            &sys.families.continuum.gauss.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]]
+        })
+        .map(|g| component.of(g.stress));
+    let pick = match extreme {
+        Extreme::Max => values.reduce(f64::max),
+        Extreme::Min => values.reduce(f64::min),
+        Extreme::Abs => values.reduce(|a, b| if b.abs() > a.abs() { b } else { a }),
+    };
+    pick.unwrap_or(0.0)
+}
+
+/// The input `kind` of a monitor (summary.json `monitors`; the plots choose display units
+/// and signs by it).
+pub fn kind_name(k: &MonitorKind) -> &'static str {
+    match k {
+        MonitorKind::Displacement { .. } => "displacement",
+        MonitorKind::Reaction { .. } => "reaction",
+        MonitorKind::LoadFactor { .. } => "load_factor",
+        MonitorKind::JointOpening { .. } => "joint_opening",
+        MonitorKind::JointContactDepth { .. } => "joint_contact_depth",
+        MonitorKind::JointSlip { .. } => "joint_slip",
+        MonitorKind::JointContactStress { .. } => "joint_contact_stress",
+        MonitorKind::TendonStress { .. } | MonitorKind::BarStress { .. } => "tendon_stress",
+        MonitorKind::TendonForce { .. } | MonitorKind::BarForce { .. } => "tendon_force",
+        MonitorKind::TendonLoss { .. } | MonitorKind::BarLoss { .. } => "tendon_loss",
+        MonitorKind::MaxCrackStrain { .. } => "max_crack_strain",
+        MonitorKind::MaxPlasticStrain { .. } => "max_plastic_strain",
+        MonitorKind::CrushedPoints { .. } => "crushed_points",
+        MonitorKind::StressAtPoint { .. } | MonitorKind::StressExtreme { .. } => "stress",
+    }
 }
 
 fn point_extreme_sum(

@@ -57,6 +57,11 @@ pub struct Ultimate {
     /// (one sentence each: step, displacement reached and aimed at).
     #[serde(default)]
     pub unfinished: Vec<String>,
+    /// When no failure was reached: what the run did reach (first yield of the
+    /// reinforcement and whether the load then kept rising or levelled off into a
+    /// plateau); empty otherwise.
+    #[serde(default)]
+    pub reached: String,
 }
 
 impl fmt::Display for Ultimate {
@@ -68,7 +73,18 @@ impl fmt::Display for Ultimate {
                 format!("{v:.4}")
             }
         };
-        if self.mode == "none reached" {
+        if self.mode == "none reached" && !self.reached.is_empty() {
+            write!(
+                f,
+                "ultimate: no collapse within the run; it reached {}; peak {} = {} (step '{}', increment {}); run {}",
+                self.reached,
+                self.load_case,
+                value(self.peak_factor),
+                self.peak_step,
+                self.peak_increment,
+                self.ended
+            )
+        } else if self.mode == "none reached" {
             write!(
                 f,
                 "ultimate: no failure reached; peak {} = {} (step '{}', increment {}); run {}",
@@ -414,7 +430,12 @@ impl UltimateWatch {
             Some(e) => (e.mode.to_string(), e.detail.clone(), v[e.at]),
             None => ("none reached".into(), String::new(), v[peak]),
         };
+        let reached = match (&self.bar_yield, modes.is_empty()) {
+            (Some(y), true) => after_yield(y, &v, &load_case),
+            _ => String::new(),
+        };
         Some(Ultimate {
+            reached,
             mode,
             detail,
             load_case,
@@ -439,6 +460,47 @@ impl UltimateWatch {
             },
         })
     }
+}
+
+/// Relative change of the load over the last quarter of the increments after first yield
+/// below which the response is called a plateau [-]: the RC beam example's load grows
+/// ≈ 0.5 % there while cracks form one by one; a still hardening member grows several %.
+const PLATEAU: f64 = 2e-2;
+
+/// What a run without failure reached after the first yield `y` of its reinforcement,
+/// from the load measure `v` (named `load`): "reinforcement yield (bar B at … MPa) at
+/// load = …, then a plateau (the load rose … % to its peak, … % over the last quarter)"
+/// or "…, then the load still rising …".
+fn after_yield(y: &Event, v: &[f64], load: &str) -> String {
+    let fmt = |x: f64| {
+        if load == CONTROL_FORCE {
+            format!("{:.4} kN", x / 1e3)
+        } else {
+            format!("{x:.4}")
+        }
+    };
+    let at = v[y.at];
+    let peak = v[y.at..].iter().copied().fold(at, f64::max);
+    let n = v.len() - y.at;
+    let tail = &v[v.len() - (n / 4).max(2).min(n)..];
+    let change = (tail[tail.len() - 1] - tail[0]) / peak.abs().max(1e-300);
+    let rise = 100.0 * (peak - at) / at.abs().max(1e-300);
+    let how = if change.abs() < PLATEAU {
+        format!(
+            "then a plateau (the load rose {rise:.1} % to its peak, {:.1} % over the last quarter of the increments after yield)",
+            100.0 * change
+        )
+    } else {
+        format!(
+            "then the load still rising ({rise:.1} % above the yield load at the peak, {:.1} % over the last quarter of the increments after yield)",
+            100.0 * change
+        )
+    };
+    format!(
+        "reinforcement yield ({}) at {load} = {}, {how}",
+        y.detail,
+        fmt(at)
+    )
 }
 
 /// Crushed concrete points at increment `k`: "crushing at an opened joint" for crushed
@@ -549,5 +611,32 @@ mod tests {
             w.limit_point(&v, 2).map(|e| e.mode),
             Some("loss of equilibrium")
         );
+    }
+}
+
+#[cfg(test)]
+mod reached_tests {
+    use super::*;
+
+    fn yield_at(k: usize) -> Event {
+        Event {
+            mode: "reinforcement yield",
+            detail: "bar B at 500 MPa".into(),
+            at: k,
+        }
+    }
+
+    /// After yield at 100 the load creeps to 110 and stays within 1 % over the last
+    /// quarter: a plateau, 10 % above the yield load; a member still gaining 10 % over the
+    /// last quarter is "still rising".
+    #[test]
+    fn plateau_or_rising_after_yield() {
+        let v = [50.0, 100.0, 105.0, 108.0, 109.0, 109.5, 110.0, 110.0, 109.8];
+        let s = after_yield(&yield_at(1), &v, "P");
+        assert!(s.contains("then a plateau"), "{s}");
+        assert!(s.contains("rose 10.0 %"), "{s}");
+        let v = [50.0, 100.0, 110.0, 120.0, 130.0, 140.0, 150.0, 160.0, 170.0];
+        let s = after_yield(&yield_at(1), &v, "P");
+        assert!(s.contains("still rising"), "{s}");
     }
 }

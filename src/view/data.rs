@@ -175,6 +175,8 @@ pub struct Output {
     pub file: PathBuf,
     /// The line-cell piece of the same instant (part 1: joints and tendons), if any.
     pub lines: Option<PathBuf>,
+    /// The joints' integration points of the same instant (part 4), if any.
+    pub joint_points: Option<PathBuf>,
 }
 
 impl Output {
@@ -259,6 +261,7 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
         .map_err(|e| ViewError::Usage(format!("{}: {e}", path.display())))?;
     let mut out: Vec<Output> = Vec::new();
     let mut lines: Vec<(f64, PathBuf)> = Vec::new();
+    let mut joint_points: Vec<(f64, PathBuf)> = Vec::new();
     for part in text.split("<DataSet").skip(1) {
         let tag = &part[..part.find('>').unwrap_or(part.len())];
         let a = attributes(tag);
@@ -271,7 +274,8 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
         let time = attr(&a, "timestep")
             .and_then(|t| t.parse().ok())
             .unwrap_or(out.len() as f64 + 1.0);
-        // Part 0 is the continuum; part 1 the joints and tendons; part 2 the bars.
+        // Part 0 is the continuum; part 1 the joints and tendons; part 2 the bars; part 3 the
+        // concrete's Gauss points; part 4 the joints' integration points.
         match attr(&a, "part")
             .and_then(|p| p.parse::<usize>().ok())
             .unwrap_or(0)
@@ -280,13 +284,19 @@ pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
                 time,
                 file: dir.join(file),
                 lines: None,
+                joint_points: None,
             }),
             1 => lines.push((time, dir.join(file))),
+            4 => joint_points.push((time, dir.join(file))),
             _ => {}
         }
     }
     for o in &mut out {
         o.lines = lines
+            .iter()
+            .find(|(t, _)| *t == o.time)
+            .map(|(_, f)| f.clone());
+        o.joint_points = joint_points
             .iter()
             .find(|(t, _)| *t == o.time)
             .map(|(_, f)| f.clone());

@@ -127,6 +127,8 @@ pub struct Series {
     pub label: String,
     /// Points in file order.
     pub points: Vec<(f64, f64)>,
+    /// Panel (one per y unit; 0 is the top one).
+    pub panel: usize,
 }
 
 /// Curves against a common x axis, with optional reference markers.
@@ -136,8 +138,10 @@ pub struct CurveFigure {
     pub title: String,
     /// x-axis label with unit.
     pub x_label: String,
-    /// y-axis label with unit.
+    /// y-axis label with unit (of the first panel).
     pub y_label: String,
+    /// y-axis label of each panel (one panel per unit).
+    pub y_labels: Vec<String>,
     /// Computed curves (lines with a dot at each converged increment).
     pub series: Vec<Series>,
     /// Reference points (hollow black circles).
@@ -146,40 +150,88 @@ pub struct CurveFigure {
 
 impl Figure for CurveFigure {
     fn size(&self) -> (u32, u32) {
-        (1000, 680)
+        (1000, 680 + 380 * (self.panels() as u32 - 1))
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-        let all = self
+        let n = self.panels();
+        let area = if n > 1 {
+            title_area(root, &self.title)?
+        } else {
+            root.clone()
+        };
+        let cells = area.split_evenly((n, 1));
+        for (p, cell) in cells.iter().enumerate() {
+            self.draw_panel(cell, p, n == 1)?;
+        }
+        Ok(())
+    }
+}
+
+impl CurveFigure {
+    /// Number of panels (one per y unit).
+    pub fn panels(&self) -> usize {
+        self.y_labels.len().max(1)
+    }
+
+    /// Panel `p`: its series (and the reference on the first), the x axis shared.
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        p: usize,
+        with_title: bool,
+    ) -> DrawResult {
+        let here = |s: &&Series| s.panel == p;
+        let reference = self.reference.iter().filter(|_| p == 0);
+        let xs = self
             .series
             .iter()
             .chain(self.reference.iter())
+            .flat_map(|s| s.points.iter().map(|q| q.0))
+            .filter(|x| x.is_finite());
+        let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        let all = self
+            .series
+            .iter()
+            .filter(here)
+            .chain(reference.clone())
             .flat_map(|s| s.points.iter().copied())
             .filter(|p| p.0.is_finite() && p.1.is_finite());
         let (lo, hi) = bounds(all.map(|(x, y)| [x, y]));
-        let (x0, x1) = padded(lo[0], hi[0], 0.04);
+        let (x0, x1) = padded(x_lo, x_hi, 0.04);
         let (y0, y1) = padded(lo[1], hi[1], 0.06);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 22))
+        let (dx, dy) = (label_step(x1 - x0, X_LABELS), label_step(y1 - y0, Y_LABELS));
+        let mut b = ChartBuilder::on(root);
+        if with_title {
+            b.caption(&self.title, (FONT, 22));
+        }
+        let mut chart = b
             .margin(18)
             .x_label_area_size(55)
             .y_label_area_size(95)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(de)?;
-        let (sx, sy) = (x1 - x0, y1 - y0);
+        let label = self.y_labels.get(p).unwrap_or(&self.y_label);
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
-            .y_desc(&self.y_label)
+            .y_desc(label)
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 17))
-            .x_label_formatter(&|v| fmt_tick(*v, sx))
-            .y_label_formatter(&|v| fmt_tick(*v, sy))
+            .x_labels(X_LABELS)
+            .y_labels(Y_LABELS)
+            .x_label_formatter(&|v| tick_label(*v, dx))
+            .y_label_formatter(&|v| tick_label(*v, dy))
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(205, 205, 205))
             .draw()
             .map_err(de)?;
         for (i, s) in self.series.iter().enumerate() {
+            if s.panel != p {
+                continue;
+            }
             let c = PALETTE[i % PALETTE.len()];
             chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
@@ -192,7 +244,7 @@ impl Figure for CurveFigure {
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
                 .map_err(de)?;
         }
-        if let Some(r) = &self.reference {
+        for r in reference.clone() {
             chart
                 .draw_series(
                     r.points
@@ -206,7 +258,8 @@ impl Figure for CurveFigure {
         let all: Vec<(f64, f64)> = self
             .series
             .iter()
-            .chain(self.reference.iter())
+            .filter(here)
+            .chain(reference)
             .flat_map(|s| s.points.iter().copied())
             .collect();
         chart
@@ -219,6 +272,58 @@ impl Figure for CurveFigure {
             .map_err(de)?;
         Ok(())
     }
+}
+
+/// Most tick labels on the x axis of a curve.
+const X_LABELS: usize = 8;
+/// Most tick labels on the y axis of a curve.
+const Y_LABELS: usize = 6;
+
+/// The smallest tick spacing the plotting library can choose for at most `n` labels over
+/// `span`: its spacings are 1, 2 or 5 × 10^k, so labels with the decimals of this one
+/// never print two ticks alike.
+pub fn label_step(span: f64, n: usize) -> f64 {
+    let span = span.abs();
+    if !(span > 0.0 && span.is_finite()) {
+        return 1.0;
+    }
+    let mut k = 10f64.powf((span / n.max(1) as f64).log10().floor() - 1.0);
+    loop {
+        for m in [1.0, 2.0, 5.0] {
+            if 1.0 + (span / (m * k)).floor() <= n as f64 {
+                return m * k;
+            }
+        }
+        k *= 10.0;
+    }
+}
+
+/// Label of a tick at `v` on an axis whose ticks are at least `step` apart: the decimals
+/// the step needs, scientific notation for very small or large values.
+pub fn tick_label(v: f64, step: f64) -> String {
+    let step = step.abs();
+    if v == 0.0 || v.abs() < 1e-9 * step {
+        return "0".into();
+    }
+    let m = v.abs().max(step);
+    if !(1e-3..1e6).contains(&m) {
+        // Mantissa digits enough to tell ticks apart.
+        let d = ((m / step).log10().ceil().max(0.0) as usize).min(8);
+        return format!("{v:.d$e}");
+    }
+    let dec = (-step.log10().floor()).max(0.0) as usize;
+    format!("{v:.dec$}")
+}
+
+/// The labels of the ticks at every multiple of the smallest spacing [`label_step`] allows
+/// on [lo, hi] with at most `n` labels (the densest the plotting library draws).
+pub fn tick_labels(lo: f64, hi: f64, n: usize) -> Vec<String> {
+    let step = label_step(hi - lo, n);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last)
+        .map(|k| tick_label(k as f64 * step, step))
+        .collect()
 }
 
 /// Outline of a cell as point indices in drawing order (mid-side nodes between corners);
@@ -285,6 +390,8 @@ struct Frame {
 }
 
 const TITLE_H: u32 = 40;
+/// Height of the legend strip under a mesh drawing [px].
+const LEGEND_H: u32 = 28;
 const MARGIN: u32 = 12;
 const XLAB: u32 = 45;
 const YLAB: u32 = 70;
@@ -329,8 +436,8 @@ macro_rules! model_chart {
             .y_desc("y [m]")
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 15))
-            .x_label_formatter(&|v| fmt_tick(*v, sx))
-            .y_label_formatter(&|v| fmt_tick(*v, sy))
+            .x_label_formatter(&|v| tick_label(*v, label_step(sx, 12)))
+            .y_label_formatter(&|v| tick_label(*v, label_step(sy, 6)))
             .x_labels(12)
             .y_labels(6)
             .draw()
@@ -377,10 +484,13 @@ fn pts(grid: &Grid, idx: &[usize], disp: Option<&[[f64; 2]]>, scale: f64) -> Vec
         .collect()
 }
 
-/// The undeformed mesh, cells filled by region; line cells (joints, tendons) in red.
+/// The undeformed mesh, cells filled by region (a legend names each region's colour); line
+/// cells (joints, tendons) in red.
 pub struct MeshFigure<'g> {
     /// Grid.
     pub grid: &'g Grid,
+    /// Region names by index (summary.json `regions`); `region k` where missing.
+    pub regions: Vec<String>,
     /// Title.
     pub title: String,
 }
@@ -388,14 +498,16 @@ pub struct MeshFigure<'g> {
 impl Figure for MeshFigure<'_> {
     fn size(&self) -> (u32, u32) {
         let (lo, hi) = self.grid.bounds();
-        frame(lo, hi, 0).size
+        frame(lo, hi, LEGEND_H).size
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let g = self.grid;
         let (lo, hi) = g.bounds();
-        let f = frame(lo, hi, 0);
+        let f = frame(lo, hi, LEGEND_H);
         let area = title_area(root, &self.title)?;
+        let (_, h) = area.dim_in_pixel();
+        let (area, strip) = area.split_vertically(h.saturating_sub(LEGEND_H));
         let mut chart = model_chart!(&area, f);
         let region = g.cell_array("region");
         let edge = RGBColor(90, 90, 90);
@@ -417,8 +529,68 @@ impl Figure for MeshFigure<'_> {
                 ])
                 .map_err(de)?;
         }
+        // The legend, in a strip below the drawing (never over the mesh): a swatch per
+        // region present, and the joint/tendon lines.
+        let mut entries: Vec<(String, RGBColor, bool)> = region_legend(g, &self.regions)
+            .into_iter()
+            .map(|(r, name)| (name, REGION_FILL[r % REGION_FILL.len()], false))
+            .collect();
+        if (0..g.cells.len()).any(|i| g.is_line(i)) {
+            entries.push(("joints, tendons".into(), RED, true));
+        }
+        let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        let mut x = (MARGIN + YLAB) as i32;
+        let y = (LEGEND_H / 2) as i32;
+        for (name, c, line) in entries {
+            if line {
+                strip
+                    .draw(&PathElement::new(
+                        vec![(x, y), (x + 18, y)],
+                        c.stroke_width(2),
+                    ))
+                    .map_err(de)?;
+            } else {
+                strip
+                    .draw(&Rectangle::new([(x, y - 6), (x + 18, y + 6)], c.filled()))
+                    .map_err(de)?;
+                strip
+                    .draw(&Rectangle::new(
+                        [(x, y - 6), (x + 18, y + 6)],
+                        RGBColor(90, 90, 90),
+                    ))
+                    .map_err(de)?;
+            }
+            strip
+                .draw(&Text::new(name.clone(), (x + 24, y), style.clone()))
+                .map_err(de)?;
+            x += 24 + 8 * name.chars().count() as i32 + 24;
+        }
         Ok(())
     }
+}
+
+/// The legend entries of a mesh figure: (region index, name) for each region some cell
+/// belongs to, in index order (`names[k]`, or `region k` without a name).
+pub fn region_legend(g: &Grid, names: &[String]) -> Vec<(usize, String)> {
+    let Some(region) = g.cell_array("region") else {
+        return Vec::new();
+    };
+    let mut present: Vec<usize> = (0..g.cells.len())
+        .filter(|&i| !g.is_line(i))
+        .map(|i| region.get(i, 0).max(0.0) as usize)
+        .collect();
+    present.sort_unstable();
+    present.dedup();
+    present
+        .into_iter()
+        .map(|r| {
+            let name = names
+                .get(r)
+                .cloned()
+                .unwrap_or_else(|| format!("region {r}"));
+            (r, name)
+        })
+        .collect()
 }
 
 /// Magnification for a deformed shape: the largest displacement drawn as 5 % of the model
@@ -936,8 +1108,10 @@ impl Figure for JointFigure {
                     .y_desc("y [m]")
                     .label_style((FONT, 12))
                     .axis_desc_style((FONT, 13))
-                    .x_label_formatter(&|v| fmt_tick(*v, sx))
-                    .y_label_formatter(&|v| fmt_tick(*v, sy))
+                    .x_labels(6)
+                    .y_labels(6)
+                    .x_label_formatter(&|v| tick_label(*v, label_step(sx, 6)))
+                    .y_label_formatter(&|v| tick_label(*v, label_step(sy, 6)))
                     .light_line_style(RGBColor(240, 240, 240))
                     .draw()
                     .map_err(de)?;
@@ -965,5 +1139,38 @@ impl Figure for JointFigure {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tick labels never repeat, over spans from 1e-7 to 1e9 and offsets that put the
+    /// ticks far from zero (the case that printed "0.001" twice before).
+    #[test]
+    fn tick_labels_are_unique() {
+        for e in -7..=9 {
+            for m in [1.0, 1.3, 2.2, 3.7, 4.9, 7.5] {
+                let span = m * 10f64.powi(e);
+                for offset in [0.0, -0.37 * span, 12.3 * span, -1e3 * span] {
+                    for n in [6, 8, 12] {
+                        let l = tick_labels(offset, offset + span, n);
+                        assert!(l.len() >= 2 && l.len() <= n, "{span} {offset} {n}: {l:?}");
+                        let mut u = l.clone();
+                        u.dedup();
+                        assert_eq!(u.len(), l.len(), "repeated labels {l:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The step is the smallest 1, 2, 5 × 10^k giving at most n labels.
+    #[test]
+    fn label_step_is_the_densest_allowed() {
+        assert_eq!(label_step(1.0, 6), 0.2);
+        assert_eq!(label_step(1.0, 11), 0.1);
+        assert_eq!(label_step(0.0021, 8), 0.0005);
     }
 }

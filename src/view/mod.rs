@@ -10,6 +10,7 @@
 pub mod data;
 pub mod figures;
 pub mod report;
+pub mod units;
 
 use data::{Grid, Output, Table};
 use figures::{
@@ -17,6 +18,7 @@ use figures::{
     JointFigure, JointProfile, MeshFigure, Series,
 };
 use std::path::{Path, PathBuf};
+pub use units::UnitOptions;
 
 /// Why a view command failed.
 #[derive(Debug, thiserror::Error)]
@@ -132,6 +134,8 @@ pub struct PlotOptions {
     pub scale: Option<f64>,
     /// Output directory; default `<dir>/figures`.
     pub out: Option<PathBuf>,
+    /// Display units and signs of the curves (default mm, kN, MPa, deflection down).
+    pub units: UnitOptions,
 }
 
 /// What `segfem plot` produced.
@@ -168,9 +172,22 @@ pub fn read_history(dir: &Path) -> Result<Table, ViewError> {
 
 /// Default (x, y) columns of the load–displacement curve of a history.
 pub fn default_columns(h: &Table) -> Result<(String, Vec<String>), ViewError> {
+    // The main displacement: the first displacement monitor (summary.json kinds; vertical
+    // first), else the first column in m.
+    let dir = h.path.parent().unwrap_or(Path::new("."));
+    let kinds = units::kinds(dir);
+    let is_disp = |c: &data::Column, vertical: bool| {
+        kinds.iter().any(|(n, k)| {
+            *n == c.name
+                && k.kind == "displacement"
+                && (!vertical || k.component.as_deref() == Some("y"))
+        })
+    };
     let x = h
         .monitors()
-        .find(|c| c.unit == "m")
+        .find(|c| is_disp(c, true))
+        .or_else(|| h.monitors().find(|c| is_disp(c, false)))
+        .or_else(|| h.monitors().find(|c| c.unit == "m"))
         .or_else(|| h.monitors().next())
         .map(|c| c.name.clone())
         .unwrap_or_else(|| "increment".into());
@@ -206,13 +223,16 @@ pub fn default_columns(h: &Table) -> Result<(String, Vec<String>), ViewError> {
 }
 
 /// The history curve figure: `y` columns against `x` for the run `dir` and the `runs`,
-/// with reference markers.
+/// with reference markers, in display units and signs (`units`, [`units::shown`]). Columns
+/// of different units go to separate panels, one y axis each. Reference points are read
+/// in the history's SI units, or as they are when their header gives the display unit.
 pub fn curve_figure(
     dir: &Path,
     x: Option<&str>,
     y: &[String],
     runs: &[PathBuf],
     reference: Option<&Path>,
+    opts: UnitOptions,
 ) -> Result<CurveFigure, ViewError> {
     let h = read_history(dir)?;
     let (dx, dy) = default_columns(&h)?;
@@ -223,6 +243,39 @@ pub fn curve_figure(
         .iter()
         .map(|k| h.column(k))
         .collect::<Result<Vec<_>, _>>()?;
+    let kinds = units::kinds(dir);
+    let kind_of = |name: &str| kinds.iter().find(|(n, _)| n == name).map(|(_, k)| k);
+    let show = |c: &data::Column| units::shown(&c.name, &c.unit, kind_of(&c.name), &c.values, opts);
+    let xs_shown = show(xc);
+    let ys_shown: Vec<units::Shown> = ycols.iter().map(|c| show(c)).collect();
+    let panel_of =
+        units::group_by_unit(&ys_shown.iter().map(|s| s.unit.clone()).collect::<Vec<_>>());
+    let n_panels = panel_of.iter().copied().max().map_or(1, |m| m + 1);
+    let y_labels: Vec<String> = (0..n_panels)
+        .map(|p| {
+            let members: Vec<usize> = (0..ycols.len()).filter(|&i| panel_of[i] == p).collect();
+            if members.len() == 1 {
+                ys_shown[members[0]].label.clone()
+            } else {
+                let unit = &ys_shown[members[0]].unit;
+                let names = members
+                    .iter()
+                    .map(|&i| {
+                        ys_shown[i]
+                            .label
+                            .rsplit_once(" [")
+                            .map_or(ys_shown[i].label.as_str(), |l| l.0)
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                if unit.is_empty() {
+                    names
+                } else {
+                    format!("{names} [{unit}]")
+                }
+            }
+        })
+        .collect();
     let several_runs = !runs.is_empty();
     let mut series = Vec::new();
     let mut tables = vec![(dir.to_path_buf(), h.clone())];
@@ -231,7 +284,7 @@ pub fn curve_figure(
     }
     for (d, t) in &tables {
         let xs = t.column(&x)?;
-        for yc in &ycols {
+        for (k, yc) in ycols.iter().enumerate() {
             let ys = t.column(&yc.name)?;
             let label = match (several_runs, ycols.len() > 1) {
                 (true, true) => format!("{}: {}", run_name(d), yc.name),
@@ -243,32 +296,13 @@ pub fn curve_figure(
                 points: xs
                     .values
                     .iter()
-                    .copied()
-                    .zip(ys.values.iter().copied())
+                    .map(|v| v * xs_shown.factor)
+                    .zip(ys.values.iter().map(|v| v * ys_shown[k].factor))
                     .collect(),
+                panel: panel_of[k],
             });
         }
     }
-    let units: Vec<&str> = ycols.iter().map(|c| c.unit.as_str()).collect();
-    let y_label = if ycols.len() == 1 {
-        ycols[0].label()
-    } else if units.iter().all(|u| *u == units[0]) && !units[0].is_empty() {
-        format!(
-            "{} [{}]",
-            ycols
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            units[0]
-        )
-    } else {
-        ycols
-            .iter()
-            .map(|c| c.label())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     let reference = match reference {
         Some(p) => {
             let t = Table::read(p)?;
@@ -279,14 +313,26 @@ pub fn curve_figure(
                 )));
             }
             let (a, b) = (&t.columns[0], &t.columns[1]);
+            // A header in the display unit is taken as drawn; otherwise as the history's.
+            let fa = if a.unit == xs_shown.unit {
+                1.0
+            } else {
+                xs_shown.factor
+            };
+            let fb = if b.unit == ys_shown[0].unit {
+                1.0
+            } else {
+                ys_shown[0].factor
+            };
             Some(Series {
                 label: format!("reference: {}", run_name(p)),
                 points: a
                     .values
                     .iter()
-                    .copied()
-                    .zip(b.values.iter().copied())
+                    .map(|v| v * fa)
+                    .zip(b.values.iter().map(|v| v * fb))
                     .collect(),
+                panel: 0,
             })
         }
         None => None,
@@ -301,8 +347,9 @@ pub fn curve_figure(
                 .join(", "),
             xc.name
         ),
-        x_label: xc.label(),
-        y_label,
+        x_label: xs_shown.label,
+        y_label: y_labels[0].clone(),
+        y_labels,
         series,
         reference,
     })
@@ -469,6 +516,64 @@ pub fn joint_profiles(g: &Grid) -> Vec<JointProfile> {
         .collect()
 }
 
+/// Joint profiles from the joints' integration points (part 4 of results.pvd: vertices with
+/// `joint`, `opening` [m] and `normal_stress` [Pa] arrays): every point, so the diagrams
+/// reach the true extremes. Joints named from `names` (summary.json `joints`), else
+/// `joint k`.
+pub fn joint_point_profiles(path: &Path, names: &[String]) -> Result<Vec<JointProfile>, ViewError> {
+    let g = Grid::read(path)?;
+    let (Some(id), Some(open)) = (g.point_array("joint"), g.point_array("opening")) else {
+        return Ok(Vec::new());
+    };
+    let sn = g.point_array("normal_stress");
+    let mut out: Vec<(i64, JointProfile)> = Vec::new();
+    for (i, p) in g.points.iter().enumerate() {
+        let k = id.get(i, 0) as i64;
+        let point = (
+            p[1],
+            open.get(i, 0) * 1e3,
+            sn.map_or(f64::NAN, |a| a.get(i, 0) / 1e6),
+        );
+        match out.iter_mut().find(|o| o.0 == k) {
+            Some(o) => o.1.points.push(point),
+            None => {
+                let name = names
+                    .get((k - 1).max(0) as usize)
+                    .map_or_else(|| format!("joint {k}"), |n| format!("joint {n}"));
+                let x = p[0];
+                out.push((
+                    k,
+                    JointProfile {
+                        name: format!("{name} (x = {x:.3} m)"),
+                        points: vec![point],
+                    },
+                ))
+            }
+        }
+    }
+    out.sort_by_key(|o| o.0);
+    Ok(out
+        .into_iter()
+        .map(|(_, mut j)| {
+            j.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            j
+        })
+        .collect())
+}
+
+/// The joint profiles of an output: from the joints' integration points when the run wrote
+/// them, else from the line cells of its grid `g`.
+pub fn output_joint_profiles(
+    output: &Output,
+    g: &Grid,
+    dir: &Path,
+) -> Result<Vec<JointProfile>, ViewError> {
+    match &output.joint_points {
+        Some(p) => joint_point_profiles(p, &units::joint_names(dir)),
+        None => Ok(joint_profiles(g)),
+    }
+}
+
 /// Most joints drawn in one joint figure.
 pub const MAX_JOINTS: usize = 8;
 
@@ -488,6 +593,7 @@ pub fn extra_curves(opts: &PlotOptions, cols: &[String]) -> Result<Vec<PathBuf>,
             std::slice::from_ref(c),
             &opts.runs,
             None,
+            opts.units,
         )?;
         // File names from the column name only (a header such as "σ [Pa]" is not a name).
         let stem: String = c
@@ -523,6 +629,7 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         &opts.y,
         &opts.runs,
         opts.reference.as_deref(),
+        opts.units,
     )?;
     let out_dir = opts.out.clone().unwrap_or_else(|| opts.dir.join("figures"));
     std::fs::create_dir_all(&out_dir)
@@ -547,6 +654,7 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
     outcome.files.extend(save(
         &MeshFigure {
             grid: &g,
+            regions: units::region_names(&opts.dir),
             title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
         },
         &out_dir,
@@ -578,13 +686,15 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         &out_dir,
         &format!("field_{}", field.name()),
     )?);
-    extra_figures(&g, &tag, &out_dir, &mut outcome)?;
+    let joints = output_joint_profiles(&output, &g, &opts.dir)?;
+    extra_figures(&g, joints, &tag, &out_dir, &mut outcome)?;
     Ok(outcome)
 }
 
 /// Crack pattern and joint diagrams, or notes when their data is absent.
 fn extra_figures(
     g: &Grid,
+    joints: Vec<JointProfile>,
     tag: &str,
     out_dir: &Path,
     outcome: &mut PlotOutcome,
@@ -593,7 +703,7 @@ fn extra_figures(
         Some(f) => outcome.files.extend(save(&f, out_dir, "cracks")?),
         None => outcome.notes.push(CRACK_NOTE.into()),
     }
-    match joint_figure(g, tag, &mut outcome.notes) {
+    match joint_figure(joints, tag, &mut outcome.notes) {
         Some(f) => outcome.files.extend(save(&f, out_dir, "joints")?),
         None => outcome.notes.push(JOINT_NOTE.into()),
     }
@@ -623,8 +733,11 @@ pub fn crack_figure<'g>(g: &'g Grid, tag: &str) -> Option<CrackFigure<'g>> {
 }
 
 /// The joint figure, when the grid has joint data (at most [`MAX_JOINTS`], noted).
-pub fn joint_figure(g: &Grid, tag: &str, notes: &mut Vec<String>) -> Option<JointFigure> {
-    let mut joints = joint_profiles(g);
+pub fn joint_figure(
+    mut joints: Vec<JointProfile>,
+    tag: &str,
+    notes: &mut Vec<String>,
+) -> Option<JointFigure> {
     if joints.is_empty() {
         return None;
     }

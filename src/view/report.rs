@@ -3,7 +3,9 @@
 //! model drawings as base64 PNG) and, given a reference CSV, a comparison table.
 
 use super::data::{Grid, Table};
-use super::figures::{png_bytes, svg_string, CurveFigure, DeformedFigure, MeshFigure};
+use super::figures::{
+    png_bytes, svg_string, CurveFigure, DeformedFigure, JointProfile, MeshFigure,
+};
 use super::{
     auto_scale, crack_figure, curve_figure, displacements, field_values, fmt_scale, joint_figure,
     pick_output, read_history, run_name, Field, ViewError, CRACK_NOTE, JOINT_NOTE,
@@ -27,6 +29,8 @@ pub struct ReportOptions {
     pub y: Option<String>,
     /// Output number for the field figures (1-based; default the last).
     pub step: Option<usize>,
+    /// Display units and signs of the curve and the peak load.
+    pub units: super::UnitOptions,
 }
 
 /// A row of the comparison table.
@@ -220,6 +224,40 @@ fn events(h: &Table) -> String {
     s
 }
 
+/// The verdict at the top of the report: how the run ended, with its converged increments
+/// counted from the history, and the `ultimate` verdict (failure mode, load, what yielded
+/// or crushed) of a run to failure.
+pub fn headline(dir: &Path, h: &Table) -> String {
+    let v: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(serde_json::Value::Null);
+    let status = v["status"].as_str().unwrap_or("unknown (no summary.json)");
+    let n = h.rows();
+    let ended = match status {
+        "completed" => format!("Run completed: {n} converged increments."),
+        "failed" => format!(
+            "Run failed: {n} converged increments before the failure; the results shown are those of the last converged increment."
+        ),
+        "implausible" => format!(
+            "Run ended with an implausible result ({n} converged increments): check the model before any use."
+        ),
+        s => format!("Run {s}: {n} converged increments."),
+    };
+    let class = if status == "completed" {
+        ""
+    } else {
+        " class=\"bad\""
+    };
+    let mut s = format!("<p id=\"headline\"{class}><b>{}</b></p>\n", esc(&ended));
+    let ultimate =
+        serde_json::from_value::<crate::results::ultimate::Ultimate>(v["ultimate"].clone());
+    if let Ok(u) = ultimate {
+        let _ = writeln!(s, "<p id=\"ultimate\"><b>{}</b></p>", esc(&u.to_string()));
+    }
+    s
+}
+
 fn summary_section(dir: &Path) -> (String, String) {
     let path = dir.join("summary.json");
     let Ok(text) = std::fs::read_to_string(&path) else {
@@ -288,6 +326,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         &y,
         &[],
         opts.reference.as_deref(),
+        opts.units,
     )?;
     let out = opts
         .out
@@ -298,8 +337,9 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
     let mut html = String::new();
     let _ = write!(
         html,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title><style>{STYLE}</style></head><body>\n<h1>{t}</h1>\n<p>Run directory: <code>{d}</code></p>\n<h2>Model and run</h2>\n{summary}",
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title><style>{STYLE}</style></head><body>\n<h1>{t}</h1>\n{head}<p>Run directory: <code>{d}</code></p>\n<h2>Model and run</h2>\n{summary}",
         t = esc(&title),
+        head = headline(&opts.dir, &h),
         d = esc(&opts.dir.display().to_string())
     );
     let _ = write!(
@@ -322,6 +362,9 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         .filter(|v| v.is_finite())
         .max_by(|a, b| a.abs().total_cmp(&b.abs()));
     if let Some(v) = peak {
+        let kinds = super::units::kinds(&opts.dir);
+        let kind = kinds.iter().find(|(n, _)| *n == load.name).map(|(_, k)| k);
+        let shown = super::units::shown(&load.name, &load.unit, kind, &load.values, opts.units);
         let what = if load.unit == "-" {
             "Peak load factor"
         } else {
@@ -329,13 +372,13 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         };
         let _ = writeln!(
             html,
-            "<p><b>{what}:</b> {} = {}{}</p>",
+            "<p id=\"peak\"><b>{what}:</b> {} = {}{}</p>",
             esc(&load.name),
-            num(v),
-            if load.unit.is_empty() || load.unit == "-" {
+            num(v * shown.factor),
+            if shown.unit.is_empty() || shown.unit == "-" {
                 String::new()
             } else {
-                format!(" {}", esc(&load.unit))
+                format!(" {}", esc(&shown.unit))
             }
         );
     }
@@ -383,7 +426,10 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         Ok((n, output)) => {
             let g = output.grid()?;
             let tag = format!("output {n}, {}", run_name(&output.file));
-            fields_section(&mut html, &g, &tag, &mut notes)?;
+            let joints = super::output_joint_profiles(&output, &g, &opts.dir)?;
+            let from_points = output.joint_points.is_some();
+            fields_section(&mut html, &opts.dir, &g, &tag, &mut notes)?;
+            joints_section(&mut html, joints, from_points, &tag, &mut notes)?;
         }
         Err(e) if opts.step.is_none() => notes.push(format!("model drawings: skipped ({e})")),
         Err(e) => return Err(e),
@@ -409,12 +455,14 @@ fn figure(html: &mut String, png: &[u8], caption: &str) {
 
 fn fields_section(
     html: &mut String,
+    dir: &Path,
     g: &Grid,
     tag: &str,
     notes: &mut Vec<String>,
 ) -> Result<(), ViewError> {
     let mesh = MeshFigure {
         grid: g,
+        regions: super::units::region_names(dir),
         title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
     };
     figure(html, &png_bytes(&mesh)?, "Mesh, cells coloured by region");
@@ -461,13 +509,60 @@ fn fields_section(
         ),
         None => notes.push(CRACK_NOTE.into()),
     }
-    match joint_figure(g, tag, notes) {
-        Some(f) => figure(
+    Ok(())
+}
+
+/// Joint diagrams along the depth and a table of their extremes: the largest opening and
+/// the largest contact (compressive normal) stress of each joint, with the height where
+/// they occur, read from the joints' integration points when the run wrote them.
+fn joints_section(
+    html: &mut String,
+    joints: Vec<JointProfile>,
+    from_points: bool,
+    tag: &str,
+    notes: &mut Vec<String>,
+) -> Result<(), ViewError> {
+    if joints.is_empty() {
+        notes.push(JOINT_NOTE.into());
+        return Ok(());
+    }
+    let source = if from_points {
+        "at the joints' integration points"
+    } else {
+        "element means of the joint line cells (the run wrote no joint integration points)"
+    };
+    let _ = writeln!(
+        html,
+        "<h2>Joints</h2>\n<p>Opening and contact stress along the depth, {source} ({}).</p>\n<table><tr><th>joint</th><th>largest opening [mm]</th><th>at y [m]</th><th>largest contact stress [MPa]</th><th>at y [m]</th></tr>",
+        esc(tag)
+    );
+    for j in &joints {
+        let pick = |f: &dyn Fn(&(f64, f64, f64)) -> f64| {
+            j.points
+                .iter()
+                .filter(|p| f(p).is_finite())
+                .max_by(|a, b| f(a).total_cmp(&f(b)))
+                .map(|p| (f(p), p.0))
+        };
+        let cell = |v: Option<(f64, f64)>| match v {
+            Some((v, y)) => format!("<td>{}</td><td>{}</td>", num(v.max(0.0)), num(y)),
+            None => "<td>—</td><td>—</td>".into(),
+        };
+        let _ = writeln!(
+            html,
+            "<tr><td>{}</td>{}{}</tr>",
+            esc(&j.name),
+            cell(pick(&|p| p.1)),
+            cell(pick(&|p| p.2))
+        );
+    }
+    html.push_str("</table>\n");
+    if let Some(f) = joint_figure(joints, tag, notes) {
+        figure(
             html,
             &png_bytes(&f)?,
-            "Joints: opening [mm] and normal stress [MPa] along the height",
-        ),
-        None => notes.push(JOINT_NOTE.into()),
+            "Joints: opening [mm] and normal stress (compression positive) [MPa] along the height",
+        );
     }
     Ok(())
 }

@@ -164,7 +164,7 @@ fn banded_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
     let ny: f64 = bands.iter().map(|b| b.rows as f64).sum();
     limits::check_size(
         ctx,
-        "mesh.nx",
+        &size_key("mesh.nx", nx, &bands),
         limits::grid_nodes(kind, nx as f64, ny),
         nx as f64 * ny,
         limits::available_memory(),
@@ -348,7 +348,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
     let n_seg = lengths.len() as f64;
     limits::check_size(
         ctx,
-        "mesh.nx_per_segment",
+        &size_key("mesh.nx_per_segment", nx, &bands),
         n_seg * limits::grid_nodes(kind, nx as f64, ny),
         n_seg * nx as f64 * ny,
         limits::available_memory(),
@@ -410,6 +410,21 @@ pub(super) fn check_generated(
         }
     }
     Ok(())
+}
+
+/// The key a too-large grid names: the band with the most rows when the rows outnumber the
+/// columns `nx` (a slip in `rows`), else `nx_key`.
+fn size_key(nx_key: &str, nx: usize, bands: &[Band]) -> String {
+    let (i, most) = bands
+        .iter()
+        .enumerate()
+        .max_by_key(|(_, b)| b.rows)
+        .map_or((0, 0), |(i, b)| (i, b.rows));
+    if most > nx {
+        format!("mesh.bands[{i}].rows")
+    } else {
+        nx_key.to_string()
+    }
 }
 
 pub(super) fn bands_of<'a, I: Iterator<Item = &'a str> + Clone>(

@@ -5,7 +5,9 @@ use super::tendons::is_bonded_kind;
 use super::R;
 use crate::input::error::Ctx;
 use crate::input::schema::{File, MonitorIn};
-use crate::model::{Bar, LossPart, Model, Monitor, MonitorKind, TendonEl};
+use crate::model::{
+    Bar, Extreme, LossPart, Model, Monitor, MonitorKind, StressComponent, TendonEl,
+};
 
 /// The monitors, resolved against the supports, load cases, tendons, joints, bars and steps.
 pub(super) fn build(ctx: &Ctx, file: &File, model: &mut Model, used: &[bool]) -> R<()> {
@@ -89,16 +91,17 @@ fn monitor(
             | "tendon_loss_creep" | "tendon_loss_relaxation" => {
                 tendon_monitor(ctx, &key, m, bonded_bar, model)?
             }
-            "joint_opening" | "joint_slip" | "joint_contact_depth" => {
+            "joint_opening" | "joint_slip" | "joint_contact_depth" | "joint_contact_stress" => {
                 joint_monitor(ctx, &key, m, model)?
             }
+        "stress" => stress_monitor(ctx, &key, m, model)?,
         "bar_stress" | "max_crack_strain" | "max_plastic_strain" | "crushed_points" => {
             material_monitor(ctx, &key, m, model)?
         }
         o => {
             return Err(ctx.err(
                 format!("{key}.kind"),
-                format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip, joint_contact_depth, tendon_stress, tendon_force, tendon_loss, tendon_loss_elastic, tendon_loss_creep, tendon_loss_relaxation, bar_stress, max_crack_strain, max_plastic_strain or crushed_points)"),
+                format!("unknown monitor kind '{o}' (expected displacement, reaction, load_factor, joint_opening, joint_slip, joint_contact_depth, joint_contact_stress, stress, tendon_stress, tendon_force, tendon_loss, tendon_loss_elastic, tendon_loss_creep, tendon_loss_relaxation, bar_stress, max_crack_strain, max_plastic_strain or crushed_points)"),
             ))
         }
     };
@@ -208,6 +211,7 @@ fn joint_monitor(ctx: &Ctx, key: &str, m: &MonitorIn, model: &Model) -> R<Monito
     Ok(match (m.kind.as_str(), joint) {
         ("joint_opening", j) => MonitorKind::JointOpening { joint: j },
         ("joint_slip", j) => MonitorKind::JointSlip { joint: j },
+        ("joint_contact_stress", j) => MonitorKind::JointContactStress { joint: j },
         (_, j) => MonitorKind::JointContactDepth {
             joint: j.expect("checked above"),
         },
@@ -311,4 +315,91 @@ pub(super) fn material_monitor(
         "max_plastic_strain" => MonitorKind::MaxPlasticStrain { region },
         _ => MonitorKind::CrushedPoints { region },
     })
+}
+
+/// A `stress` monitor: a component (`sx`, `sy`, `txy`, `s1`, `s2`) at the Gauss point
+/// nearest `point`, or its extreme over a region (all regions without `region`).
+fn stress_monitor(ctx: &Ctx, key: &str, m: &MonitorIn, model: &Model) -> R<MonitorKind> {
+    let component = match m.component.as_deref() {
+        Some("sx") => StressComponent::Sx,
+        Some("sy") => StressComponent::Sy,
+        Some("txy") => StressComponent::Txy,
+        Some("s1") => StressComponent::S1,
+        Some("s2") => StressComponent::S2,
+        Some(o) => {
+            return Err(ctx.err(
+                format!("{key}.component"),
+                format!("unknown stress component '{o}' (expected sx, sy, txy, s1 or s2)"),
+            ))
+        }
+        None => {
+            return Err(ctx.err(
+                format!("{key}.component"),
+                "missing (sx, sy, txy, s1 or s2)",
+            ))
+        }
+    };
+    if m.node.is_some() {
+        return Err(ctx.err(
+            format!("{key}.node"),
+            "a stress monitor reads a Gauss point: give `point` (the nearest Gauss point) or a `region`",
+        ));
+    }
+    if let Some(p) = m.point {
+        if m.region.is_some() || m.extreme.is_some() {
+            return Err(ctx.err(
+                format!("{key}.point"),
+                "give either `point` (the Gauss point nearest it) or `region`/`extreme` (the extreme over the region), not both",
+            ));
+        }
+        return Ok(MonitorKind::StressAtPoint {
+            component,
+            gauss_point: nearest_gauss_point(model, p),
+        });
+    }
+    let region = optional_region(ctx, &format!("{key}.region"), model, m.region.as_deref())?;
+    let extreme = match m.extreme.as_deref() {
+        Some("max") => Extreme::Max,
+        Some("min") => Extreme::Min,
+        Some("abs") => Extreme::Abs,
+        Some(o) => {
+            return Err(ctx.err(
+                format!("{key}.extreme"),
+                format!("unknown extreme '{o}' (expected max, min or abs)"),
+            ))
+        }
+        // The design checks: the largest tension, the most compressive value, else the
+        // largest magnitude.
+        None => match component {
+            StressComponent::S1 => Extreme::Max,
+            StressComponent::S2 => Extreme::Min,
+            _ => Extreme::Abs,
+        },
+    };
+    Ok(MonitorKind::StressExtreme {
+        component,
+        region,
+        extreme,
+    })
+}
+
+/// Index of the continuum Gauss point nearest `p` [m] (element order, then rule order: the
+/// order of the analysis' point states).
+fn nearest_gauss_point(model: &Model, p: [f64; 2]) -> usize {
+    use crate::elements::continuum::rule_points;
+    use crate::fem::shape::map_point;
+    let mut best = (f64::INFINITY, 0);
+    let mut k = 0;
+    for e in &model.elements {
+        let coords = model.element_coords(e);
+        for &(xi, eta, _) in rule_points(e.kind, e.integration) {
+            let x = map_point(&e.kind.eval(xi, eta), &coords);
+            let d = (x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2);
+            if d < best.0 {
+                best = (d, k);
+            }
+            k += 1;
+        }
+    }
+    best.1
 }

@@ -22,6 +22,15 @@ pub(super) fn build_external(
     warnings: &mut Vec<String>,
 ) -> R<Vec<Option<usize>>> {
     unique_names(ctx, "tendons", list.iter().map(|t| t.name.as_str()))?;
+    // A prestress below 1 MPa is a unit slip (MPa for Pa), as the moduli are checked.
+    for (i, t) in list.iter().enumerate() {
+        if let Some(s) = t.initial_stress.filter(|s| *s > 0.0 && *s < 1e6) {
+            warnings.push(format!(
+                "{}: tendons[{i}].initial_stress: {s} Pa looks like MPa; segfem works in Pa",
+                ctx.file
+            ));
+        }
+    }
     // External tendons go to `model.tendons`; bonded post-tensioned ones become bars (below).
     let mut external_of = vec![None; list.len()];
     for (i, t) in list.iter().enumerate() {
