@@ -115,6 +115,8 @@ fn seed_beam_behaves_as_the_seed_reports() {
 fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
     let row = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(row.mode, "tendon yield", "{}", row.end);
+    // The run finished: the arc-length step reached its stop deflection L/60.
+    assert_eq!(row.end, "deflection L/60 reached");
     assert!(
         row.tendon_stress >= 0.999 * 0.9 * 1900e6,
         "tendon {:.0} MPa ({})",
@@ -128,6 +130,56 @@ fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
         "Q_max {:.1} kN vs statics {:.1} kN",
         q / 1e3,
         q_u / 1e3
+    );
+}
+
+/// The same MC90-concrete beam refined 2× (12 rows through the depth, 6,731 equations)
+/// runs to L/60 and its tendon yields too, and its peak load is the coarse run's within 2 %
+/// (mesh objectivity): at tendon yield Q is set by the yield force T_y times the lever arm
+/// at the opened joint, d_p − a/2 ≈ 0.49 m, whose only mesh-dependent part is the depth of
+/// the compression block at the joint (a ≈ 24 mm in statics; one element row of the
+/// coarse mesh is 0.1 m, so its resolution moves the lever arm by at most ≈ 1–2 %).
+/// Release only (≈ 22 s in release on 2 idle cores; minutes unoptimised). Refined 3× the
+/// top concrete crushes at 99 % of the tendon's yield (peak −0.6 %), refined 4× the run
+/// stops at 157 kN, an open defect: docs/performance.md ("The seed beam to failure").
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release test: the 2× mesh to failure")]
+fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
+    let coarse = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let fine = segfem::bench::seed_failure_case(2, true).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!(
+        "coarse: Q_max {:.1} kN, {} increments, {} iterations, {:.1} s; 2x: Q_max {:.1} kN, {} increments, {} iterations, {:.1} s ({})",
+        coarse.q_max,
+        coarse.increments,
+        coarse.iterations,
+        coarse.total_s,
+        fine.q_max,
+        fine.increments,
+        fine.iterations,
+        fine.total_s,
+        fine.end
+    );
+    assert_eq!(fine.equations, 6731, "not the 2× mesh");
+    assert_eq!(fine.end, "deflection L/60 reached");
+    assert_eq!(fine.mode, "tendon yield", "{}", fine.end);
+    assert!(
+        fine.tendon_stress >= 0.999 * 0.9 * 1900e6,
+        "tendon {:.0} MPa",
+        fine.tendon_stress / 1e6
+    );
+    // Mesh objectivity of the peak (reason above): 2 %.
+    assert!(
+        (fine.q_max - coarse.q_max).abs() < 0.02 * coarse.q_max,
+        "Q_max {:.1} kN (2×) vs {:.1} kN (coarse)",
+        fine.q_max,
+        coarse.q_max
+    );
+    // And both against statics of the opened joint within 10 % (as the coarse test).
+    let q_u = statics_ultimate_load() / 1e3;
+    assert!(
+        (fine.q_max - q_u).abs() < 0.10 * q_u,
+        "{} vs {q_u}",
+        fine.q_max
     );
 }
 
