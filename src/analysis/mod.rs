@@ -6,6 +6,7 @@ pub mod families;
 pub mod loads;
 pub mod ordering;
 pub mod path;
+mod responses;
 pub mod solver;
 pub mod staged;
 pub mod state;
