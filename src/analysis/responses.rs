@@ -4,11 +4,11 @@
 
 use super::families::{BarOutput, BarPhase, Families};
 use crate::analysis::bonded_time::BarPointTime;
-use crate::elements::bar::{bar_green_strain, bar_strain_row};
+use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
 use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput};
 use crate::elements::{ElementResponse, Response};
 use crate::materials::point::{PointState, TimeContext, UpdateError};
-use crate::materials::steel::{update_uniaxial, SteelState};
+use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
 /// Element force entries per slot of the chunk buffers (2 per node of the largest element).
@@ -183,11 +183,12 @@ impl HostChunk<'_> {
                 k: tangent.then_some(&mut *ke),
             },
         )?;
-        // Embedded bars hosted by this element: uniaxial steel at each point,
-        // ε_b = T(φ) B u_e − ε_ref + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
-        // A locked-off, ungrouted tendon adds f += g σ_lock A w only: these are
-        // the equivalent prestressing forces (anchor, curvature and friction
-        // forces integrated by parts through the shape functions).
+        // Embedded bars hosted by this element, through the one bar-point law.
+        let kinematics = if tl {
+            BarKinematics::TotalLagrangian
+        } else {
+            BarKinematics::SmallStrain
+        };
         let bc0 = bar_offset[e] - b0;
         for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
             .iter()
@@ -195,155 +196,41 @@ impl HostChunk<'_> {
             .enumerate()
         {
             let bar = &model.bars[b];
-            let bp = &bar.points[p].point;
             // Relaxation of a tendon's steel: a stress-free strain.
             let relax = bar_time[bc0 + i]
                 .as_ref()
                 .map_or(0.0, |r| r.relax_strain_trial);
-            if tl {
-                tl_bar_point(
-                    TlBar {
-                        kind: el.kind,
-                        coords,
-                        bar,
-                        p,
-                        phase: bar_phase[b],
-                        committed: &bar_committed[bc0 + i],
-                        eps_ref: bar_eps_ref[bc0 + i],
-                        relax,
-                    },
-                    ue,
-                    fe,
-                    tangent.then_some(&mut *ke),
-                    st,
-                    out,
-                );
-                continue;
-            }
-            match bar_phase[b] {
-                BarPhase::Inactive => {
-                    *st = bar_committed[bc0 + i];
-                    *out = BarOutput::default();
-                    continue;
-                }
-                BarPhase::Locked => {
-                    let sig = bar.bonding_stress(p) - bar.steel.es * relax;
-                    *st = bar_committed[bc0 + i];
-                    *out = BarOutput {
-                        strain: sig / bar.steel.es,
-                        stress: sig,
-                        plastic_strain: 0.0,
-                    };
-                    let g = bar_strain_row(el.kind, coords, bp);
-                    let fs = sig * bar.area * bp.weight_length;
-                    for r in 0..nd {
-                        fe[r] += g[r] * fs;
-                    }
-                    continue;
-                }
-                BarPhase::Bonded => {}
-            }
-            let g = bar_strain_row(el.kind, coords, bp);
-            let eps = g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>() - bar_eps_ref[bc0 + i]
-                + bar.bonding_stress(p) / bar.steel.es
-                - relax;
-            let (s_new, sig, et) = update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
-            *st = s_new;
-            *out = BarOutput {
-                strain: eps,
-                stress: sig,
-                plastic_strain: s_new.plastic_strain,
+            let stage = match bar_phase[b] {
+                BarPhase::Inactive => BarStage::Absent,
+                BarPhase::Locked => BarStage::Locked {
+                    stress: bar.bonding_stress(p) - bar.steel.es * relax,
+                },
+                BarPhase::Bonded => BarStage::Bonded {
+                    eps_ref: bar_eps_ref[bc0 + i],
+                    prestrain: bar.bonding_stress(p) / bar.steel.es,
+                    relax,
+                },
             };
-            let fs = sig * bar.area * bp.weight_length;
-            let ks = et * bar.area * bp.weight_length;
-            for r in 0..nd {
-                fe[r] += g[r] * fs;
-                let gr = g[r] * ks;
-                if gr != 0.0 {
-                    for c in 0..nd {
-                        ke[r * nd + c] += gr * g[c];
-                    }
-                }
-            }
+            let r = bar_point_response(
+                kinematics,
+                el.kind,
+                coords,
+                &bar.points[p].point,
+                &bar.steel,
+                bar.area,
+                stage,
+                &bar_committed[bc0 + i],
+                ue,
+                fe,
+                tangent.then_some(&mut *ke),
+            );
+            *st = r.state;
+            *out = BarOutput {
+                strain: r.strain,
+                stress: r.stress,
+                plastic_strain: r.plastic_strain,
+            };
         }
         Ok(())
-    }
-}
-
-/// One embedded-bar point of a host element under the total Lagrangian kinematics.
-struct TlBar<'a> {
-    kind: crate::fem::shape::QuadKind,
-    coords: &'a [[f64; 2]],
-    bar: &'a crate::model::Bar,
-    /// Point index in the bar.
-    p: usize,
-    phase: BarPhase,
-    committed: &'a SteelState,
-    /// Green strain along the bar when it was bonded [-].
-    eps_ref: f64,
-    /// Relaxation strain of a tendon's steel (stress-free) [-].
-    relax: f64,
-}
-
-/// Add one bar point's force to `fe` [N] and, if given, its tangent to `ke` [N/m] with the
-/// total Lagrangian kinematics (see [`bar_green_strain`]): E_b = Green strain along the bar,
-/// σ_b from the steel law at E_b − ε_ref + σ_b,0/E_s, f += g σ A w,
-/// K += g E_t A w gᵀ + σ A w (d dᵀ ⊗ I₂). A locked-off, ungrouted tendon keeps its stress;
-/// its equivalent forces turn with the concrete (f += g σ_lock A w with the geometric term
-/// in K). The trial state and output go to `st` and `out`.
-fn tl_bar_point(
-    b: TlBar,
-    ue: &[f64],
-    fe: &mut [f64],
-    ke: Option<&mut [f64]>,
-    st: &mut SteelState,
-    out: &mut BarOutput,
-) {
-    let nd = ue.len();
-    let bp = &b.bar.points[b.p].point;
-    if b.phase == BarPhase::Inactive {
-        *st = *b.committed;
-        *out = BarOutput::default();
-        return;
-    }
-    let (e_b, g, d) = bar_green_strain(b.kind, b.coords, bp, ue);
-    let (sig, et) = if b.phase == BarPhase::Locked {
-        let sig = b.bar.bonding_stress(b.p) - b.bar.steel.es * b.relax;
-        *st = *b.committed;
-        *out = BarOutput {
-            strain: sig / b.bar.steel.es,
-            stress: sig,
-            plastic_strain: 0.0,
-        };
-        (sig, 0.0)
-    } else {
-        let eps = e_b - b.eps_ref + b.bar.bonding_stress(b.p) / b.bar.steel.es - b.relax;
-        let (s_new, sig, et) = update_uniaxial(&b.bar.steel, b.committed, eps);
-        *st = s_new;
-        *out = BarOutput {
-            strain: eps,
-            stress: sig,
-            plastic_strain: s_new.plastic_strain,
-        };
-        (sig, et)
-    };
-    let aw = b.bar.area * bp.weight_length;
-    let (fs, ks) = (sig * aw, et * aw);
-    for r in 0..nd {
-        fe[r] += g[r] * fs;
-    }
-    let Some(ke) = ke else {
-        return;
-    };
-    for r in 0..nd {
-        let gr = g[r] * ks;
-        let dr = d[r / 2] * fs;
-        for c in 0..nd {
-            let mut v = gr * g[c];
-            if r % 2 == c % 2 {
-                v += dr * d[c / 2];
-            }
-            ke[r * nd + c] += v;
-        }
     }
 }
