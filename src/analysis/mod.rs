@@ -4,6 +4,7 @@ pub mod bonded_time;
 pub mod failure;
 pub mod families;
 pub mod loads;
+mod newton;
 pub mod ordering;
 pub mod path;
 mod responses;

@@ -388,7 +388,7 @@ impl<'m> System<'m> {
 
     /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
     /// the rest of the increment (see [`crate::materials::point::freeze_cracks`]); the Newton
-    /// drivers call it when their iterations cycle (`path::cycling`). At most once per
+    /// drivers call it when their iterations cycle (`newton::cycling`). At most once per
     /// increment. Returns the number of points held.
     pub fn freeze_cracks(&mut self) -> usize {
         let c = &mut self.families.continuum;
