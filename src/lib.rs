@@ -7,10 +7,8 @@
 //! writers.
 
 pub mod analysis;
-pub mod bench;
 pub mod elements;
 pub mod fem;
-pub mod hugepages;
 pub mod input;
 pub mod materials;
 pub mod mesh;

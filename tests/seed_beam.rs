@@ -4,6 +4,11 @@
 //! faster once joints open) and compares deflections and the largest opening with the
 //! seed's computed values; then the run on to failure against statics of the opened joint.
 
+/// The benchmark cases of the `segfem` binary (not part of the library); this test runs one.
+#[path = "../src/cli/bench.rs"]
+#[allow(dead_code)]
+mod bench;
+
 mod common;
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
@@ -113,7 +118,7 @@ fn seed_beam_behaves_as_the_seed_reports() {
 /// joint faces).
 #[test]
 fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
-    let row = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let row = bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(row.mode, "tendon yield", "{}", row.end);
     assert!(
         row.tendon_stress >= 0.999 * 0.9 * 1900e6,
