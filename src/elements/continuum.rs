@@ -76,6 +76,22 @@ impl Formulation {
     }
 }
 
+/// The signature of [`response_at`] and the total Lagrangian response.
+type ResponseFn = fn(
+    QuadKind,
+    Integration,
+    &[[f64; 2]],
+    f64,
+    &Material,
+    &[PointState],
+    &[f64],
+    &mut [f64],
+    Option<&mut [f64]>,
+    &mut [PointState],
+    &mut [GaussOutput],
+    &TimeContext,
+) -> Result<(), UpdateError>;
+
 /// A continuum element ready to answer: formulation, node coordinates [m], thickness [m],
 /// material and the time increment of the analysis clock.
 pub struct ContinuumElement<'a> {
@@ -105,41 +121,33 @@ impl super::ElementResponse for ContinuumElement<'_> {
     ) -> Result<bool, UpdateError> {
         let (c, t, m) = (self.coords, self.thickness, self.material);
         let (f, k) = (into.f, into.k);
-        match self.formulation {
-            Formulation::SmallStrain { kind, integration } => response_at(
-                kind,
-                integration,
-                c,
-                t,
-                m,
-                committed,
-                u,
-                f,
-                k,
-                trial,
-                out,
-                self.time,
-            ),
-            Formulation::IncompatibleModes => {
-                super::incompatible::response_at(c, t, m, committed, u, f, k, trial, out, self.time)
-            }
+        // The small-strain and total Lagrangian responses take the same arguments.
+        let (kind, integration, respond): (_, _, ResponseFn) = match self.formulation {
+            Formulation::SmallStrain { kind, integration } => (kind, integration, response_at),
             Formulation::TotalLagrangian { kind, integration } => {
-                super::total_lagrangian::response_tl(
-                    kind,
-                    integration,
-                    c,
-                    t,
-                    m,
-                    committed,
-                    u,
-                    f,
-                    k,
-                    trial,
-                    out,
-                    self.time,
-                )
+                (kind, integration, super::total_lagrangian::response_tl)
             }
-        }?;
+            Formulation::IncompatibleModes => {
+                super::incompatible::response_at(
+                    c, t, m, committed, u, f, k, trial, out, self.time,
+                )?;
+                return Ok(true);
+            }
+        };
+        respond(
+            kind,
+            integration,
+            c,
+            t,
+            m,
+            committed,
+            u,
+            f,
+            k,
+            trial,
+            out,
+            self.time,
+        )?;
         Ok(true)
     }
 }
