@@ -6,6 +6,8 @@
 //! Data flows one way: input → validated [`model`] → mesh and dofs → analysis → results →
 //! writers.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod elements;
 pub mod fem;
