@@ -6,11 +6,11 @@
 //! Data flows one way: input → validated [`model`] → mesh and dofs → analysis → results →
 //! writers.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
-pub mod bench;
 pub mod elements;
 pub mod fem;
-pub mod hugepages;
 pub mod input;
 pub mod materials;
 pub mod mesh;

@@ -2,7 +2,6 @@
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use segfem::fem::shape::QuadKind;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -42,9 +41,20 @@ fn stdout_failed(e: std::io::Error) -> ! {
     std::process::exit(1);
 }
 
-/// Large blocks on transparent huge pages (segfem::hugepages: fewer page faults).
+/// Large blocks on transparent huge pages (cli::hugepages: fewer page faults).
+/// Binary-side modules: the benchmark cases and the allocator (not part of the library).
+mod cli {
+    pub mod bench;
+    pub mod bench_cmd;
+    pub mod hugepages;
+}
+use cli::bench_cmd::{
+    bench, bench_bare, bench_beams, bench_material_point, bench_panels, bench_rc, bench_seed,
+    bench_seed_failure,
+};
+
 #[global_allocator]
-static ALLOC: segfem::hugepages::HugePageAlloc = segfem::hugepages::HugePageAlloc;
+static ALLOC: cli::hugepages::HugePageAlloc = cli::hugepages::HugePageAlloc;
 
 /// Bundled examples: (name, description, model file text).
 const EXAMPLES: &[(&str, &str, &str)] = &[
@@ -315,8 +325,8 @@ fn main() -> ExitCode {
                 bench_bare(model.as_deref().expect("checked"))
             }
             "linear" => bench(dofs, element),
-            "seed" => bench_seed(refine, segfem::bench::seed_case),
-            "long_term" => bench_seed(refine, segfem::bench::seed_long_term_case),
+            "seed" => bench_seed(refine, cli::bench::seed_case),
+            "long_term" => bench_seed(refine, cli::bench::seed_long_term_case),
             "seed-failure" => bench_seed_failure(refine, false),
             "rc" => bench_rc(refine),
             "material-point" => bench_material_point(),
@@ -638,224 +648,4 @@ fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
             ExitCode::SUCCESS
         }
     }
-}
-
-fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
-    outln!(
-        "{:>4} {:>9} {:>7} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>12}",
-        "elem",
-        "dofs",
-        "mesh s",
-        "setup s",
-        "assemb s",
-        "order s",
-        "factor s",
-        "solve s",
-        "total s",
-        "peak MiB",
-        "tip uy [m]"
-    );
-    for e in &element {
-        let kind = match e.as_str() {
-            "Q4" => QuadKind::Q4,
-            "Q8" => QuadKind::Q8,
-            "Q9" => QuadKind::Q9,
-            o => {
-                eprintln!("error: --element: unknown element '{o}' (Q4, Q8, Q9)");
-                return ExitCode::from(2);
-            }
-        };
-        for &n in &dofs {
-            match segfem::bench::run_case(kind, n as usize) {
-                Ok(r) => outln!(
-                    "{:>4} {:>9} {:>7.3} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>7.3} {:>8.3} {:>9.0} {:>12.5e}",
-                    r.kind, r.dofs, r.mesh_s, r.setup_s, r.assembly_s, r.ordering_s, r.factor_s, r.solve_s, r.total_s,
-                    r.peak_bytes as f64 / 1048576.0, r.tip_uy
-                ),
-                Err(err) => {
-                    eprintln!("error: {err}");
-                    return ExitCode::from(3);
-                }
-            }
-        }
-    }
-    ExitCode::SUCCESS
-}
-
-fn bench_bare(path: &std::path::Path) -> ExitCode {
-    match segfem::bench::bare_factorisation(path) {
-        Ok(r) => {
-            outln!("{}", serde_json::to_string(&r).expect("row serialises"));
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
-}
-
-fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
-    outln!(
-        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
-        "case",
-        "equations",
-        "incs",
-        "iters",
-        "total s",
-        "Q max",
-        "uy [m]",
-        "σp [MPa]",
-        "open [mm]",
-        "crushed"
-    );
-    for r in refine {
-        match segfem::bench::seed_failure_case(r, concrete) {
-            Ok(x) => {
-                outln!(
-                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
-                    x.case,
-                    x.equations,
-                    x.increments,
-                    x.iterations,
-                    x.total_s,
-                    x.q_max,
-                    x.deflection,
-                    x.tendon_stress / 1e6,
-                    x.max_opening * 1e3,
-                    x.crushed,
-                    x.mode,
-                    x.end
-                );
-                let (t, s) = (&x.timings, &x.timings.solver);
-                outln!(
-                    "{:>28} assembly {:.3} s, {} factorisations ({} LDLT) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
-                    "",
-                    t.assembly_s,
-                    s.factorisations,
-                    s.ldlt_factorisations,
-                    s.numeric_s,
-                    1e3 * s.numeric_s / s.factorisations.max(1) as f64,
-                    s.factor_nnz,
-                    s.solve_s
-                );
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(3);
-            }
-        }
-    }
-    ExitCode::SUCCESS
-}
-
-/// Print one row per refinement factor of a seed-beam benchmark `case`.
-fn bench_rc(refine: Vec<usize>) -> ExitCode {
-    outln!(
-        "{:>18} {:>9} {:>5} {:>6} {:>8} {:>9} {:>9}  end",
-        "case",
-        "equations",
-        "incs",
-        "iters",
-        "total s",
-        "P max kN",
-        "w [mm]"
-    );
-    for r in refine {
-        match segfem::bench::rc_case(r) {
-            Ok(x) => outln!(
-                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>9.1} {:>9.2}  {}",
-                x.case,
-                x.equations,
-                x.increments,
-                x.iterations,
-                x.total_s,
-                x.p_max / 1e3,
-                x.deflection * 1e3,
-                x.end
-            ),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(3);
-            }
-        }
-    }
-    ExitCode::SUCCESS
-}
-
-fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
-    let path = file.unwrap_or(std::path::Path::new("validation/panels/panels.csv"));
-    match segfem::materials::concrete::panel_bench::series(path) {
-        Ok((report, secs)) => {
-            outln!("{report}");
-            outln!("total time of the series: {secs:.1} s");
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn bench_beams(file: Option<&std::path::Path>) -> ExitCode {
-    let path = file.unwrap_or(std::path::Path::new("validation/beams/beams.csv"));
-    match segfem::materials::concrete::beam_bench::series(path) {
-        Ok((report, secs)) => {
-            outln!("{report}");
-            outln!("total time of the series: {secs:.1} s");
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn bench_material_point() -> ExitCode {
-    outln!("{:>26} {:>14}", "concrete point", "updates/s");
-    for (label, rate) in segfem::bench::material_point_rates(2_000_000) {
-        outln!("{label:>26} {rate:>14.3e}");
-    }
-    ExitCode::SUCCESS
-}
-
-fn bench_seed(
-    refine: Vec<usize>,
-    case: fn(usize) -> Result<segfem::bench::NonlinearRow, String>,
-) -> ExitCode {
-    outln!(
-        "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10} {:>9} {:>8} {:>13}",
-        "case",
-        "equations",
-        "incs",
-        "iters",
-        "factors",
-        "factor ms",
-        "assemb s",
-        "total s",
-        "midspan uy [m]"
-    );
-    for r in refine {
-        match case(r) {
-            Ok(x) => outln!(
-                "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10.2} {:>9.3} {:>8.3} {:>13.5e}",
-                x.case,
-                x.equations,
-                x.increments,
-                x.iterations,
-                x.factorisations,
-                x.factor_mean_s * 1e3,
-                x.assembly_s,
-                x.total_s,
-                x.result
-            ),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(3);
-            }
-        }
-    }
-    ExitCode::SUCCESS
 }

@@ -4,6 +4,11 @@
 //! faster once joints open) and compares deflections and the largest opening with the
 //! seed's computed values; then the run on to failure against statics of the opened joint.
 
+/// The benchmark cases of the `segfem` binary (not part of the library); this test runs one.
+#[path = "../src/cli/bench.rs"]
+#[allow(dead_code)]
+mod bench;
+
 mod common;
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
@@ -113,7 +118,7 @@ fn seed_beam_behaves_as_the_seed_reports() {
 /// joint faces).
 #[test]
 fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
-    let row = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let row = bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(row.mode, "tendon yield", "{}", row.end);
     // The run finished: the arc-length step reached its stop deflection L/60.
     assert_eq!(row.end, "deflection L/60 reached");
@@ -145,8 +150,8 @@ fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release test: the 2× mesh to failure")]
 fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
-    let coarse = segfem::bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
-    let fine = segfem::bench::seed_failure_case(2, true).unwrap_or_else(|e| panic!("{e}"));
+    let coarse = bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let fine = bench::seed_failure_case(2, true).unwrap_or_else(|e| panic!("{e}"));
     eprintln!(
         "coarse: Q_max {:.1} kN, {} increments, {} iterations, {:.1} s; 2x: Q_max {:.1} kN, {} increments, {} iterations, {:.1} s ({})",
         coarse.q_max,

@@ -7,6 +7,7 @@
 use super::solver::SolverError;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
+use crate::materials::point::UpdateError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -26,6 +27,16 @@ pub(crate) enum NewtonFailure {
 }
 
 impl NewtonFailure {
+    /// A failed material update at element `e` (0-based): a step cut when it did not
+    /// converge; a broken internal contract stops the program as the bug it is (cutting the
+    /// step would only hide it).
+    pub(crate) fn material((e, err): (usize, UpdateError)) -> Self {
+        match err {
+            UpdateError::NotConverged(_) => NewtonFailure::Material(e, err.to_string()),
+            UpdateError::Internal(_) => panic!("element {}: {err}", e + 1),
+        }
+    }
+
     /// A divergence with its residual history and last residual.
     pub(crate) fn diverged(history: Vec<f64>, residual: Vec<f64>) -> Self {
         NewtonFailure::Diverged { history, residual }
@@ -112,7 +123,7 @@ pub(crate) fn report(sys: &System, at: FailedAt, failure: &NewtonFailure) -> Fai
     let (cause, reason, history, worst, mut elements) = match failure {
         NewtonFailure::Singular(e) => (
             "singular",
-            super::steps::mechanism(sys, e.clone()).to_string(),
+            mechanism_message(sys, e.clone()),
             Vec::new(),
             Vec::new(),
             Vec::new(),
@@ -355,4 +366,33 @@ pub(crate) fn census(sys: &System, residual: &[f64]) -> String {
         "{cracked} newly cracked, {crushed} newly crushed, {plastic} flowing, {} latched{worst}",
         sys.families.continuum.holds.latched.len()
     )
+}
+
+/// A solver failure as a message naming the node and dof (a mechanism or a lost stiffness).
+pub(crate) fn mechanism_message(sys: &System, e: SolverError) -> String {
+    match e {
+        SolverError::NotPositiveDefinite { equation } => {
+            let dof = sys.dofs.eq.iter().position(|&q| q == equation).unwrap_or(0);
+            let node = dof / 2;
+            let dir = if dof % 2 == 0 { "x" } else { "y" };
+            let regions: Vec<&str> = sys
+                .model
+                .elements
+                .iter()
+                .filter(|el| el.nodes.contains(&node))
+                .map(|el| sys.model.regions[el.region].name.as_str())
+                .collect();
+            let [x, y] = sys.model.nodes[node];
+            format!(
+                "the structure is a mechanism or has lost stiffness: zero pivot at node {} ({x}, {y}), dof u{dir}, region(s) {:?} — check supports and connections",
+                node + 1,
+                regions
+            )
+        }
+        SolverError::Internal(m) => m,
+        SolverError::Singular => {
+            "the tangent stiffness is singular (zero pivot): a mechanism, or exactly at a limit point"
+                .into()
+        }
+    }
 }

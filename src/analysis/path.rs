@@ -4,10 +4,10 @@
 //! reports the number of negative pivots.
 
 use super::failure::{report, FailedAt};
+use super::newton::{cycling, damping, norm};
 use super::solver::SparseCholesky;
 use super::steps::{
-    check_stop, newton, norm, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot,
-    Timings,
+    check_stop, newton, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot, Timings,
 };
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
@@ -52,7 +52,7 @@ impl PathContext<'_, '_> {
         let a = self
             .sys
             .assemble(u, true)
-            .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+            .map_err(NewtonFailure::material)?;
         self.sys.latch_cracks();
         self.timings.assembly_s += t.elapsed().as_secs_f64();
         Ok((
@@ -460,7 +460,7 @@ fn line_search(
         let a = ctx
             .sys
             .assemble(&ut, false)
-            .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+            .map_err(NewtonFailure::material)?;
         let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
         let mut rf = ctx.sys.to_free(&r);
         for k in ctl {
@@ -857,25 +857,4 @@ fn arc_residual(
             .max(scale)
             .max(f64::MIN_POSITIVE);
     Ok(Residual { f_int, k, rf, rel })
-}
-
-/// Newton cycles: six iterations made and the relative residual not halved over the last
-/// three (crack points alternating between loading and unloading); the drivers then hold the
-/// crack branches for the rest of the increment.
-pub(super) fn cycling(history: &[f64]) -> bool {
-    let n = history.len();
-    n >= 7 && history[n - 1] >= 0.5 * history[n - 4]
-}
-
-/// Correction scale from the residual history: 1, or ½, ¼, … (at least 1/16) while the
-/// relative residual has not fallen by 10 % over the last two iterations.
-pub(super) fn damping(history: &[f64]) -> f64 {
-    let n = history.len();
-    let mut k = 0;
-    let mut i = n;
-    while i >= 3 && history[i - 1] >= 0.9 * history[i - 3] && k < 4 {
-        k += 1;
-        i -= 1;
-    }
-    0.5_f64.powi(k)
 }

@@ -4,6 +4,7 @@
 pub(crate) use super::failure::NewtonFailure;
 use super::failure::{report, FailedAt, FailureReport};
 use super::loads::load_vector;
+use super::newton::{cycling, damping, norm};
 use super::solver::{SolverError, SolverStats, SparseCholesky};
 use super::state::{DriverState, SystemState};
 use super::system::System;
@@ -537,7 +538,7 @@ pub(super) fn newton(
             return Err(NewtonFailure::diverged(history, rf));
         }
         history.push(rel);
-        if super::path::cycling(&history) {
+        if cycling(&history) {
             sys.freeze_cracks();
         }
         if c.verbose {
@@ -572,8 +573,8 @@ pub(super) fn newton(
         let mut du = rf;
         solver.solve_in_place(&mut du);
         // Damped correction while the residual stagnates (cycling across a kink of the
-        // material response); see `path::damping`.
-        let damp = super::path::damping(&history);
+        // material response); see `newton::damping`.
+        let damp = damping(&history);
         if damp < 1.0 {
             du.iter_mut().for_each(|v| *v *= damp);
         }
@@ -612,9 +613,7 @@ fn residual_at(
     timings: &mut Timings,
 ) -> Result<Evaluated, NewtonFailure> {
     let t = Instant::now();
-    let a = sys
-        .assemble(u, need_k)
-        .map_err(|(e, err)| NewtonFailure::Material(e, err.to_string()))?;
+    let a = sys.assemble(u, need_k).map_err(NewtonFailure::material)?;
     sys.latch_cracks();
     timings.assembly_s += t.elapsed().as_secs_f64();
     let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
@@ -624,35 +623,7 @@ fn residual_at(
     Ok((a, r, rf, rel))
 }
 
-pub(super) fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-/// Turn a solver failure into a message naming the node and dof.
+/// A solver failure as the analysis error it is (see [`super::failure::mechanism_message`]).
 pub(super) fn mechanism(sys: &System, e: SolverError) -> AnalysisError {
-    match e {
-        SolverError::NotPositiveDefinite { equation } => {
-            let dof = sys.dofs.eq.iter().position(|&q| q == equation).unwrap_or(0);
-            let node = dof / 2;
-            let dir = if dof % 2 == 0 { "x" } else { "y" };
-            let regions: Vec<&str> = sys
-                .model
-                .elements
-                .iter()
-                .filter(|el| el.nodes.contains(&node))
-                .map(|el| sys.model.regions[el.region].name.as_str())
-                .collect();
-            let [x, y] = sys.model.nodes[node];
-            AnalysisError::Mechanism(format!(
-                "the structure is a mechanism or has lost stiffness: zero pivot at node {} ({x}, {y}), dof u{dir}, region(s) {:?} — check supports and connections",
-                node + 1,
-                regions
-            ))
-        }
-        SolverError::Internal(m) => AnalysisError::Mechanism(m),
-        SolverError::Singular => AnalysisError::Mechanism(
-            "the tangent stiffness is singular (zero pivot): a mechanism, or exactly at a limit point"
-                .into(),
-        ),
-    }
+    AnalysisError::Mechanism(super::failure::mechanism_message(sys, e))
 }

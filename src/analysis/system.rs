@@ -3,17 +3,18 @@
 
 use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
-use crate::elements::interface::{InterfaceElement, InterfacePointState};
+use crate::elements::interface::{InterfaceElement, InterfacePointState, Joint};
 use crate::elements::tendon::{ExternalTendon, TendonLaw};
-use crate::elements::total_lagrangian;
+use crate::elements::{ElementResponse, Response};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext, UpdateError};
-use crate::materials::steel::{update_uniaxial, SteelState};
+use crate::materials::point::{crack_base, plastic_base, TimeContext, UpdateError};
+use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
 use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBlock};
 pub use super::families::{BarOutput, BarPhase};
+use super::responses;
 use super::staged::Staged;
 use crate::fem::numbering::{ElementNumbers, Family};
 use rayon::prelude::*;
@@ -68,84 +69,6 @@ pub struct System<'m> {
     elem_buf: (Vec<f64>, Vec<f64>),
 }
 
-/// One embedded-bar point of a host element under the total Lagrangian kinematics.
-struct TlBar<'a> {
-    kind: crate::fem::shape::QuadKind,
-    coords: &'a [[f64; 2]],
-    bar: &'a crate::model::Bar,
-    /// Point index in the bar.
-    p: usize,
-    phase: BarPhase,
-    committed: &'a SteelState,
-    /// Green strain along the bar when it was bonded [-].
-    eps_ref: f64,
-    /// Relaxation strain of a tendon's steel (stress-free) [-].
-    relax: f64,
-}
-
-/// Add one bar point's force to `fe` [N] and, if given, its tangent to `ke` [N/m] with the
-/// total Lagrangian kinematics (see [`bar_green_strain`]): E_b = Green strain along the bar,
-/// σ_b from the steel law at E_b − ε_ref + σ_b,0/E_s, f += g σ A w,
-/// K += g E_t A w gᵀ + σ A w (d dᵀ ⊗ I₂). A locked-off, ungrouted tendon keeps its stress;
-/// its equivalent forces turn with the concrete (f += g σ_lock A w with the geometric term
-/// in K). The trial state and output go to `st` and `out`.
-fn tl_bar_point(
-    b: TlBar,
-    ue: &[f64],
-    fe: &mut [f64],
-    ke: Option<&mut [f64]>,
-    st: &mut SteelState,
-    out: &mut BarOutput,
-) {
-    let nd = ue.len();
-    let bp = &b.bar.points[b.p].point;
-    if b.phase == BarPhase::Inactive {
-        *st = *b.committed;
-        *out = BarOutput::default();
-        return;
-    }
-    let (e_b, g, d) = bar_green_strain(b.kind, b.coords, bp, ue);
-    let (sig, et) = if b.phase == BarPhase::Locked {
-        let sig = b.bar.bonding_stress(b.p) - b.bar.steel.es * b.relax;
-        *st = *b.committed;
-        *out = BarOutput {
-            strain: sig / b.bar.steel.es,
-            stress: sig,
-            plastic_strain: 0.0,
-        };
-        (sig, 0.0)
-    } else {
-        let eps = e_b - b.eps_ref + b.bar.bonding_stress(b.p) / b.bar.steel.es - b.relax;
-        let (s_new, sig, et) = update_uniaxial(&b.bar.steel, b.committed, eps);
-        *st = s_new;
-        *out = BarOutput {
-            strain: eps,
-            stress: sig,
-            plastic_strain: s_new.plastic_strain,
-        };
-        (sig, et)
-    };
-    let aw = b.bar.area * bp.weight_length;
-    let (fs, ks) = (sig * aw, et * aw);
-    for r in 0..nd {
-        fe[r] += g[r] * fs;
-    }
-    let Some(ke) = ke else {
-        return;
-    };
-    for r in 0..nd {
-        let gr = g[r] * ks;
-        let dr = d[r / 2] * fs;
-        for c in 0..nd {
-            let mut v = gr * g[c];
-            if r % 2 == c % 2 {
-                v += dr * d[c / 2];
-            }
-            ke[r * nd + c] += v;
-        }
-    }
-}
-
 /// Replace a square row-major matrix of order n by its symmetric part.
 fn symmetrise(k: &mut [f64], n: usize) {
     for i in 0..n {
@@ -157,9 +80,115 @@ fn symmetrise(k: &mut [f64], n: usize) {
     }
 }
 
-/// Success of one element's update (its force and tangent are in the chunk buffers), or the
-/// failing element and why.
-type ElementResult = Result<(), (usize, UpdateError)>;
+/// One element's outcome: `None` when it is absent (a tendon not yet stressed), else whether
+/// its tangent is symmetric; or why a material point failed.
+type Outcome = Result<Option<bool>, UpdateError>;
+
+/// Every `CHUNK` pieces with the index of the first.
+fn chunks<P>(pieces: Vec<P>) -> Vec<(usize, Vec<P>)> {
+    let mut out = Vec::new();
+    let mut it = pieces.into_iter().peekable();
+    let mut start = 0;
+    while it.peek().is_some() {
+        let c: Vec<P> = it.by_ref().take(CHUNK).collect();
+        let n = c.len();
+        out.push((start, c));
+        start += n;
+    }
+    out
+}
+
+/// Dofs of the largest of elements with these node counts.
+fn max_dofs(nodes: impl Iterator<Item = usize>) -> usize {
+    2 * nodes.max().unwrap_or(0)
+}
+
+/// The response buffers of an element of `nd` dofs in its slot.
+fn slot<'a>(fe: &'a mut [f64], ke: &'a mut [f64], nd: usize, tangent: bool) -> Response<'a> {
+    Response {
+        f: &mut fe[..nd],
+        k: tangent.then_some(&mut ke[..nd * nd]),
+    }
+}
+
+/// Compute the responses of one chunk of elements in parallel, element i into slot i of
+/// `buf` (`nd` force and `nd²` tangent entries); the outcomes in element order.
+fn compute_chunk<P: Send>(
+    pieces: Vec<P>,
+    nd: usize,
+    buf: &mut (Vec<f64>, Vec<f64>),
+    compute: impl Fn(P, &mut [f64], &mut [f64]) -> Outcome + Sync + Send,
+) -> Vec<Outcome> {
+    let n = pieces.len().max(1);
+    // Grown, never shrunk: a run of many small assemblies must not zero or reallocate them
+    // each time (every element writes its own slot before use).
+    if buf.0.len() < n * nd {
+        buf.0.resize(n * nd, 0.0);
+    }
+    if buf.1.len() < n * nd * nd {
+        buf.1.resize(n * nd * nd, 0.0);
+    }
+    if nd == 0 {
+        return Vec::new();
+    }
+    pieces
+        .into_par_iter()
+        .zip(buf.0.par_chunks_mut(nd))
+        .zip(buf.1.par_chunks_mut(nd * nd))
+        .map(|((p, fe), ke)| compute(p, fe, ke))
+        .collect()
+}
+
+/// The global forces, force scale and tangent the element responses are scattered into.
+struct Scatter<'a> {
+    asm: &'a Assembler,
+    f_int: Vec<f64>,
+    f_abs: Vec<f64>,
+    k_values: Option<Vec<f64>>,
+    symmetrised: bool,
+}
+
+impl Scatter<'_> {
+    /// Add the responses of a chunk (elements `start..`, slots of `nd` dofs in `buf`) in
+    /// element order; `of(i)` gives element i's nodes and assembler number. Stops at the
+    /// first failed element.
+    fn add_chunk<'n>(
+        &mut self,
+        results: Vec<Outcome>,
+        start: usize,
+        nd_slot: usize,
+        buf: &mut (Vec<f64>, Vec<f64>),
+        of: impl Fn(usize) -> (&'n [usize], usize),
+    ) -> Result<(), (usize, UpdateError)> {
+        for (i, r) in results.into_iter().enumerate() {
+            let e = start + i;
+            let Some(symmetric) = r.map_err(|err| (e, err))? else {
+                continue;
+            };
+            let (nodes, number) = of(e);
+            let nd = 2 * nodes.len();
+            let fe = &buf.0[i * nd_slot..i * nd_slot + nd];
+            for (a, &n) in nodes.iter().enumerate() {
+                self.f_int[2 * n] += fe[2 * a];
+                self.f_int[2 * n + 1] += fe[2 * a + 1];
+                self.f_abs[2 * n] += fe[2 * a].abs();
+                self.f_abs[2 * n + 1] += fe[2 * a + 1].abs();
+            }
+            if let Some(k) = self.k_values.as_mut() {
+                let s = i * nd_slot * nd_slot;
+                let ke = &mut buf.1[s..s + nd * nd];
+                if !symmetric {
+                    // Slip makes the tangent unsymmetric; the Cholesky path takes its
+                    // symmetric part (more iterations, same converged answer).
+                    symmetrise(ke, nd);
+                    self.symmetrised = true;
+                }
+                self.asm.add_matrix(number, ke, k);
+            }
+        }
+        Ok(())
+    }
+}
 
 /// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
 pub struct Assembled {
@@ -359,7 +388,7 @@ impl<'m> System<'m> {
 
     /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
     /// the rest of the increment (see [`crate::materials::point::freeze_cracks`]); the Newton
-    /// drivers call it when their iterations cycle (`path::cycling`). At most once per
+    /// drivers call it when their iterations cycle (`newton::cycling`). At most once per
     /// increment. Returns the number of points held.
     pub fn freeze_cracks(&mut self) -> usize {
         let c = &mut self.families.continuum;
@@ -389,320 +418,109 @@ impl<'m> System<'m> {
     }
 
     /// Internal forces and (optionally) tangent at displacements `u` from the committed
-    /// states; trial states and Gauss outputs are stored in `self.trial` / `self.gauss_trial`.
-    /// Element work runs in parallel; the scatter is sequential in element order, so results
-    /// are bit-identical whatever the thread count.
+    /// states; trial states and Gauss outputs go to the trial side of the family blocks.
+    /// Element work runs in parallel chunks, each element into its own slot of the chunk
+    /// buffers; the scatter is sequential in element order (continuum elements, joints,
+    /// tendons), so results are bit-identical whatever the thread count. The error names
+    /// the continuum element whose material point failed.
     pub fn assemble(
         &mut self,
         u: &[f64],
         tangent: bool,
     ) -> Result<Assembled, (usize, UpdateError)> {
         let model = self.model;
-        let mut f_int = vec![0.0; u.len()];
-        let mut f_abs = vec![0.0; u.len()];
-        let mut k_values = tangent.then(|| vec![0.0; self.asm.pattern.nnz()]);
-        let n_el = model.elements.len();
+        let mut sc = Scatter {
+            asm: &self.asm,
+            f_int: vec![0.0; u.len()],
+            f_abs: vec![0.0; u.len()],
+            k_values: tangent.then(|| vec![0.0; self.asm.pattern.nnz()]),
+            symmetrised: false,
+        };
+        let numbers = &self.numbers;
+        let mut buf = std::mem::take(&mut self.elem_buf);
         let time = self.time;
-        // Total Lagrangian continuum and bars (a separate code path: the linear one is
-        // untouched).
-        let tl = model.geometry == Geometry::Nonlinear;
+        // Continuum elements with the bars they host.
+        let n_el = model.elements.len();
         let mut start = 0;
-        // Element vectors and matrices of one chunk, allocated once per assembly (the
-        // element loop itself does not allocate).
-        const ND: usize = 2 * crate::fem::shape::MAX_NODES;
-        // Sized for the elements there are: a small model must not zero a 10 MB buffer on
-        // every iteration (that was a quarter of a small contact run).
-        let chunk = CHUNK.min(n_el).max(1);
-        let (mut fbuf, mut kbuf) = std::mem::take(&mut self.elem_buf);
-        fbuf.resize(chunk * ND, 0.0);
-        kbuf.resize(chunk * ND * ND, 0.0);
-        // Split the state arrays per element once per chunk so that chunks can be filled in
-        // parallel without aliasing.
         while start < n_el {
             let end = (start + CHUNK).min(n_el);
-            let g0 = self.gp_offset[start];
-            let g1 = self.gp_offset[end];
-            let (cont, bars) = (&mut self.families.continuum, &mut self.families.bars);
-            let trial = &mut cont.points.trial[g0..g1];
-            let gout = &mut cont.gauss.trial[g0..g1];
-            let committed = &cont.points.committed[g0..g1];
-            let gp_offset = &self.gp_offset;
-            let (b0, b1) = (self.bar_offset[start], self.bar_offset[end]);
-            let bar_committed = &bars.steel.committed[b0..b1];
-            let bar_gps = &self.bar_gps;
-            let bar_phase = &bars.phase;
-            let bar_eps_ref = &bars.eps_ref[b0..b1];
-            let bar_time = &bars.time[b0..b1];
-            let latched = &cont.holds.latched;
-            let bar_offset = &self.bar_offset;
-            let (mut bt_rest, mut bo_rest) =
-                (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
-            // Per-element slices.
-            let mut pieces = Vec::with_capacity(end - start);
-            let (mut t_rest, mut o_rest) = (trial, gout);
-            for e in start..end {
-                let ngp = gp_offset[e + 1] - gp_offset[e];
-                let (t, tr) = t_rest.split_at_mut(ngp);
-                let (o, or) = o_rest.split_at_mut(ngp);
-                t_rest = tr;
-                o_rest = or;
-                let nb = bar_offset[e + 1] - bar_offset[e];
-                let (bt, btr) = bt_rest.split_at_mut(nb);
-                let (bo, bor) = bo_rest.split_at_mut(nb);
-                bt_rest = btr;
-                bo_rest = bor;
-                pieces.push((e, t, o, (bt, bo)));
-            }
-            let results: Vec<ElementResult> = pieces
-                .into_par_iter()
-                .zip(fbuf.par_chunks_mut(ND))
-                .zip(kbuf.par_chunks_mut(ND * ND))
-                .map(|(((e, t, o, (bt, bo)), fe), ke)| {
-                    let el = &model.elements[e];
-                    let region = &model.regions[el.region];
-                    let mat = &model.materials[region.material].law;
-                    let nn = el.nodes.len();
-                    let nd = 2 * nn;
-                    let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
-                    let mut ue = [0.0; ND];
-                    for (a, &n) in el.nodes.iter().enumerate() {
-                        coords[a] = model.nodes[n];
-                        ue[2 * a] = u[2 * n];
-                        ue[2 * a + 1] = u[2 * n + 1];
-                    }
-                    let (coords, ue) = (&coords[..nn], &ue[..nd]);
-                    let (fe, ke) = (&mut fe[..nd], &mut ke[..nd * nd]);
-                    let c0 = gp_offset[e] - g0;
-                    // Start from the latched crack states where a crack formed in this
-                    // increment, from the committed states elsewhere.
-                    let base = &committed[c0..c0 + t.len()];
-                    let first = latched.partition_point(|x| x.0 < gp_offset[e]);
-                    let owned: Option<Vec<PointState>> = latched
-                        .get(first)
-                        .filter(|x| x.0 < gp_offset[e + 1])
-                        .map(|_| {
-                            let mut v = base.to_vec();
-                            for (g, st) in latched[first..]
-                                .iter()
-                                .take_while(|x| x.0 < gp_offset[e + 1])
-                            {
-                                v[g - gp_offset[e]] = st.clone();
-                            }
-                            v
-                        });
-                    let states = owned.as_deref().unwrap_or(base);
-                    if tl {
-                        total_lagrangian::response_tl(
-                            el.kind,
-                            el.integration,
-                            coords,
-                            region.thickness,
-                            mat,
-                            states,
-                            ue,
-                            fe,
-                            tangent.then_some(&mut *ke),
-                            t,
-                            o,
-                            &time,
-                        )
-                    } else {
-                        continuum::response_at(
-                            el.kind,
-                            el.integration,
-                            coords,
-                            region.thickness,
-                            mat,
-                            states,
-                            ue,
-                            fe,
-                            tangent.then_some(&mut *ke),
-                            t,
-                            o,
-                            &time,
-                        )
-                    }
-                    .map_err(|err| (e, err))?;
-                    // Embedded bars hosted by this element: uniaxial steel at each point,
-                    // ε_b = T(φ) B u_e − ε_ref + σ_b,0/E_s; f += g σ A w, K += g E_t A w gᵀ.
-                    // A locked-off, ungrouted tendon adds f += g σ_lock A w only: these are
-                    // the equivalent prestressing forces (anchor, curvature and friction
-                    // forces integrated by parts through the shape functions).
-                    let bc0 = bar_offset[e] - b0;
-                    for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
-                        .iter()
-                        .zip(bt.iter_mut().zip(bo.iter_mut()))
-                        .enumerate()
-                    {
-                        let bar = &model.bars[b];
-                        let bp = &bar.points[p].point;
-                        // Relaxation of a tendon's steel: a stress-free strain.
-                        let relax = bar_time[bc0 + i]
-                            .as_ref()
-                            .map_or(0.0, |r| r.relax_strain_trial);
-                        if tl {
-                            tl_bar_point(
-                                TlBar {
-                                    kind: el.kind,
-                                    coords,
-                                    bar,
-                                    p,
-                                    phase: bar_phase[b],
-                                    committed: &bar_committed[bc0 + i],
-                                    eps_ref: bar_eps_ref[bc0 + i],
-                                    relax,
-                                },
-                                ue,
-                                fe,
-                                tangent.then_some(&mut *ke),
-                                st,
-                                out,
-                            );
-                            continue;
-                        }
-                        match bar_phase[b] {
-                            BarPhase::Inactive => {
-                                *st = bar_committed[bc0 + i];
-                                *out = BarOutput::default();
-                                continue;
-                            }
-                            BarPhase::Locked => {
-                                let sig = bar.bonding_stress(p) - bar.steel.es * relax;
-                                *st = bar_committed[bc0 + i];
-                                *out = BarOutput {
-                                    strain: sig / bar.steel.es,
-                                    stress: sig,
-                                    plastic_strain: 0.0,
-                                };
-                                let g = bar_strain_row(el.kind, coords, bp);
-                                let fs = sig * bar.area * bp.weight_length;
-                                for r in 0..nd {
-                                    fe[r] += g[r] * fs;
-                                }
-                                continue;
-                            }
-                            BarPhase::Bonded => {}
-                        }
-                        let g = bar_strain_row(el.kind, coords, bp);
-                        let eps = g.iter().zip(ue).map(|(a, b)| a * b).sum::<f64>()
-                            - bar_eps_ref[bc0 + i]
-                            + bar.bonding_stress(p) / bar.steel.es
-                            - relax;
-                        let (s_new, sig, et) =
-                            update_uniaxial(&bar.steel, &bar_committed[bc0 + i], eps);
-                        *st = s_new;
-                        *out = BarOutput {
-                            strain: eps,
-                            stress: sig,
-                            plastic_strain: s_new.plastic_strain,
-                        };
-                        let fs = sig * bar.area * bp.weight_length;
-                        let ks = et * bar.area * bp.weight_length;
-                        for r in 0..nd {
-                            fe[r] += g[r] * fs;
-                            let gr = g[r] * ks;
-                            if gr != 0.0 {
-                                for c in 0..nd {
-                                    ke[r * nd + c] += gr * g[c];
-                                }
-                            }
-                        }
-                    }
-                    Ok(())
-                })
-                .collect();
-            for (i, r) in results.into_iter().enumerate() {
-                let e = start + i;
-                r?;
-                let nd = 2 * model.elements[e].nodes.len();
-                let fe = &fbuf[i * ND..i * ND + nd];
-                let ke = &kbuf[i * ND * ND..i * ND * ND + nd * nd];
-                for (a, &n) in model.elements[e].nodes.iter().enumerate() {
-                    f_int[2 * n] += fe[2 * a];
-                    f_int[2 * n + 1] += fe[2 * a + 1];
-                    f_abs[2 * n] += fe[2 * a].abs();
-                    f_abs[2 * n + 1] += fe[2 * a + 1].abs();
-                }
-                if let Some(k) = k_values.as_mut() {
-                    self.asm
-                        .add_matrix(self.numbers.number(Family::Continuum, e), ke, k);
-                }
-            }
+            let (chunk, pieces) = responses::split_chunk(
+                model,
+                &mut self.families,
+                &self.gp_offset,
+                &self.bar_gps,
+                &self.bar_offset,
+                u,
+                &time,
+                tangent,
+                (start, end),
+            );
+            let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
+                chunk.element(p, fe, ke).map(|()| Some(true))
+            });
+            sc.add_chunk(results, start, responses::ND, &mut buf, |e| {
+                let nodes = &model.elements[e].nodes;
+                (nodes, numbers.number(Family::Continuum, e))
+            })?;
             start = end;
         }
-        self.elem_buf = (fbuf, kbuf);
         // Joint contact elements.
-        let results: Vec<_> = self
-            .interfaces
-            .par_iter()
-            .zip(&model.interfaces)
-            .zip(&self.families.joints.points.committed)
-            .map(|((el, data), committed)| {
+        let joints = &mut self.families.joints.points;
+        let nd = max_dofs(model.interfaces.iter().map(|i| i.nodes.len()));
+        let pieces: Vec<_> = joints.trial.iter_mut().enumerate().collect();
+        for (start, pieces) in chunks(pieces) {
+            let results = compute_chunk(pieces, nd, &mut buf, |(i, trial), fe, ke| {
+                let data = &model.interfaces[i];
                 let ue: Vec<f64> = data
                     .nodes
                     .iter()
                     .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
                     .collect();
-                el.response_with(&data.params, data.thickness, &ue, committed, true)
-            })
-            .collect();
-        let mut symmetrised = false;
-        for (i, r) in results.into_iter().enumerate() {
-            let nodes = &model.interfaces[i].nodes;
-            for (a, &n) in nodes.iter().enumerate() {
-                f_int[2 * n] += r.f_int[2 * a];
-                f_int[2 * n + 1] += r.f_int[2 * a + 1];
-                f_abs[2 * n] += r.f_int[2 * a].abs();
-                f_abs[2 * n + 1] += r.f_int[2 * a + 1].abs();
-            }
-            if let Some(k) = k_values.as_mut() {
-                let mut ke = r.k;
-                if !r.symmetric {
-                    // Slip makes the tangent unsymmetric; the Cholesky path takes its
-                    // symmetric part (more iterations, same converged answer).
-                    symmetrise(&mut ke, 2 * nodes.len());
-                    symmetrised = true;
-                }
-                self.asm
-                    .add_matrix(self.numbers.number(Family::Joint, i), &ke, k);
-            }
-            self.families.joints.points.trial[i] = r.states;
+                let joint = Joint {
+                    element: &self.interfaces[i],
+                    params: &data.params,
+                    thickness: data.thickness,
+                };
+                let into = slot(fe, ke, ue.len(), tangent);
+                joint
+                    .response(&ue, &joints.committed[i], trial, into)
+                    .map(Some)
+            });
+            sc.add_chunk(results, start, nd, &mut buf, |i| {
+                let nodes = &model.interfaces[i].nodes;
+                (nodes, numbers.number(Family::Joint, i))
+            })?;
         }
         // External tendons (corotational: their forces follow the deformed geometry).
         let tb = &mut self.families.tendons;
-        for (t, tendon) in self.tendons.iter().enumerate() {
-            let (Some(el), Some(committed)) = (tendon, &tb.states.committed[t]) else {
-                continue;
-            };
-            let nodes = &model.tendons[t].nodes;
-            let ut: Vec<[f64; 2]> = nodes
-                .iter()
-                .zip(&tb.u0[t])
-                .map(|(&n, u0)| [u[2 * n] - u0[0], u[2 * n + 1] - u0[1]])
-                .collect();
-            let r = el.response(&ut, committed);
-            for (a, &n) in nodes.iter().enumerate() {
-                f_int[2 * n] += r.f_int[2 * a];
-                f_int[2 * n + 1] += r.f_int[2 * a + 1];
-                f_abs[2 * n] += r.f_int[2 * a].abs();
-                f_abs[2 * n + 1] += r.f_int[2 * a + 1].abs();
-            }
-            if let Some(k) = k_values.as_mut() {
-                let mut ke = r.k;
-                if !r.symmetric {
-                    symmetrise(&mut ke, 2 * nodes.len());
-                    symmetrised = true;
-                }
-                self.asm
-                    .add_matrix(self.numbers.number(Family::Tendon, t), &ke, k);
-            }
-            tb.states.trial[t] = Some(r.state);
+        let nd = max_dofs(model.tendons.iter().map(|t| t.nodes.len()));
+        let pieces: Vec<_> = tb.states.trial.iter_mut().enumerate().collect();
+        for (start, pieces) in chunks(pieces) {
+            let results = compute_chunk(pieces, nd, &mut buf, |(t, trial), fe, ke| {
+                let (Some(el), Some(committed)) = (&self.tendons[t], &tb.states.committed[t])
+                else {
+                    return Ok(None);
+                };
+                let ut: Vec<f64> = model.tendons[t]
+                    .nodes
+                    .iter()
+                    .zip(&tb.u0[t])
+                    .flat_map(|(&n, u0)| [u[2 * n] - u0[0], u[2 * n + 1] - u0[1]])
+                    .collect();
+                let into = slot(fe, ke, ut.len(), tangent);
+                ElementResponse::response(el, &ut, committed, trial, into).map(Some)
+            });
+            sc.add_chunk(results, start, nd, &mut buf, |t| {
+                let nodes = &model.tendons[t].nodes;
+                (nodes, numbers.number(Family::Tendon, t))
+            })?;
         }
-        self.symmetrised = symmetrised;
-        let force_scale = f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.elem_buf = buf;
+        self.symmetrised = sc.symmetrised;
+        let force_scale = sc.f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
         Ok(Assembled {
-            f_int,
-            k_values,
+            f_int: sc.f_int,
+            k_values: sc.k_values,
             force_scale,
         })
     }

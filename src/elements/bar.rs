@@ -11,6 +11,7 @@
 //! host's VTK node order; element matrices are dense, row-major, `2n × 2n`.
 
 use crate::fem::shape::{cartesian_derivatives, jacobian, QuadKind, MAX_NODES};
+use crate::materials::steel::{update_uniaxial, SteelParams, SteelState};
 use serde::{Deserialize, Serialize};
 
 /// One integration point of a bar piece.
@@ -137,6 +138,160 @@ pub fn add_bar_point(
             }
         }
     }
+}
+
+/// Kinematics of an embedded bar point, as of its host element.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BarKinematics {
+    /// Small strain: ε_b = g·u_e with g = T(φ) B ([`bar_strain_row`]).
+    SmallStrain,
+    /// Total Lagrangian: Green strain along the bar ([`bar_green_strain`]), with the bar's
+    /// geometric stiffness.
+    TotalLagrangian,
+}
+
+/// A bar point's stage, as its law sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BarStage {
+    /// Not there yet (a post-tensioned tendon before stressing): no force, state kept.
+    Absent,
+    /// Locked off, duct not grouted: carries `stress` [Pa] and no material stiffness; these
+    /// are the equivalent prestressing forces (anchor, curvature and friction forces
+    /// integrated by parts through the shape functions).
+    Locked {
+        /// Stress held [Pa].
+        stress: f64,
+    },
+    /// Bonded: strain ε = ε_b − `eps_ref` + `prestrain` − `relax` [-] through the steel law.
+    Bonded {
+        /// Bond strain when the point became bonded [-].
+        eps_ref: f64,
+        /// Bonding stress over the modulus, σ_b,0/E_s [-].
+        prestrain: f64,
+        /// Relaxation of a tendon's steel, a stress-free strain [-].
+        relax: f64,
+    },
+}
+
+/// What one bar point's law gives: its trial steel state and output values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarPointResult {
+    /// Trial steel state.
+    pub state: SteelState,
+    /// Bar strain including the prestrain [-].
+    pub strain: f64,
+    /// Bar stress [Pa].
+    pub stress: f64,
+    /// Plastic strain [-].
+    pub plastic_strain: f64,
+}
+
+/// The bar-point law, the one place an embedded bar point turns its host's displacements
+/// `u_e` [m] into a force: uniaxial steel `steel` at the point's stage, f += g σ A w into
+/// `f` [N] and, if given, K += g E_t A w gᵀ (+ σ A w (d dᵀ ⊗ I₂) under the total Lagrangian
+/// kinematics) into `k` [N/m]; `area` A [m²]. With a host of `kind` and node coordinates
+/// `coords` [m].
+#[allow(clippy::too_many_arguments)]
+pub fn bar_point_response(
+    kinematics: BarKinematics,
+    kind: QuadKind,
+    coords: &[[f64; 2]],
+    p: &BarPoint,
+    steel: &SteelParams,
+    area: f64,
+    stage: BarStage,
+    committed: &SteelState,
+    u_e: &[f64],
+    f: &mut [f64],
+    k: Option<&mut [f64]>,
+) -> BarPointResult {
+    let nd = u_e.len();
+    let (eps_b, g, d) = match kinematics {
+        BarKinematics::SmallStrain => {
+            let g = bar_strain_row(kind, coords, p);
+            let e = g.iter().zip(u_e).map(|(a, b)| a * b).sum::<f64>();
+            (e, g, None)
+        }
+        BarKinematics::TotalLagrangian => {
+            let (e, g, d) = bar_green_strain(kind, coords, p, u_e);
+            (e, g, Some(d))
+        }
+    };
+    let (res, et) = match stage {
+        BarStage::Absent => {
+            return BarPointResult {
+                state: *committed,
+                strain: 0.0,
+                stress: 0.0,
+                plastic_strain: 0.0,
+            }
+        }
+        BarStage::Locked { stress } => (
+            BarPointResult {
+                state: *committed,
+                strain: stress / steel.es,
+                stress,
+                plastic_strain: 0.0,
+            },
+            0.0,
+        ),
+        BarStage::Bonded {
+            eps_ref,
+            prestrain,
+            relax,
+        } => {
+            let eps = eps_b - eps_ref + prestrain - relax;
+            let (state, sig, et) = update_uniaxial(steel, committed, eps);
+            (
+                BarPointResult {
+                    state,
+                    strain: eps,
+                    stress: sig,
+                    plastic_strain: state.plastic_strain,
+                },
+                et,
+            )
+        }
+    };
+    // The two kinematics keep their own rounding order of σ A w (the histories of cracking
+    // models branch on a last-bit change: one order would move the total Lagrangian ones).
+    let (fs, ks) = if d.is_some() {
+        let aw = area * p.weight_length;
+        (res.stress * aw, et * aw)
+    } else {
+        (
+            res.stress * area * p.weight_length,
+            et * area * p.weight_length,
+        )
+    };
+    for r in 0..nd {
+        f[r] += g[r] * fs;
+    }
+    let Some(k) = k else {
+        return res;
+    };
+    for r in 0..nd {
+        let gr = g[r] * ks;
+        match d {
+            None if gr != 0.0 => {
+                for c in 0..nd {
+                    k[r * nd + c] += gr * g[c];
+                }
+            }
+            None => {}
+            Some(d) => {
+                let dr = d[r / 2] * fs;
+                for c in 0..nd {
+                    let mut v = gr * g[c];
+                    if r % 2 == c % 2 {
+                        v += dr * d[c / 2];
+                    }
+                    k[r * nd + c] += v;
+                }
+            }
+        }
+    }
+    res
 }
 
 #[cfg(test)]

@@ -36,6 +36,122 @@ pub fn rule_points(kind: QuadKind, integration: Integration) -> &'static [Point2
     }
 }
 
+/// How a continuum element turns nodal displacements into strains and forces: the one switch
+/// between the small-strain element, the Q4 with incompatible modes and the total Lagrangian
+/// element (chosen from the element's kind and rule and the model's geometry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Formulation {
+    /// Small strains: an isoparametric element of `kind` integrated by `integration`.
+    SmallStrain {
+        /// Element kind.
+        kind: QuadKind,
+        /// Integration rule (full or reduced).
+        integration: Integration,
+    },
+    /// Q4 with Wilson–Taylor incompatible bending modes, condensed in the element
+    /// ([`super::incompatible`]).
+    IncompatibleModes,
+    /// Total Lagrangian: Green strain, second Piola–Kirchhoff stress, referred to the
+    /// undeformed element ([`super::total_lagrangian`]).
+    TotalLagrangian {
+        /// Element kind.
+        kind: QuadKind,
+        /// Integration rule.
+        integration: Integration,
+    },
+}
+
+impl Formulation {
+    /// The formulation of an element of `kind` under `integration`; `large_displacements`
+    /// for a geometrically nonlinear model (the input refuses incompatible modes with it).
+    pub fn new(kind: QuadKind, integration: Integration, large_displacements: bool) -> Self {
+        if large_displacements {
+            Formulation::TotalLagrangian { kind, integration }
+        } else if integration == Integration::Incompatible {
+            debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
+            Formulation::IncompatibleModes
+        } else {
+            Formulation::SmallStrain { kind, integration }
+        }
+    }
+}
+
+/// The signature of [`response_at`] and the total Lagrangian response.
+type ResponseFn = fn(
+    QuadKind,
+    Integration,
+    &[[f64; 2]],
+    f64,
+    &Material,
+    &[PointState],
+    &[f64],
+    &mut [f64],
+    Option<&mut [f64]>,
+    &mut [PointState],
+    &mut [GaussOutput],
+    &TimeContext,
+) -> Result<(), UpdateError>;
+
+/// A continuum element ready to answer: formulation, node coordinates [m], thickness [m],
+/// material and the time increment of the analysis clock.
+pub struct ContinuumElement<'a> {
+    /// Kinematics and integration.
+    pub formulation: Formulation,
+    /// Node coordinates [m].
+    pub coords: &'a [[f64; 2]],
+    /// Thickness [m].
+    pub thickness: f64,
+    /// Material of every point.
+    pub material: &'a Material,
+    /// Time increment (creep, shrinkage) [d].
+    pub time: &'a TimeContext,
+}
+
+impl super::ElementResponse for ContinuumElement<'_> {
+    type Committed = [PointState];
+    /// The points' trial states and Gauss outputs.
+    type Trial<'t> = (&'t mut [PointState], &'t mut [GaussOutput]);
+
+    fn response(
+        &self,
+        u: &[f64],
+        committed: &[PointState],
+        (trial, out): Self::Trial<'_>,
+        into: super::Response<'_>,
+    ) -> Result<bool, UpdateError> {
+        let (c, t, m) = (self.coords, self.thickness, self.material);
+        let (f, k) = (into.f, into.k);
+        // The small-strain and total Lagrangian responses take the same arguments.
+        let (kind, integration, respond): (_, _, ResponseFn) = match self.formulation {
+            Formulation::SmallStrain { kind, integration } => (kind, integration, response_at),
+            Formulation::TotalLagrangian { kind, integration } => {
+                (kind, integration, super::total_lagrangian::response_tl)
+            }
+            Formulation::IncompatibleModes => {
+                super::incompatible::response_at(
+                    c, t, m, committed, u, f, k, trial, out, self.time,
+                )?;
+                return Ok(true);
+            }
+        };
+        respond(
+            kind,
+            integration,
+            c,
+            t,
+            m,
+            committed,
+            u,
+            f,
+            k,
+            trial,
+            out,
+            self.time,
+        )?;
+        Ok(true)
+    }
+}
+
 /// Values computed at one Gauss point for output.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct GaussOutput {

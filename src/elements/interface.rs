@@ -230,6 +230,40 @@ impl InterfacePointState {
     }
 }
 
+/// A joint element with its law and thickness, as the assembly calls it.
+pub struct Joint<'a> {
+    /// Contact geometry.
+    pub element: &'a InterfaceElement,
+    /// Joint law.
+    pub params: &'a InterfaceParams,
+    /// Out-of-plane thickness [m].
+    pub thickness: f64,
+}
+
+impl super::ElementResponse for Joint<'_> {
+    type Committed = [InterfacePointState];
+    type Trial<'t> = &'t mut Vec<InterfacePointState>;
+
+    /// [`InterfaceElement::response_with`] with the full (possibly unsymmetric) tangent.
+    fn response(
+        &self,
+        u: &[f64],
+        committed: &[InterfacePointState],
+        trial: Self::Trial<'_>,
+        into: super::Response<'_>,
+    ) -> Result<bool, crate::materials::point::UpdateError> {
+        let r = self
+            .element
+            .response_with(self.params, self.thickness, u, committed, true);
+        into.f.copy_from_slice(&r.f_int);
+        if let Some(k) = into.k {
+            k.copy_from_slice(&r.k);
+        }
+        *trial = r.states;
+        Ok(r.symmetric)
+    }
+}
+
 /// Internal forces, tangent and updated (trial) states of an interface element.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterfaceResponse {

@@ -249,6 +249,30 @@ pub struct TendonResponse {
     pub state: TendonState,
 }
 
+impl super::ElementResponse for ExternalTendon {
+    type Committed = TendonState;
+    type Trial<'t> = &'t mut Option<TendonState>;
+
+    /// [`ExternalTendon::response`]; `u` holds the displacements of the tendon points since
+    /// the tendon was stressed [m], (x, y) per point.
+    fn response(
+        &self,
+        u: &[f64],
+        committed: &TendonState,
+        trial: Self::Trial<'_>,
+        into: super::Response<'_>,
+    ) -> Result<bool, crate::materials::point::UpdateError> {
+        let ut: Vec<[f64; 2]> = u.chunks_exact(2).map(|d| [d[0], d[1]]).collect();
+        let r = ExternalTendon::response(self, &ut, committed);
+        into.f.copy_from_slice(&r.f_int);
+        if let Some(k) = into.k {
+            k.copy_from_slice(&r.k);
+        }
+        *trial = Some(r.state);
+        Ok(r.symmetric)
+    }
+}
+
 /// External tendon element.
 #[derive(Debug, Clone)]
 pub struct ExternalTendon {

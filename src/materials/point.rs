@@ -227,9 +227,27 @@ impl TimeContext {
 /// Why a material update failed (the increment is then cut).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UpdateError {
-    /// The local return mapping did not converge.
+    /// The local return mapping did not converge (or met a non-finite strain): the driver
+    /// cuts the step and retries.
     #[error("material update did not converge: {0}")]
     NotConverged(String),
+    /// A contract inside segfem was broken (parameters the input checks, a time interval
+    /// the drivers make): a bug, reported as such and never mistaken for a step cut.
+    #[error("internal error in a material update: {0}; please report")]
+    Internal(String),
+}
+
+impl From<crate::materials::error::MaterialError> for UpdateError {
+    fn from(e: crate::materials::error::MaterialError) -> Self {
+        use crate::materials::error::MaterialError;
+        match e {
+            // The input checks every parameter: an invalid one here is a bug.
+            MaterialError::InvalidParams(_) => UpdateError::Internal(e.to_string()),
+            MaterialError::ReturnMappingNotConverged { .. } | MaterialError::NonFiniteStrain(_) => {
+                UpdateError::NotConverged(e.to_string())
+            }
+        }
+    }
 }
 
 /// Result of a material update: trial state, stress [Pa] and tangent [Pa].
@@ -288,7 +306,7 @@ pub fn update_with_time(
                     time.extrapolation,
                 ),
             };
-            let (st, sig, mut d) = res.map_err(|e| UpdateError::NotConverged(e.to_string()))?;
+            let (st, sig, mut d) = res.map_err(UpdateError::from)?;
             // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
             // the symmetric solvers take its symmetric part (same converged answer, possibly
             // more iterations).
@@ -316,7 +334,7 @@ pub fn update_with_time(
         ) => {
             let (a0, a1) = (time.t_from - cast_day, time.t_to - cast_day);
             if !(a1 >= a0 && a0.is_finite() && a1.is_finite()) {
-                return Err(UpdateError::NotConverged(format!(
+                return Err(UpdateError::Internal(format!(
                     "ageing concrete: bad time interval {} → {} d",
                     time.t_from, time.t_to
                 )));

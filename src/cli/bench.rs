@@ -1,12 +1,12 @@
 //! The `segfem bench` job: build and solve banded plane-stress beams of growing size and
 //! print the time of each phase and the peak memory.
 
-use crate::analysis::steps::{self, Observer, Snapshot};
-use crate::elements::continuum::Integration;
-use crate::fem::shape::QuadKind;
-use crate::materials::point::Material;
-use crate::mesh::banded::{generate, Band};
-use crate::model::*;
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::elements::continuum::Integration;
+use segfem::fem::shape::QuadKind;
+use segfem::materials::point::Material;
+use segfem::mesh::banded::{generate, Band};
+use segfem::model::*;
 use std::time::Instant;
 
 /// A simply supported-free cantilever-like banded beam (three bands: flange, web, flange)
@@ -193,7 +193,7 @@ pub fn run_case(kind: QuadKind, target_dofs: usize) -> Result<BenchRow, steps::A
         factor_s: t.solver.numeric_s,
         solve_s: t.solver.solve_s,
         total_s: t0.elapsed().as_secs_f64(),
-        peak_bytes: crate::run::peak_memory().unwrap_or(0),
+        peak_bytes: segfem::run::peak_memory().unwrap_or(0),
         tip_uy: obs.value,
     })
 }
@@ -251,7 +251,7 @@ fn seed_text(refine: usize) -> String {
 /// The bundled seed beam, refined as in [`seed_text`], with its last step on to failure.
 fn seed_text_to_failure(refine: usize) -> String {
     let r = refine.max(1);
-    include_str!("../examples/seed-beam.toml")
+    include_str!("../../examples/seed-beam.toml")
         .replace(
             "nx_per_segment = 6 ",
             &format!("nx_per_segment = {} ", 6 * r),
@@ -273,12 +273,12 @@ pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
     let r = refine.max(1);
     let text = seed_text(r);
     let t0 = Instant::now();
-    let model = crate::input::parse(&text, "seed-beam.toml")
+    let model = segfem::input::parse(&text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Nothing(0.0);
     let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(NonlinearRow {
         case: format!("seed beam, {} rows", 6 * r),
         equations,
@@ -319,12 +319,12 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
         "{text}\n[[steps]]\nname = \"prestress\"\nkind = \"load\"\nloads = {{ self_weight = 1.0 }}\n\n[[steps]]\nname = \"long_term\"\nkind = \"time\"\nfrom = 28.0\nduration = 1e4\nsubsteps = 50\n"
     );
     let t0 = Instant::now();
-    let model = crate::input::parse(&text, "seed-beam-long-term.toml")
+    let model = segfem::input::parse(&text, "seed-beam-long-term.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Nothing(0.0);
     let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(NonlinearRow {
         case: format!("seed 1e4 d, {} rows", 6 * r),
         equations,
@@ -363,7 +363,7 @@ pub struct FailureRow {
     pub crushed: usize,
     /// How the run ended.
     pub end: String,
-    /// The first failure met (see [`crate::results::ultimate`]).
+    /// The first failure met (see [`segfem::results::ultimate`]).
     pub mode: String,
     /// Solver and assembly figures (zero when the run ended without converging).
     pub timings: steps::Timings,
@@ -372,7 +372,7 @@ pub struct FailureRow {
 /// Records what a failure run reaches.
 #[derive(Default)]
 struct Reach {
-    watch: crate::results::ultimate::UltimateWatch,
+    watch: segfem::results::ultimate::UltimateWatch,
     increments: usize,
     iterations: usize,
     q_max: f64,
@@ -401,7 +401,7 @@ impl Observer for Reach {
             .as_ref()
             .map_or(0.0, |t| t.stresses().into_iter().fold(0.0, f64::max));
         self.max_opening = (0..m.joints.len())
-            .map(|j| crate::results::joints::summarise(sys, j).max_opening)
+            .map(|j| segfem::results::joints::summarise(sys, j).max_opening)
             .fold(0.0, f64::max);
         self.crushed = sys
             .families
@@ -452,7 +452,7 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
     text.push('\n');
     text.push_str(step);
     let t0 = Instant::now();
-    let model = crate::input::parse(&text, "seed-beam.toml")
+    let model = segfem::input::parse(&text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Reach::default();
@@ -477,7 +477,7 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         ),
         Err(e) => return Err(e.to_string()),
     };
-    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(FailureRow {
         case: format!(
             "seed beam {}, {} rows",
@@ -523,9 +523,9 @@ pub struct BareRow {
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
 /// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
 pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
-    use crate::analysis::solver::SparseCholesky;
-    use crate::analysis::system::System;
-    let model = crate::input::load(path).map_err(|e| e.to_string())?.model;
+    use segfem::analysis::solver::SparseCholesky;
+    use segfem::analysis::system::System;
+    let model = segfem::input::load(path).map_err(|e| e.to_string())?.model;
     let mut sys = System::new(&model);
     let u = vec![0.0; model.n_dofs()];
     let k = sys
@@ -607,14 +607,14 @@ impl Observer for RcWatch {
 /// directions (1: 32 × 10 Q8; 5: 160 × 50 Q8, about 5e4 equations), taken to failure.
 pub fn rc_case(refine: usize) -> Result<RcRow, String> {
     let r = refine.max(1);
-    let text = include_str!("../examples/rc-beam.toml")
+    let text = include_str!("../../examples/rc-beam.toml")
         .replace("nx = 32\n", &format!("nx = {}\n", 32 * r))
         .replace("rows = 10 }", &format!("rows = {} }}", 10 * r));
     if r > 1 && !text.contains(&format!("nx = {}\n", 32 * r)) {
         return Err("rc-beam.toml changed: cannot refine its mesh".into());
     }
     let t0 = Instant::now();
-    let model = crate::input::parse(&text, "rc-beam.toml")
+    let model = segfem::input::parse(&text, "rc-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = RcWatch::default();
@@ -622,7 +622,7 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         Ok(_) => "completed".to_string(),
         Err(e) => e.to_string().lines().next().unwrap_or("").to_string(),
     };
-    let equations = crate::analysis::system::System::new(&model).dofs.n_eq;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(RcRow {
         case: format!("RC beam, {} rows", 10 * r),
         equations,
@@ -639,7 +639,7 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
 /// point (one crack opened to 4 ε0, strains around it, implicit and IMPL-EX laws) and a
 /// plastic point (biaxial compression past initial yield). Returns (label, updates/s).
 pub fn material_point_rates(n: usize) -> Vec<(String, f64)> {
-    use crate::materials::concrete::{update, update_extrapolated, ConcreteParams, ConcreteState};
+    use segfem::materials::concrete::{update, update_extrapolated, ConcreteParams, ConcreteState};
     use std::hint::black_box;
     let mut p = ConcreteParams::from_mc90(38e6, 0.2);
     p.initial_yield_ratio = 0.3;
@@ -697,7 +697,7 @@ pub fn material_point_rates(n: usize) -> Vec<(String, f64)> {
         ),
     ]
     .into_iter()
-    .chain(crate::materials::concrete::panel_bench::shear_model_rates(
+    .chain(segfem::materials::concrete::panel_bench::shear_model_rates(
         rate,
     ))
     .collect()

@@ -1,0 +1,236 @@
+//! The continuum elements with the bars they host, as the assembly calls them: each
+//! element's data gathered from the model, its state slices from the family blocks, its
+//! response written into the caller's buffers ([`ElementResponse`]).
+
+use super::families::{BarOutput, BarPhase, Families};
+use crate::analysis::bonded_time::BarPointTime;
+use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
+use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput};
+use crate::elements::{ElementResponse, Response};
+use crate::materials::point::{PointState, TimeContext, UpdateError};
+use crate::materials::steel::SteelState;
+use crate::model::{Geometry, Model};
+
+/// Element force entries per slot of the chunk buffers (2 per node of the largest element).
+pub(super) const ND: usize = 2 * crate::fem::shape::MAX_NODES;
+
+/// What the continuum elements of one chunk share (read-only).
+pub(super) struct HostChunk<'a> {
+    model: &'a Model,
+    u: &'a [f64],
+    time: &'a TimeContext,
+    tangent: bool,
+    /// Total Lagrangian kinematics for the continuum and the bars.
+    tl: bool,
+    gp_offset: &'a [usize],
+    /// First Gauss point of the chunk.
+    g0: usize,
+    /// Committed point states of the chunk.
+    committed: &'a [PointState],
+    latched: &'a [(usize, PointState)],
+    bar_gps: &'a [(usize, usize)],
+    bar_offset: &'a [usize],
+    /// First bar point of the chunk.
+    b0: usize,
+    bar_committed: &'a [SteelState],
+    bar_phase: &'a [BarPhase],
+    bar_eps_ref: &'a [f64],
+    bar_time: &'a [Option<BarPointTime>],
+}
+
+/// One element's own trial slices: element index, point states, Gauss outputs, bar steel
+/// states and bar outputs.
+pub(super) type HostPiece<'a> = (
+    usize,
+    &'a mut [PointState],
+    &'a mut [GaussOutput],
+    (&'a mut [SteelState], &'a mut [BarOutput]),
+);
+
+/// Split the state of elements `start..end` so that each element's trial slices can be
+/// filled in parallel without aliasing.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn split_chunk<'a>(
+    model: &'a Model,
+    families: &'a mut Families,
+    gp_offset: &'a [usize],
+    bar_gps: &'a [(usize, usize)],
+    bar_offset: &'a [usize],
+    u: &'a [f64],
+    time: &'a TimeContext,
+    tangent: bool,
+    (start, end): (usize, usize),
+) -> (HostChunk<'a>, Vec<HostPiece<'a>>) {
+    let g0 = gp_offset[start];
+    let g1 = gp_offset[end];
+    let (cont, bars) = (&mut families.continuum, &mut families.bars);
+    let (b0, b1) = (bar_offset[start], bar_offset[end]);
+    let chunk = HostChunk {
+        model,
+        u,
+        time,
+        tangent,
+        tl: model.geometry == Geometry::Nonlinear,
+        gp_offset,
+        g0,
+        committed: &cont.points.committed[g0..g1],
+        latched: &cont.holds.latched,
+        bar_gps,
+        bar_offset,
+        b0,
+        bar_committed: &bars.steel.committed[b0..b1],
+        bar_phase: &bars.phase,
+        bar_eps_ref: &bars.eps_ref[b0..b1],
+        bar_time: &bars.time[b0..b1],
+    };
+    let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
+    // Per-element slices.
+    let mut pieces = Vec::with_capacity(end - start);
+    let (mut t_rest, mut o_rest) = (
+        &mut cont.points.trial[g0..g1],
+        &mut cont.gauss.trial[g0..g1],
+    );
+    for e in start..end {
+        let ngp = gp_offset[e + 1] - gp_offset[e];
+        let (t, tr) = t_rest.split_at_mut(ngp);
+        let (o, or) = o_rest.split_at_mut(ngp);
+        t_rest = tr;
+        o_rest = or;
+        let nb = bar_offset[e + 1] - bar_offset[e];
+        let (bt, btr) = bt_rest.split_at_mut(nb);
+        let (bo, bor) = bo_rest.split_at_mut(nb);
+        bt_rest = btr;
+        bo_rest = bor;
+        pieces.push((e, t, o, (bt, bo)));
+    }
+    (chunk, pieces)
+}
+
+impl HostChunk<'_> {
+    /// Force into `fe` and (if the chunk wants the tangent) tangent into `ke` of one
+    /// continuum element and the bars it hosts; `fe`, `ke` are slots of [`ND`] and `ND²`
+    /// entries.
+    pub(super) fn element(
+        &self,
+        (e, t, o, (bt, bo)): HostPiece,
+        fe: &mut [f64],
+        ke: &mut [f64],
+    ) -> Result<(), UpdateError> {
+        let HostChunk {
+            model,
+            u,
+            time,
+            tangent,
+            tl,
+            gp_offset,
+            g0,
+            committed,
+            latched,
+            bar_gps,
+            bar_offset,
+            b0,
+            bar_committed,
+            bar_phase,
+            bar_eps_ref,
+            bar_time,
+        } = *self;
+        let el = &model.elements[e];
+        let region = &model.regions[el.region];
+        let mat = &model.materials[region.material].law;
+        let nn = el.nodes.len();
+        let nd = 2 * nn;
+        let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+        let mut ue = [0.0; ND];
+        for (a, &n) in el.nodes.iter().enumerate() {
+            coords[a] = model.nodes[n];
+            ue[2 * a] = u[2 * n];
+            ue[2 * a + 1] = u[2 * n + 1];
+        }
+        let (coords, ue) = (&coords[..nn], &ue[..nd]);
+        let (fe, ke) = (&mut fe[..nd], &mut ke[..nd * nd]);
+        let c0 = gp_offset[e] - g0;
+        // Start from the latched crack states where a crack formed in this
+        // increment, from the committed states elsewhere.
+        let base = &committed[c0..c0 + t.len()];
+        let first = latched.partition_point(|x| x.0 < gp_offset[e]);
+        let owned: Option<Vec<PointState>> = latched
+            .get(first)
+            .filter(|x| x.0 < gp_offset[e + 1])
+            .map(|_| {
+                let mut v = base.to_vec();
+                for (g, st) in latched[first..]
+                    .iter()
+                    .take_while(|x| x.0 < gp_offset[e + 1])
+                {
+                    v[g - gp_offset[e]] = st.clone();
+                }
+                v
+            });
+        let states = owned.as_deref().unwrap_or(base);
+        let element = ContinuumElement {
+            formulation: Formulation::new(el.kind, el.integration, tl),
+            coords,
+            thickness: region.thickness,
+            material: mat,
+            time,
+        };
+        element.response(
+            ue,
+            states,
+            (t, o),
+            Response {
+                f: fe,
+                k: tangent.then_some(&mut *ke),
+            },
+        )?;
+        // Embedded bars hosted by this element, through the one bar-point law.
+        let kinematics = if tl {
+            BarKinematics::TotalLagrangian
+        } else {
+            BarKinematics::SmallStrain
+        };
+        let bc0 = bar_offset[e] - b0;
+        for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
+            .iter()
+            .zip(bt.iter_mut().zip(bo.iter_mut()))
+            .enumerate()
+        {
+            let bar = &model.bars[b];
+            // Relaxation of a tendon's steel: a stress-free strain.
+            let relax = bar_time[bc0 + i]
+                .as_ref()
+                .map_or(0.0, |r| r.relax_strain_trial);
+            let stage = match bar_phase[b] {
+                BarPhase::Inactive => BarStage::Absent,
+                BarPhase::Locked => BarStage::Locked {
+                    stress: bar.bonding_stress(p) - bar.steel.es * relax,
+                },
+                BarPhase::Bonded => BarStage::Bonded {
+                    eps_ref: bar_eps_ref[bc0 + i],
+                    prestrain: bar.bonding_stress(p) / bar.steel.es,
+                    relax,
+                },
+            };
+            let r = bar_point_response(
+                kinematics,
+                el.kind,
+                coords,
+                &bar.points[p].point,
+                &bar.steel,
+                bar.area,
+                stage,
+                &bar_committed[bc0 + i],
+                ue,
+                fe,
+                tangent.then_some(&mut *ke),
+            );
+            *st = r.state;
+            *out = BarOutput {
+                strain: r.strain,
+                stress: r.stress,
+                plastic_strain: r.plastic_strain,
+            };
+        }
+        Ok(())
+    }
+}

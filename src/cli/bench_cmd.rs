@@ -1,0 +1,229 @@
+//! The `segfem bench` command: one function per `--case`, printing one row per size or
+//! refinement (the cases themselves are in [`super::bench`]).
+
+use segfem::fem::shape::QuadKind;
+use std::process::ExitCode;
+
+use crate::stdout_failed;
+
+pub(crate) fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
+    outln!(
+        "{:>4} {:>9} {:>7} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>12}",
+        "elem",
+        "dofs",
+        "mesh s",
+        "setup s",
+        "assemb s",
+        "order s",
+        "factor s",
+        "solve s",
+        "total s",
+        "peak MiB",
+        "tip uy [m]"
+    );
+    for e in &element {
+        let kind = match e.as_str() {
+            "Q4" => QuadKind::Q4,
+            "Q8" => QuadKind::Q8,
+            "Q9" => QuadKind::Q9,
+            o => {
+                eprintln!("error: --element: unknown element '{o}' (Q4, Q8, Q9)");
+                return ExitCode::from(2);
+            }
+        };
+        for &n in &dofs {
+            match super::bench::run_case(kind, n as usize) {
+                Ok(r) => outln!(
+                    "{:>4} {:>9} {:>7.3} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>7.3} {:>8.3} {:>9.0} {:>12.5e}",
+                    r.kind, r.dofs, r.mesh_s, r.setup_s, r.assembly_s, r.ordering_s, r.factor_s, r.solve_s, r.total_s,
+                    r.peak_bytes as f64 / 1048576.0, r.tip_uy
+                ),
+                Err(err) => {
+                    eprintln!("error: {err}");
+                    return ExitCode::from(3);
+                }
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+pub(crate) fn bench_bare(path: &std::path::Path) -> ExitCode {
+    match super::bench::bare_factorisation(path) {
+        Ok(r) => {
+            outln!("{}", serde_json::to_string(&r).expect("row serialises"));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
+    outln!(
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "total s",
+        "Q max",
+        "uy [m]",
+        "σp [MPa]",
+        "open [mm]",
+        "crushed"
+    );
+    for r in refine {
+        match super::bench::seed_failure_case(r, concrete) {
+            Ok(x) => {
+                outln!(
+                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
+                    x.case,
+                    x.equations,
+                    x.increments,
+                    x.iterations,
+                    x.total_s,
+                    x.q_max,
+                    x.deflection,
+                    x.tendon_stress / 1e6,
+                    x.max_opening * 1e3,
+                    x.crushed,
+                    x.mode,
+                    x.end
+                );
+                let (t, s) = (&x.timings, &x.timings.solver);
+                outln!(
+                    "{:>28} assembly {:.3} s, {} factorisations ({} LDLT) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
+                    "",
+                    t.assembly_s,
+                    s.factorisations,
+                    s.ldlt_factorisations,
+                    s.numeric_s,
+                    1e3 * s.numeric_s / s.factorisations.max(1) as f64,
+                    s.factor_nnz,
+                    s.solve_s
+                );
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Print one row per refinement factor of a seed-beam benchmark `case`.
+pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
+    outln!(
+        "{:>18} {:>9} {:>5} {:>6} {:>8} {:>9} {:>9}  end",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "total s",
+        "P max kN",
+        "w [mm]"
+    );
+    for r in refine {
+        match super::bench::rc_case(r) {
+            Ok(x) => outln!(
+                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>9.1} {:>9.2}  {}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.total_s,
+                x.p_max / 1e3,
+                x.deflection * 1e3,
+                x.end
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+pub(crate) fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
+    let path = file.unwrap_or(std::path::Path::new("validation/panels/panels.csv"));
+    match segfem::materials::concrete::panel_bench::series(path) {
+        Ok((report, secs)) => {
+            outln!("{report}");
+            outln!("total time of the series: {secs:.1} s");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Print the shear-beam series (validation/beams/beams.csv, or `file`) under each concrete
+/// model option on two meshes.
+pub(crate) fn bench_beams(file: Option<&std::path::Path>) -> ExitCode {
+    let path = file.unwrap_or(std::path::Path::new("validation/beams/beams.csv"));
+    match segfem::materials::concrete::beam_bench::series(path) {
+        Ok((report, secs)) => {
+            outln!("{report}");
+            outln!("total time of the series: {secs:.1} s");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+pub(crate) fn bench_material_point() -> ExitCode {
+    outln!("{:>26} {:>14}", "concrete point", "updates/s");
+    for (label, rate) in super::bench::material_point_rates(2_000_000) {
+        outln!("{label:>26} {rate:>14.3e}");
+    }
+    ExitCode::SUCCESS
+}
+
+pub(crate) fn bench_seed(
+    refine: Vec<usize>,
+    case: fn(usize) -> Result<super::bench::NonlinearRow, String>,
+) -> ExitCode {
+    outln!(
+        "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10} {:>9} {:>8} {:>13}",
+        "case",
+        "equations",
+        "incs",
+        "iters",
+        "factors",
+        "factor ms",
+        "assemb s",
+        "total s",
+        "midspan uy [m]"
+    );
+    for r in refine {
+        match case(r) {
+            Ok(x) => outln!(
+                "{:>22} {:>9} {:>5} {:>6} {:>7} {:>10.2} {:>9.3} {:>8.3} {:>13.5e}",
+                x.case,
+                x.equations,
+                x.increments,
+                x.iterations,
+                x.factorisations,
+                x.factor_mean_s * 1e3,
+                x.assembly_s,
+                x.total_s,
+                x.result
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(3);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
