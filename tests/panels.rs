@@ -123,3 +123,35 @@ fn panel_peaks_do_not_depend_on_the_mesh() {
         assert!((a - b).abs() < 0.01 * a, "1×1 {a:.4e} vs 4×4 {b:.4e}");
     }
 }
+
+/// Known deviation: the same unequally reinforced panel (ρx = 2 %, ρy = 1 %) with the fixed
+/// crack and the seed's shear retention (the default crack model). The 45° crack cannot let
+/// its strut turn onto the stronger x steel, so after the weak y layer yields (the 45° truss
+/// gives ρy f_y = 4.0 MPa) the panel carries little more, well below the rotating-crack truss
+/// v_u = √(ρx ρy) f_y = 5.657 MPa. Asserted: the peak lies above ρy f_y (the weak layer
+/// yields, the truss holds until then) and inside the measured band 4.0 … 4.6 MPa (≈ 20 %
+/// below v_u), so that a regression and an unexplained improvement both fail
+/// (docs/validation.md, "Concrete, bars and path following").
+#[test]
+fn fixed_crack_on_the_unequal_panel_stalls_below_the_rotating_truss_a_known_deviation() {
+    let p = panel([0.02, 0.01], 30e6);
+    let r = run_panel(&p, "tension_softening = \"crack_band\"\n", 1).unwrap();
+    let v_u = (0.02_f64 * 0.01).sqrt() * 400e6;
+    let v_weak = 0.01 * 400e6;
+    eprintln!(
+        "fixed, seed β: v = {:.4e} ({:.3} of v_u), {}; steel {:?}",
+        r.v_peak,
+        r.v_peak / v_u,
+        r.mode,
+        r.steel_at_peak
+    );
+    // The weak layer yields at the peak (its strain over the yield strain ≥ 1, 0.1 % for
+    // the increment that reaches it).
+    assert!(r.steel_at_peak[1] >= 0.999, "{:?}", r.steel_at_peak);
+    // Known-deviation band (measured, see the doc comment).
+    assert!(
+        r.v_peak > v_weak && r.v_peak < 4.6e6,
+        "peak {:.4e} outside the known band 4.0 … 4.6 MPa (v_u = {v_u:.4e})",
+        r.v_peak
+    );
+}
