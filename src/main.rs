@@ -74,6 +74,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/creep-beam.toml"),
     ),
     (
+        "cracked-beam-30y",
+        "cracked RC beam (MC90 creep and shrinkage with cracking) under sustained load for 30 years",
+        include_str!("../examples/cracked-beam-30y.toml"),
+    ),
+    (
         "segmental-decompression",
         "three dry-jointed segments, eccentric axial force, bent until the joints open",
         include_str!("../examples/segmental-decompression.toml"),

@@ -11,6 +11,7 @@ use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
 use crate::results::plausibility::Plausibility;
 use crate::results::recorder::Recorder;
+use crate::results::sustained::SustainedStress;
 use crate::results::ultimate::{Ultimate, UltimateWatch};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -268,6 +269,7 @@ struct Progress<'a, 'm> {
     rec: Recorder<'m>,
     watch: UltimateWatch,
     plausible: Plausibility,
+    sustained: SustainedStress,
     on_increment: &'a mut dyn FnMut(&Snapshot),
     dir: PathBuf,
     origin: Origin,
@@ -284,6 +286,7 @@ impl Observer for Progress<'_, '_> {
         self.rec.increment(snap)?;
         self.watch.increment(snap);
         self.plausible.increment(snap);
+        self.sustained.increment(snap);
         (self.on_increment)(snap);
         Ok(())
     }
@@ -434,6 +437,7 @@ pub fn run_file_opts(
         rec,
         watch: UltimateWatch::new(),
         plausible: Plausibility::new(),
+        sustained: SustainedStress::new(),
         on_increment,
         dir: PathBuf::from(out),
         origin: Origin {
@@ -457,6 +461,7 @@ pub fn run_file_opts(
     let mut rec = obs.rec;
     let watch = obs.watch;
     let plausibility = obs.plausible.findings();
+    let sustained = obs.sustained.warning(&model);
     let mut failures = obs.failures;
     let (timings, error) = match result {
         Ok(t) => (t, None),
@@ -533,6 +538,7 @@ pub fn run_file_opts(
     );
     let mut warnings = built.warnings;
     warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
+    warnings.extend(sustained);
     if error.is_some() || !failures.is_empty() {
         // A failed or stopped run says why it failed; the findings still go with it.
         warnings.extend(plausibility.iter().cloned());

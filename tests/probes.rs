@@ -581,3 +581,104 @@ fn plot_units_option() {
     let svg = read(&tmp.join("out/figures/curves.svg"));
     assert!(svg.contains("tip_uy [m]"), "SI label");
 }
+
+/// A 1 × 0.2 m strip (0.2 m thick) of creeping C30 concrete (`creep = "mc90"`) held for
+/// 1000 days under an axial compression of 15 MPa = 0.5 f_cm, with `extra` keys on the
+/// material.
+fn sustained_strip(extra: &str) -> String {
+    format!(
+        r#"title = "strip under sustained compression"
+
+[[materials]]
+name = "C30"
+kind = "concrete"
+creep = "mc90"
+fcm = 30e6
+nu = 0.2
+rh = 0.7
+h0 = 0.1
+cement = "N"
+{extra}
+
+[[regions]]
+name = "strip"
+material = "C30"
+thickness = 0.2
+
+[mesh]
+type = "banded"
+length = 1.0
+nx = 4
+element = "Q4"
+bands = [{{ region = "strip", depth = 0.2, rows = 1 }}]
+
+[[supports]]
+name = "end"
+line = [[0.0, 0.0], [0.0, 0.2]]
+ux = 0.0
+
+[[supports]]
+name = "corner"
+point = [0.0, 0.0]
+uy = 0.0
+
+[[load_cases]]
+name = "N"
+line_loads = [{{ line = [[1.0, 0.0], [1.0, 0.2]], q = [-3.0e6, 0.0] }}]
+
+[[monitors]]
+name = "shortening"
+kind = "displacement"
+point = [1.0, 0.0]
+component = "x"
+
+[[steps]]
+name = "load"
+kind = "load"
+loads = {{ N = 1.0 }}
+
+[[steps]]
+name = "hold"
+kind = "time"
+from = 28.0
+duration = 1000.0
+"#
+    )
+}
+
+/// Sustained compression above MC90's linear creep limit (0.4 f_cm) with linear creep
+/// warns once, naming the region and suggesting `nonlinear_creep`; with the option on there
+/// is no warning. The stress is q t / (h t) = 3e6 N/m / 0.2 m = 15 MPa = 0.5 f_cm (uniform
+/// axial stress in a free-to-expand strip: the ratio is exact up to round-off).
+#[test]
+fn sustained_stress_above_linear_creep_warns() {
+    let tmp = TempDir::new("probe-sustained");
+    std::fs::write(tmp.join("lin.toml"), sustained_strip("")).unwrap();
+    let o = segfem(tmp.path(), &["run", "lin.toml", "-o", "lin"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 0, "{err}");
+    assert_eq!(err.matches("linear creep range").count(), 1, "{err}");
+    assert!(err.contains("region 'strip'"), "{err}");
+    assert!(err.contains("material 'C30'"), "{err}");
+    assert!(err.contains("|σ_c| = 0.50 f_cm"), "{err}");
+    assert!(err.contains("nonlinear_creep = true"), "{err}");
+    let s = summary(&tmp.join("lin"));
+    let w = s["warnings"].as_array().expect("warnings");
+    assert_eq!(
+        w.iter()
+            .filter(|w| w.as_str().unwrap().contains("linear creep range"))
+            .count(),
+        1,
+        "{w:?}"
+    );
+
+    std::fs::write(
+        tmp.join("nl.toml"),
+        sustained_strip("nonlinear_creep = true"),
+    )
+    .unwrap();
+    let o = segfem(tmp.path(), &["run", "nl.toml", "-o", "nl"]);
+    let err = stderr(&o);
+    assert_eq!(code(&o), 0, "{err}");
+    assert!(!err.contains("linear creep range"), "{err}");
+}

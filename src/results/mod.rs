@@ -7,5 +7,6 @@ pub mod gauss_points;
 pub mod joints;
 pub mod plausibility;
 pub mod recorder;
+pub mod sustained;
 pub mod ultimate;
 pub mod vtu;
