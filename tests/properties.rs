@@ -21,7 +21,7 @@ use segfem::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
 use segfem::fem::shape::QuadKind;
 use segfem::materials::concrete::{self, ConcreteParams, ConcreteState};
 use segfem::materials::point::{update, Material, PointState};
-use segfem::materials::steel::{update_uniaxial, SteelParams, SteelState};
+use segfem::materials::steel::{update_uniaxial, HardeningRule, SteelParams, SteelState};
 use std::cell::Cell;
 
 // ------------------------------------------------------------------------------------------
@@ -607,7 +607,7 @@ fn tendon_tangent_fd_and_symmetry() {
     )| {
         let pts = tendon_points(6.0, &sag);
         let law = if plastic {
-            TendonLaw::ElasticPlastic { yield_stress: 1.4e9, hardening: 5e9, cap: f64::INFINITY }
+            TendonLaw::from_steel(&SteelParams { es: 195e9, fy: 1.4e9, hardening: 5e9, fu: f64::INFINITY, rule: HardeningRule::Isotropic })
         } else {
             TendonLaw::Elastic
         };
@@ -797,7 +797,7 @@ proptest! {
     /// against central differences, as above.
     #[test]
     fn tendon_law_tangent_fd(path in prop::collection::vec(-0.01..0.03f64, 3), hard in 0.0..1e10f64) {
-        let law = TendonLaw::ElasticPlastic { yield_stress: 1.674e9, hardening: hard, cap: f64::INFINITY };
+        let law = TendonLaw::from_steel(&SteelParams { es: 195e9, fy: 1.674e9, hardening: hard, fu: f64::INFINITY, rule: HardeningRule::Isotropic });
         let mut c = Default::default();
         for &eps in &path {
             let (s, et, st) = law.update(195e9, eps, &c);
@@ -805,7 +805,7 @@ proptest! {
             let h = 1e-10;
             let (sp, _, stp) = law.update(195e9, eps + h, &c);
             let (sm, _, stm) = law.update(195e9, eps - h, &c);
-            let yielded = |x: &segfem::elements::tendon::LawState| x.plastic_strain != c.plastic_strain;
+            let yielded = |x: &segfem::materials::steel::SteelState| x.plastic_strain != c.plastic_strain;
             let slack = |v: f64| v <= 0.0;
             if yielded(&stp) == yielded(&st) && yielded(&stm) == yielded(&st)
                 && slack(sp) == slack(s) && slack(sm) == slack(s) {

@@ -176,7 +176,7 @@ pub(crate) mod layout {
     use crate::analysis::time::{SpanTime, TendonTime};
     use crate::elements::continuum::GaussOutput;
     use crate::elements::interface::InterfacePointState;
-    use crate::elements::tendon::{LawState, SpanState, TendonState};
+    use crate::elements::tendon::{SpanState, TendonState};
     use crate::materials::chain::{ChainState, SteelRelaxationChain};
     use crate::materials::point::PointState;
     use crate::materials::steel::SteelState;
@@ -205,7 +205,7 @@ pub(crate) mod layout {
             stress: 2.0,
             force: 3.0,
             length: 4.0,
-            law: LawState::default(),
+            law: SteelState::default(),
         };
         let span_time = SpanTime {
             sigma_initial: 1.0,

@@ -28,6 +28,8 @@
 use std::fmt;
 use std::sync::Arc;
 
+use crate::materials::steel::{update_uniaxial, HardeningRule, SteelParams, SteelState};
+
 /// How the tendon interacts with the deviators.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum DeviatorMode {
@@ -45,24 +47,16 @@ pub enum DeviatorMode {
 /// Uniaxial stress–strain function σ(ε) → (σ \[Pa\], dσ/dε \[Pa\]) of total mechanical strain.
 pub type StressFn = Arc<dyn Fn(f64) -> (f64, f64) + Send + Sync>;
 
-/// Uniaxial law of the tendon steel. Small and self-contained so that it can later be replaced
-/// by `segfem::materials::steel`. A tendon cannot carry compression: negative stresses are
+/// Uniaxial law of the tendon steel. A tendon cannot carry compression: negative stresses are
 /// cut to zero (slack tendon).
 #[derive(Clone)]
 pub enum TendonLaw {
     /// Linear elastic, σ = E_p ε.
     Elastic,
-    /// Elastic–plastic with yield stress `yield_stress` \[Pa\] (e.g. 0.9 f_ptk), linear
-    /// isotropic hardening modulus `hardening` \[Pa\] (0 = perfectly plastic) and the stress
-    /// held at `cap` \[Pa\] once the hardening reaches it (f_ptk; infinity for no cap).
-    ElasticPlastic {
-        /// Yield stress f_y \[Pa\].
-        yield_stress: f64,
-        /// Plastic hardening modulus H \[Pa\] (dσ/dε_p).
-        hardening: f64,
-        /// Largest stress \[Pa\]: perfectly plastic there (≥ `yield_stress`).
-        cap: f64,
-    },
+    /// The uniaxial steel law of [`crate::materials::steel`] (yield f_y, e.g. 0.9 f_ptk,
+    /// hardening H, cap f_u), normally with isotropic hardening; its modulus is replaced by
+    /// the tendon's E_p so that one tendon has one modulus.
+    Steel(SteelParams),
     /// User-supplied nonlinear-elastic (path-independent) law σ(ε), dσ/dε.
     Custom(StressFn),
 }
@@ -71,81 +65,37 @@ impl fmt::Debug for TendonLaw {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             TendonLaw::Elastic => write!(f, "Elastic"),
-            TendonLaw::ElasticPlastic {
-                yield_stress,
-                hardening,
-                cap,
-            } => write!(
-                f,
-                "ElasticPlastic {{ yield_stress: {yield_stress}, hardening: {hardening}, cap: {cap} }}"
-            ),
+            TendonLaw::Steel(p) => write!(f, "Steel({p:?})"),
             TendonLaw::Custom(_) => write!(f, "Custom(..)"),
         }
     }
 }
 
-/// History of the steel law at one span.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
-pub struct LawState {
-    /// Plastic strain ε_p \[-\].
-    pub plastic_strain: f64,
-    /// Accumulated plastic strain (hardening variable) \[-\].
-    pub hardening_var: f64,
-}
-
 impl TendonLaw {
-    /// Prestressing steel as in the seed (MODEL.md §2.3): elastic up to 0.9 f_ptk, then
-    /// perfectly plastic. `fptk` in Pa.
+    /// Prestressing steel as in the seed (docs/theory-joints-tendons.md): elastic up to
+    /// 0.9 f_ptk, then perfectly plastic. `fptk` in Pa.
     pub fn prestressing_steel(fptk: f64) -> Self {
-        TendonLaw::ElasticPlastic {
-            yield_stress: 0.9 * fptk,
-            hardening: 0.0,
-            cap: f64::INFINITY,
-        }
+        // The modulus is the tendon's (see `Steel`); 1 Pa is a placeholder.
+        Self::from_steel(&SteelParams::prestressing(1.0, fptk))
     }
 
     /// Prestressing steel of a uniaxial steel law `steel` (yield f_y, hardening H, cap
     /// f_u: e.g. [`SteelParams::prestressing_hardening`], linear from 0.9 f_ptk to f_ptk at
-    /// ε_uk, then perfectly plastic).
-    ///
-    /// [`SteelParams::prestressing_hardening`]: crate::materials::steel::SteelParams::prestressing_hardening
-    pub fn from_steel(steel: &crate::materials::steel::SteelParams) -> Self {
-        TendonLaw::ElasticPlastic {
-            yield_stress: steel.fy,
-            hardening: steel.hardening,
-            cap: steel.fu,
-        }
+    /// ε_uk, then perfectly plastic), with **isotropic** hardening: an external tendon is
+    /// loaded in tension only (it goes slack instead of yielding in compression), so the
+    /// rule matters only after reloading from a slack state.
+    pub fn from_steel(steel: &SteelParams) -> Self {
+        TendonLaw::Steel(steel.with_rule(HardeningRule::Isotropic))
     }
 
     /// Stress \[Pa\], tangent \[Pa\] and new history for total strain `eps` \[-\], modulus `e` \[Pa\]
     /// and committed history `c`.
-    pub fn update(&self, e: f64, eps: f64, c: &LawState) -> (f64, f64, LawState) {
+    pub fn update(&self, e: f64, eps: f64, c: &SteelState) -> (f64, f64, SteelState) {
         let (sig, et, st) = match self {
             TendonLaw::Elastic => (e * eps, e, *c),
-            TendonLaw::ElasticPlastic {
-                yield_stress,
-                hardening,
-                cap,
-            } => {
-                let trial = e * (eps - c.plastic_strain);
-                let f = trial.abs() - (yield_stress + hardening * c.hardening_var).min(*cap);
-                if f <= 0.0 {
-                    (trial, e, *c)
-                } else {
-                    // Return on the hardening line, or onto the cap if that line passes it.
-                    let mut dg = f / (e + hardening);
-                    let mut tangent = e * hardening / (e + hardening);
-                    if yield_stress + hardening * (c.hardening_var + dg) > *cap {
-                        dg = (trial.abs() - cap) / e;
-                        tangent = 0.0;
-                    }
-                    let s = trial.signum();
-                    let st = LawState {
-                        plastic_strain: c.plastic_strain + s * dg,
-                        hardening_var: c.hardening_var + dg,
-                    };
-                    (trial - s * e * dg, tangent, st)
-                }
+            TendonLaw::Steel(p) => {
+                let (st, sig, et) = update_uniaxial(&SteelParams { es: e, ..*p }, c, eps);
+                (sig, et, st)
             }
             TendonLaw::Custom(fun) => {
                 let (s, t) = fun(eps);
@@ -179,11 +129,10 @@ impl TendonLaw {
                     "custom law: cannot find the strain of the initial stress {sigma} Pa"
                 )))
             }
-            TendonLaw::ElasticPlastic { yield_stress, .. } if sigma > *yield_stress => {
-                Err(TendonError::Invalid(format!(
-                    "initial stress {sigma} Pa exceeds the yield stress {yield_stress} Pa"
-                )))
-            }
+            TendonLaw::Steel(p) if sigma > p.fy => Err(TendonError::Invalid(format!(
+                "initial stress {sigma} Pa exceeds the yield stress {} Pa",
+                p.fy
+            ))),
             _ => Ok(sigma / e),
         }
     }
@@ -208,8 +157,8 @@ pub struct SpanState {
     pub force: f64,
     /// Current chord length ℓ \[m\].
     pub length: f64,
-    /// Steel-law history.
-    pub law: LawState,
+    /// Steel-law history (committed or trial, as the enclosing state).
+    pub law: SteelState,
 }
 
 /// Committed or trial state of an external tendon.
@@ -460,7 +409,7 @@ impl ExternalTendon {
                     stress: self.initial_stress[i],
                     force: self.area * self.initial_stress[i],
                     length: self.ref_lengths[i],
-                    law: LawState::default(),
+                    law: SteelState::default(),
                 })
                 .collect(),
             slips: vec![0.0; m.saturating_sub(1)],
@@ -675,11 +624,11 @@ impl ExternalTendon {
         mu: f64,
         len: &[f64],
         committed: &TendonState,
-    ) -> (Vec<f64>, Vec<i8>, Vec<(f64, f64, LawState)>) {
+    ) -> (Vec<f64>, Vec<i8>, Vec<(f64, f64, SteelState)>) {
         let m = self.n_spans();
         let nd = m.saturating_sub(1);
         let sc = &committed.slips;
-        let eval = |s: &[f64]| -> Vec<(f64, f64, LawState)> {
+        let eval = |s: &[f64]| -> Vec<(f64, f64, SteelState)> {
             (0..m)
                 .map(|i| {
                     let eps = self.span_strain(i, len[i], s);
@@ -792,7 +741,7 @@ fn capstan_residual(
     act: &[i8],
     ratio: &[f64],
     area: f64,
-    st: &[(f64, f64, LawState)],
+    st: &[(f64, f64, SteelState)],
 ) -> f64 {
     idx.iter()
         .map(|&j| {
@@ -1058,11 +1007,13 @@ mod tests {
     fn tangent_matches_finite_differences() {
         let laws = [
             TendonLaw::Elastic,
-            TendonLaw::ElasticPlastic {
-                yield_stress: 1010e6,
+            TendonLaw::from_steel(&SteelParams {
+                es: EP,
+                fy: 1010e6,
                 hardening: 5e9,
-                cap: f64::INFINITY,
-            },
+                fu: f64::INFINITY,
+                rule: HardeningRule::Isotropic,
+            }),
         ];
         for law in laws {
             for mode in [
@@ -1109,11 +1060,11 @@ mod tests {
     #[test]
     fn prestressing_steel_hardens_to_fptk_at_eps_uk() {
         let (fptk, eps_uk) = (1860e6, 0.035);
-        let steel = crate::materials::steel::SteelParams::prestressing_hardening(EP, fptk, eps_uk);
+        let steel = SteelParams::prestressing_hardening(EP, fptk, eps_uk);
         let law = TendonLaw::from_steel(&steel);
         let (fy, eps_y) = (0.9 * fptk, 0.9 * fptk / EP);
         let slope = (fptk - fy) / (eps_uk - eps_y);
-        let c = LawState::default();
+        let c = SteelState::default();
         for eps in [0.5 * eps_y, eps_y + 1e-4, 0.02, eps_uk - 1e-6] {
             let (s, t, _) = law.update(EP, eps, &c);
             let (es, et) = if eps <= eps_y {

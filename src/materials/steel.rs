@@ -1,16 +1,29 @@
-//! Uniaxial steel laws for embedded bars and tendons (MODEL.md §2.3).
+//! The uniaxial steel law of embedded bars, bar layers and external tendons
+//! (docs/theory-bars.md, docs/theory-joints-tendons.md).
 //!
 //! One law covers both rebar and prestressing steel: linear elastic up to the yield stress
-//! f_y, then linear **kinematic** hardening with modulus H (H = 0: perfectly plastic),
-//! optionally capped so that the stress never exceeds f_u in magnitude (beyond the cap the
-//! law is perfectly plastic at ±f_u). Kinematic hardening was chosen because it reproduces
-//! the Bauschinger effect on load reversal and keeps the elastic range 2 f_y wide, which is
-//! the usual choice for bars under cyclic/reversed loading; for monotonic loading it is
-//! identical to isotropic hardening. Symmetric in tension and compression.
+//! f_y, then linear hardening with modulus H (H = 0: perfectly plastic), optionally capped so
+//! that the stress never exceeds f_u in magnitude (beyond the cap the law is perfectly plastic
+//! at ±f_u). The hardening rule is a parameter ([`HardeningRule`]): **kinematic** for bars
+//! (it reproduces the Bauschinger effect on load reversal and keeps the elastic range 2 f_y
+//! wide, the usual choice under cyclic/reversed loading) and **isotropic** for external
+//! tendons (loaded monotonically in tension; [`crate::elements::tendon::TendonLaw`] adds the
+//! slack cut). For monotonic loading the two rules give the same curve. Symmetric in tension
+//! and compression.
 //!
 //! Units: stresses and moduli in Pa, strains dimensionless. The strain passed to
 //! [`update_uniaxial`] is the total mechanical strain of the bar *including* any initial
 //! (prestressing) strain; the caller adds the prestrain.
+
+/// How the elastic range moves once the steel yields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum HardeningRule {
+    /// The elastic range (width 2 f_y) translates with the back stress: Bauschinger effect.
+    #[default]
+    Kinematic,
+    /// The elastic range grows symmetrically to ±min(f_y + H ε̄_p, f_u), ε̄_p = Σ|Δε_p|.
+    Isotropic,
+}
 
 /// Parameters of the uniaxial steel law.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -24,6 +37,9 @@ pub struct SteelParams {
     pub hardening: f64,
     /// Stress cap f_u ≥ f_y [Pa]; f64::INFINITY for no cap.
     pub fu: f64,
+    /// Hardening rule (kinematic unless set by [`Self::with_rule`]).
+    #[serde(default)]
+    pub rule: HardeningRule,
 }
 
 impl SteelParams {
@@ -34,6 +50,7 @@ impl SteelParams {
             fy,
             hardening: 0.0,
             fu: f64::INFINITY,
+            rule: HardeningRule::Kinematic,
         }
     }
 
@@ -45,6 +62,7 @@ impl SteelParams {
             fy,
             hardening: es * et / (es - et),
             fu: f64::INFINITY,
+            rule: HardeningRule::Kinematic,
         }
     }
 
@@ -56,6 +74,7 @@ impl SteelParams {
             fy: 0.9 * fptk,
             hardening: 0.0,
             fu: f64::INFINITY,
+            rule: HardeningRule::Kinematic,
         }
     }
 
@@ -71,7 +90,13 @@ impl SteelParams {
             fy,
             hardening: ep * et / (ep - et),
             fu: fptk,
+            rule: HardeningRule::Kinematic,
         }
+    }
+
+    /// The same law with hardening rule `rule`.
+    pub fn with_rule(self, rule: HardeningRule) -> Self {
+        SteelParams { rule, ..self }
     }
 }
 
@@ -80,9 +105,9 @@ impl SteelParams {
 pub struct SteelState {
     /// Plastic strain ε_p [-].
     pub plastic_strain: f64,
-    /// Back stress (centre of the elastic range) [Pa].
+    /// Back stress (centre of the elastic range) [Pa]; stays 0 under isotropic hardening.
     pub back_stress: f64,
-    /// Accumulated plastic strain Σ|Δε_p| [-].
+    /// Accumulated plastic strain Σ|Δε_p| [-] (the isotropic hardening variable ε̄_p).
     pub acc_plastic: f64,
 }
 
@@ -103,6 +128,14 @@ pub fn update_uniaxial(
     committed: &SteelState,
     strain: f64,
 ) -> (SteelState, f64, f64) {
+    match p.rule {
+        HardeningRule::Kinematic => kinematic(p, committed, strain),
+        HardeningRule::Isotropic => isotropic(p, committed, strain),
+    }
+}
+
+/// Return mapping with linear kinematic hardening up to the back stress f_u − f_y.
+fn kinematic(p: &SteelParams, committed: &SteelState, strain: f64) -> (SteelState, f64, f64) {
     let e = p.es;
     let sig_tr = e * (strain - committed.plastic_strain);
     let xi = sig_tr - committed.back_stress;
@@ -134,6 +167,30 @@ pub fn update_uniaxial(
         acc_plastic: committed.acc_plastic + dgamma,
     };
     (state, sig_tr - sgn * e * dgamma, tangent)
+}
+
+/// Return mapping with linear isotropic hardening: yield radius min(f_y + H ε̄_p, f_u).
+fn isotropic(p: &SteelParams, c: &SteelState, strain: f64) -> (SteelState, f64, f64) {
+    let (e, h, cap) = (p.es, p.hardening, p.fu);
+    let trial = e * (strain - c.plastic_strain);
+    let f = trial.abs() - (p.fy + h * c.acc_plastic).min(cap);
+    if f <= 0.0 {
+        return (*c, trial, e);
+    }
+    // Return on the hardening line, or onto the cap if that line passes it.
+    let mut dg = f / (e + h);
+    let mut tangent = e * h / (e + h);
+    if p.fy + h * (c.acc_plastic + dg) > cap {
+        dg = (trial.abs() - cap) / e;
+        tangent = 0.0;
+    }
+    let s = trial.signum();
+    let state = SteelState {
+        plastic_strain: c.plastic_strain + s * dg,
+        back_stress: c.back_stress,
+        acc_plastic: c.acc_plastic + dg,
+    };
+    (state, trial - s * e * dg, tangent)
 }
 
 #[cfg(test)]
@@ -195,6 +252,32 @@ mod tests {
             "{} vs {want}",
             r[1].0
         );
+    }
+
+    /// Isotropic hardening: the elastic range grows to ±σ_max, so reverse yield happens at
+    /// −σ_max (not at σ_max − 2 f_y as with the kinematic rule); the cap f_u bounds the
+    /// radius. Hand values, 1e-12 rel (closed form, round-off only).
+    #[test]
+    fn isotropic_hardening_reverse_and_cap() {
+        let et = 2e9;
+        let p = SteelParams::rebar_hardening(ES, FY, et).with_rule(HardeningRule::Isotropic);
+        let eps_y = FY / ES;
+        let r = drive(&p, &[0.02, 0.0, -0.05]);
+        let smax = FY + et * (0.02 - eps_y);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        assert!(close(r[0].0, smax) && close(r[0].1, et));
+        // Unloading by 0.02 is elastic while 2 σ_max/E_s = 0.0103 < 0.02 of strain: reverse
+        // yield at −σ_max, then hardening again along E_t.
+        let eps_rev = 0.02 - 2.0 * smax / ES;
+        let want = -smax - et * (eps_rev - 0.0);
+        assert!(close(r[1].0, want), "{} vs {want}", r[1].0);
+        assert_eq!(r[1].2.back_stress, 0.0);
+        // With a cap the radius stops at f_u.
+        let fu = FY + 10e6;
+        let pc = SteelParams { fu, ..p };
+        let rc = drive(&pc, &[0.02, -0.02]);
+        assert!(close(rc[0].0, fu) && rc[0].1 == 0.0);
+        assert!(close(rc[1].0, -fu) && rc[1].1 == 0.0);
     }
 
     /// Prestressing steel: elastic to 0.9 f_ptk, plastic; hardening variant reaches f_ptk at

@@ -22,8 +22,8 @@ pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &str = "segfem checkpoint";
 /// Format version; bumped whenever a saved structure changes (the test `layout_has_a_version`
 /// fails until it is). 2: trailing checksum; 3: state saved by element family; 4: creep state
-/// of creeping concrete points.
-const VERSION: u32 = 4;
+/// of creeping concrete points; 5: tendon spans keep the shared steel state `SteelState`.
+const VERSION: u32 = 5;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -35,6 +35,7 @@ const CHECKSUM_BYTES: usize = 8;
 const LAYOUTS: &[(u32, u64)] = &[
     (3, 16_113_229_074_358_229_730),
     (4, 14_334_971_633_857_522_506),
+    (5, 10_812_821_786_394_591_690),
 ];
 
 #[derive(Serialize, Deserialize)]
