@@ -1,4 +1,4 @@
-//! Uniaxial steel laws for embedded bars and tendons (MODEL.md §2.3).
+//! Uniaxial steel laws for embedded bars and tendons (docs/theory-concrete.md §6).
 //!
 //! One law covers both rebar and prestressing steel: linear elastic up to the yield stress
 //! f_y, then linear **kinematic** hardening with modulus H (H = 0: perfectly plastic),
@@ -48,8 +48,8 @@ impl SteelParams {
         }
     }
 
-    /// Prestressing steel (seed + MODEL.md §2.3 decision): linear elastic up to 0.9 f_ptk,
-    /// then perfectly plastic. `ep` [Pa], `fptk` [Pa].
+    /// Prestressing steel (seed + a project decision, docs/theory-concrete.md §6): linear elastic
+    /// up to 0.9 f_ptk, then perfectly plastic. `ep` [Pa], `fptk` [Pa].
     pub fn prestressing(ep: f64, fptk: f64) -> Self {
         SteelParams {
             es: ep,
