@@ -131,8 +131,8 @@ jacking_stress = 1000e6
     )
 }
 
-/// Friction along the tendon as built in the model (seed eq. 27, MODEL.md §8.2): at every
-/// integration point of a parabolic tendon jacked from the start and of a straight – arc –
+/// Friction along the tendon as built in the model (seed eq. 27, docs/theory-joints-tendons.md §3):
+/// at every integration point of a parabolic tendon jacked from the start and of a straight – arc –
 /// straight chain jacked from both ends, the lock-off stress equals
 /// σ_pi exp[−μ(Δα + k s)], with Δα and s computed here in closed form from the point's
 /// abscissa (parabola: Δα = atan y′(x) − atan y′(0), s by the exact arc-length integral;

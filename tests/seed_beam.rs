@@ -1,6 +1,6 @@
-//! The seed's validation beam (VALIDATION.md §1): a 7.2 m dry-jointed segmental box beam
-//! with one external tendon, from the bundled example. Checks the behaviour the seed reports
-//! (joints closed at service load, first opening between 56 and 70 kN, tendon stress rising
+//! The seed's validation beam (docs/validation.md, "The seed beam"): a 7.2 m dry-jointed segmental
+//! box beam with one external tendon, from the bundled example. Checks the behaviour the seed
+//! reports (joints closed at service load, first opening between 56 and 70 kN, tendon stress rising
 //! faster once joints open) and compares deflections and the largest opening with the
 //! seed's computed values; then the run on to failure against statics of the opened joint.
 
@@ -82,8 +82,8 @@ fn seed_beam_behaves_as_the_seed_reports() {
         (s56.0 - 56.0).abs() < 1e-9 && s56.4,
         "joints must be closed and compressed at Q = 56 kN"
     );
-    // Elastic deflection from Q = 56 kN against the hand value of VALIDATION.md §1 (1.7 mm,
-    // beam theory without shear deformation: the FE value is a few per cent larger).
+    // Elastic deflection from Q = 56 kN against the hand value of docs/validation.md "The seed
+    // beam" (1.7 mm, beam theory without shear deformation: the FE value is a few per cent larger).
     let d56 = u0 - s56.1;
     assert!(
         (d56 - 1.7e-3).abs() < 0.1 * 1.7e-3,

@@ -69,7 +69,8 @@ fn run(text: &str) -> Vec<Rec> {
     k.0
 }
 
-/// The MC90 data of MODEL.md's checks: fcm 45 MPa, RH 70 %, h = 200 mm, cement N.
+/// The MC90 data of the check case (docs/theory-time.md §2): fcm 45 MPa, RH 70 %, h = 200 mm,
+/// cement N.
 fn params(drying_start: f64) -> CreepShrinkageParams {
     CreepShrinkageParams::new(45e6, 0.70, 0.200, CementClass::N, drying_start)
 }

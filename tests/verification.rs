@@ -468,7 +468,7 @@ fn reactions_of_the_simply_supported_box_beam_match_statics() {
 
 /// Section properties integrated over the generated mesh (element areas × region
 /// thicknesses) equal the closed-form values of the bands, and the hand values of
-/// VALIDATION.md §1 for the seed beam's box section.
+/// docs/validation.md ("The seed beam", hand check) for the seed beam's box section.
 #[test]
 fn banded_generator_reproduces_section_properties() {
     let depths = [0.10, 0.40, 0.10];
@@ -507,7 +507,7 @@ fn banded_generator_reproduces_section_properties() {
                 && (c - c_ref).abs() < 1e-12
                 && (i - i_ref).abs() < 1e-12 * i_ref.max(1.0)
         );
-        // VALIDATION.md §1 hand values, given to 3–4 significant digits.
+        // Hand values of docs/validation.md "The seed beam", given to 3–4 significant digits.
         assert!(
             (a - 0.270).abs() < 5e-4 && (c - 0.346).abs() < 5e-4 && (i - 0.01252).abs() < 5e-6,
             "{a} {c} {i}"

@@ -1,6 +1,7 @@
 //! Analysis: steps, the Newton loop, and the linear-solver wrapper.
 
 pub mod bonded_time;
+mod driver;
 pub mod failure;
 pub mod families;
 pub mod loads;

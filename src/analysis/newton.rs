@@ -1,6 +1,15 @@
-//! Helpers of the Newton iterations shared by the step drivers (`steps`, `path`): norms and
-//! the residual-history tests. Pure functions of their arguments; this module calls no
-//! driver, so the drivers can share it without calling each other for it.
+//! The Newton iterations shared by the step drivers (`steps`, `path`): the Newton–Raphson
+//! loop of one increment (`newton`), the residual at an iterate, the overshoot test the
+//! drivers backtrack on, norms and the residual-history tests. This module calls no driver,
+//! so the drivers share it without calling each other for it.
+
+use super::driver::Timings;
+use super::failure::NewtonFailure;
+use super::solver::SparseCholesky;
+use super::system::System;
+use crate::fem::dofs::CONSTRAINED;
+use crate::model::StepKind;
+use std::time::Instant;
 
 /// Euclidean norm of `v`.
 pub(super) fn norm(v: &[f64]) -> f64 {
@@ -26,4 +35,151 @@ pub(super) fn damping(history: &[f64]) -> f64 {
         i -= 1;
     }
     0.5_f64.powi(k)
+}
+
+/// Growth of the relative residual over one Newton correction beyond which the displacement
+/// driver backtracks along that correction [-]: well above the ups and downs of an iteration
+/// that crosses a kink (≤ 1.5 on the RC beam), well below the jumps of an overshoot (10×).
+const BACKTRACK_GROWTH: f64 = 2.0;
+
+/// Whether a Newton correction overshot: the relative residual after it grew more than
+/// [`BACKTRACK_GROWTH`] × the one before it, or is not a number.
+pub(super) fn overshot(after: f64, before: f64) -> bool {
+    after.is_nan() || after > BACKTRACK_GROWTH * before
+}
+
+/// Newton–Raphson for one increment: returns the converged internal forces and iterations.
+pub(super) fn newton(
+    sys: &mut System,
+    solver: &mut SparseCholesky,
+    u: &mut [f64],
+    f_ext: &[f64],
+    timings: &mut Timings,
+    factored_linear: &mut bool,
+    kind: StepKind,
+) -> Result<(Vec<f64>, usize), NewtonFailure> {
+    let c = &sys.model.controls;
+    let max_it = if kind == StepKind::Linear {
+        2
+    } else {
+        c.max_iterations
+    };
+    let mut history = Vec::new();
+    let mut first_energy: Option<f64> = None;
+    let mut last_energy: Option<f64> = None;
+    // The last correction (free equations) and the relative residual before it.
+    let mut last: Option<(Vec<f64>, f64)> = None;
+    for it in 0..=max_it {
+        let need_k = !(sys.linear && *factored_linear);
+        let mut eval = residual_at(sys, u, f_ext, need_k, timings);
+        if let Some((du, rel0)) = last.take() {
+            // An overshooting correction (residual grown more than 2×, or a material update
+            // failing at its strains) is halved, up to three times ([`overshot`]).
+            let mut s = 1.0;
+            while s > 0.2 && eval.as_ref().map_or(true, |e| overshot(e.3, rel0)) {
+                s *= 0.5;
+                for (d, &q) in sys.dofs.eq.iter().enumerate() {
+                    if q != CONSTRAINED {
+                        u[d] -= s * du[q];
+                    }
+                }
+                eval = residual_at(sys, u, f_ext, need_k, timings);
+                if c.verbose {
+                    let r = eval.as_ref().map_or(f64::NAN, |e| e.3);
+                    eprintln!(
+                        "    residual grew: back to {s:.3} of the last correction, relative residual {r:.3e}"
+                    );
+                }
+            }
+        }
+        let (a, r, rf, rel) = eval?;
+        let rnorm = norm(&rf);
+        if !rel.is_finite() {
+            history.push(rel);
+            return Err(NewtonFailure::diverged(history, rf));
+        }
+        history.push(rel);
+        if cycling(&history) {
+            sys.freeze_cracks();
+        }
+        if c.verbose {
+            eprintln!(
+                "    iteration {it:2}: relative residual {rel:.3e}, last energy {:.3e}",
+                last_energy.unwrap_or(0.0)
+            );
+        }
+        // Converged on force, or on energy (|Δu·r| of the last correction small against the
+        // first one) once at least one correction has been made.
+        let energy_ok = it > 1
+            && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= c.energy_tolerance * e0);
+        if rnorm == 0.0 || (it > 0 && (rel <= c.force_tolerance || energy_ok)) {
+            return Ok((a.f_int, it));
+        }
+        if it == max_it {
+            return Err(NewtonFailure::diverged(history, rf));
+        }
+        if let Some(k) = a.k_values {
+            if sys.linear {
+                solver
+                    .factorize(&sys.asm.pattern, &k)
+                    .map_err(NewtonFailure::Singular)?;
+            } else {
+                // Nonlinear tangents may be indefinite (softening): LDLᵀ fallback.
+                solver
+                    .factorize_indefinite(&sys.asm.pattern, &k)
+                    .map_err(NewtonFailure::Singular)?;
+            }
+            *factored_linear = sys.linear;
+        }
+        let mut du = rf;
+        solver.solve_in_place(&mut du);
+        // Damped correction while the residual stagnates (cycling across a kink of the
+        // material response); see [`damping`].
+        let damp = damping(&history);
+        if damp < 1.0 {
+            du.iter_mut().for_each(|v| *v *= damp);
+        }
+        let energy = du
+            .iter()
+            .zip(&sys.to_free(&r))
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            .abs();
+        first_energy.get_or_insert(energy);
+        last_energy = Some(energy);
+        for (d, &q) in sys.dofs.eq.iter().enumerate() {
+            if q != CONSTRAINED {
+                u[d] += du[q];
+            }
+        }
+        if it > 0 && !sys.linear {
+            last = Some((du, rel));
+        }
+    }
+    // The loop returns at its last iteration; this is for max_it = usize::MAX only.
+    Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// An assembly, the full and free residuals [N] and the relative residual norm [-].
+type Evaluated = (crate::analysis::system::Assembled, Vec<f64>, Vec<f64>, f64);
+
+/// Assembly at `u` (with the tangent if `need_k`), crack latching, and the residual; the
+/// relative norm is taken against the larger of the external force norm and the
+/// element-force scale (which stays finite under self-equilibrated prestress).
+fn residual_at(
+    sys: &mut System,
+    u: &[f64],
+    f_ext: &[f64],
+    need_k: bool,
+    timings: &mut Timings,
+) -> Result<Evaluated, NewtonFailure> {
+    let t = Instant::now();
+    let a = sys.assemble(u, need_k).map_err(NewtonFailure::material)?;
+    sys.latch_cracks();
+    timings.assembly_s += t.elapsed().as_secs_f64();
+    let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
+    let rf = sys.to_free(&r);
+    let reference = norm(f_ext).max(a.force_scale).max(f64::MIN_POSITIVE);
+    let rel = norm(&rf) / reference;
+    Ok((a, r, rf, rel))
 }

@@ -3,12 +3,10 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
-use super::failure::{report, FailedAt};
-use super::newton::{cycling, damping, norm};
+use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
+use super::failure::{report, FailedAt, NewtonFailure};
+use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
-use super::steps::{
-    check_stop, newton, note_limit_point, AnalysisError, NewtonFailure, Observer, Snapshot, Timings,
-};
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::{ArcLengthControl, PathControl, Step, StepKind};
@@ -380,17 +378,6 @@ fn newton_controlled(
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
-}
-
-/// Growth of the relative residual over one Newton correction beyond which the displacement
-/// driver backtracks along that correction [-]: well above the ups and downs of an iteration
-/// that crosses a kink (≤ 1.5 on the RC beam), well below the jumps of an overshoot (10×).
-const BACKTRACK_GROWTH: f64 = 2.0;
-
-/// Whether a Newton correction overshot: the relative residual after it grew more than
-/// [`BACKTRACK_GROWTH`] × the one before it, or is not a number.
-pub(super) fn overshot(after: f64, before: f64) -> bool {
-    after.is_nan() || after > BACKTRACK_GROWTH * before
 }
 
 /// One Newton correction of the displacement driver, kept to backtrack along it.

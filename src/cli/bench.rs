@@ -419,8 +419,8 @@ impl Observer for Reach {
 /// then its arc-length step on Q until the midspan deflection reaches 0.12 m, L/60) refined
 /// `refine` times; the run ends there, where Newton gives up (the furthest point the model
 /// reaches), or after 400 increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
-/// the same strength (fcm = 45 MPa, VALIDATION.md §1, IMPL-EX cracking) with elastic end
-/// blocks of 0.3 m at the anchors and the solver settings of the RC beam example.
+/// the same strength (fcm = 45 MPa, docs/validation.md "The seed beam", IMPL-EX cracking) with
+/// elastic end blocks of 0.3 m at the anchors and the solver settings of the RC beam example.
 pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, String> {
     let r = refine.max(1);
     let mut text = seed_text(r);

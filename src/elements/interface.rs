@@ -1,6 +1,7 @@
 //! Joint contact (interface) element between two precast segments, after the contact element
 //! of Habraken & Cescotto (1998) as described in Ribeiro, Campos Filho & Pacheco (2006), §4,
-//! with the small-displacement kinematics and penalty/Coulomb law of MODEL.md §7.
+//! with the small-displacement kinematics and penalty/Coulomb law of
+//! docs/theory-joints-tendons.md §1.
 //!
 //! * Face A: 2 or 3 nodes (an edge of a Q4 or Q8/Q9 element of segment A), given in the
 //!   counter-clockwise edge order of its element (start, end, \[middle\]), so that body A lies to
@@ -8,8 +9,8 @@
 //! * Face B: 2 or 3 nodes (an edge of the opposite segment), any orientation.
 //! * At every integration point ξ_g of face A the opposite point on B is found once, in the
 //!   reference configuration, by solving `x_B(ζ_B) − x_A − λ0 n_A = 0` (Newton).
-//! * Small displacements (MODEL.md §7.1 DECISION): with Δu = u_B(ζ_B) − u_A(ξ_g),
-//!   `λ = λ0 + Δu·n_A` (λ ≥ 0: closed, λ = penetration; λ < 0: open, gap −λ) and
+//! * Small displacements (a project decision, docs/theory-joints-tendons.md §1): with Δu = u_B(ζ_B)
+//!   − u_A(ξ_g), `λ = λ0 + Δu·n_A` (λ ≥ 0: closed, λ = penetration; λ < 0: open, gap −λ) and
 //!   `g_t = Δu·t_A` (tangential relative displacement).
 //!
 //! Units: coordinates and displacements in m, penalty stiffnesses in Pa/m, stresses in Pa,
@@ -61,7 +62,8 @@ impl InterfaceParams {
         }
     }
 
-    /// Dry shear-keyed joint (closed → stick, only opening modelled; MODEL.md §7.3 option 1).
+    /// Dry shear-keyed joint (closed → stick, only opening modelled; `keyed` in
+    /// docs/theory-joints-tendons.md §1).
     pub fn keyed(kn: f64, kt: f64) -> Self {
         Self {
             keyed: true,
@@ -296,8 +298,9 @@ pub struct JointLawResult {
     pub sliding: bool,
 }
 
-/// Penalty/Coulomb joint law (MODEL.md §7.2) for one point: `lambda` \[m\] (penetration
-/// positive), `g_t` \[m\], committed plastic slip `sp_c` \[m\] and bond flag `bonded_c`.
+/// Penalty/Coulomb joint law (docs/theory-joints-tendons.md §1) for one point: `lambda` \[m\]
+/// (penetration positive), `g_t` \[m\], committed plastic slip `sp_c` \[m\] and bond flag
+/// `bonded_c`.
 ///
 /// * bonded (epoxy intact): σ_n = K_n λ in compression and tension; if −σ_n > f_t the point
 ///   debonds and is evaluated as dry in the same call;
@@ -565,8 +568,8 @@ impl InterfaceElement {
 
     /// As [`Self::response`]; with `symmetric_tangent` the friction coupling term of sliding
     /// points (∂τ/∂λ = μ K_n) is dropped, which keeps the tangent symmetric and positive
-    /// semi-definite for a Cholesky solver (MODEL.md §7.2); Newton then converges linearly
-    /// while points slide, to the same answer.
+    /// semi-definite for a Cholesky solver (docs/theory-joints-tendons.md §1); Newton then
+    /// converges linearly while points slide, to the same answer.
     pub fn response_with(
         &self,
         params: &InterfaceParams,
@@ -665,7 +668,8 @@ pub struct JointNeighbour {
 }
 
 /// Default penalty factor of [`suggest_normal_stiffness`]: the joint's penetration is 1/100 of
-/// the elastic shortening of the two adjacent element layers (MODEL.md §7.2: 10…1000).
+/// the elastic shortening of the two adjacent element layers (docs/theory-joints-tendons.md §1:
+/// 10…1000).
 pub const DEFAULT_PENALTY_FACTOR: f64 = 100.0;
 
 /// Suggested normal penalty K_n \[Pa/m\] for a joint of thickness `joint_thickness` \[m\] between
@@ -745,8 +749,8 @@ mod tests {
 
     /// Check 18: uniform compression σ; A fixed, consistent nodal loads on B (pushing B into
     /// A, i.e. along n_A = −y). Penetration must be σ/K_n at every point and the resultant of
-    /// the contact forces σ·b·L. Tolerance 1e-8 rel (MODEL.md §9 #18; round-off of a 4×4…6×6
-    /// dense solve with entries ~1e11 is ~1e-15 rel).
+    /// the contact forces σ·b·L. Tolerance 1e-8 rel (check 18, docs/theory-joints-tendons.md §4;
+    /// round-off of a 4×4…6×6 dense solve with entries ~1e11 is ~1e-15 rel).
     #[test]
     fn uniform_compression_penetration_and_resultant() {
         let sigma = 12e6;

@@ -1,5 +1,5 @@
 //! External (unbonded) prestressing tendon connected to the structure only at its anchors
-//! and deviators (MODEL.md §8.3–8.4).
+//! and deviators (docs/theory-joints-tendons.md §2).
 //!
 //! The tendon is a chain of points P_0 (anchor), P_1 … P_{m−1} (deviators), P_m (anchor) with
 //! straight spans between them. Span i joins P_i and P_{i+1}. Kinematics are corotational:

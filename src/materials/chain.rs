@@ -1,12 +1,12 @@
 //! Ageing Maxwell chain (Bažant & Wu 1974) for MC90 creep of concrete in plane stress, and a
 //! non-ageing uniaxial chain for the relaxation of prestressing steel.
 //!
-//! Formulation as implemented (`design/MODEL.md` §4, `docs/theory-time.md`):
+//! Formulation as implemented (docs/theory-time.md §2–§3):
 //!
 //! * N Maxwell units in parallel under the same strain; unit μ has an ageing spring E_μ(t)
 //!   and a dashpot with constant relaxation time τ_μ (a unit with τ = ∞ is a pure spring).
 //!   Relaxation function R(t, t') = Σ_μ E_μ(t') exp(−(t − t')/τ_μ).
-//! * Relaxation times (§4.2): **[DECISION, MODEL.md]** for the paper's 5 units
+//! * Relaxation times: **[DECISION, docs/theory-time.md §2]** for the paper's 5 units
 //!   τ = {1, 10, 100, 1000, ∞} days; for other N one unit per decade ending at 1000 d, plus
 //!   the spring unit (N = 6 → {0.1, 1, …, 1000, ∞}).
 //! * R(t, t') from the MC90 compliance by the step-by-step (midpoint) method (§4.3) on a
@@ -48,7 +48,8 @@ pub struct ChainSettings {
 
 impl ChainSettings {
     /// Default settings for `n_units` ≥ 2 units: τ one per decade ending at 1000 d plus a
-    /// spring (τ = ∞); n = 5 gives the MODEL.md set {1, 10, 100, 1000, ∞} d.
+    /// spring (τ = ∞); n = 5 gives the default set {1, 10, 100, 1000, ∞} d
+    /// (docs/theory-time.md §2).
     pub fn with_units(n_units: usize) -> Result<Self, TimeModelError> {
         if n_units < 2 {
             return Err(TimeModelError::InvalidParameter(
@@ -260,7 +261,7 @@ fn geometric_grid(start: f64, end: f64, per_decade: usize) -> Vec<f64> {
 
 /// Relaxation function R(t' + d_k, t') \[Pa\] of the MC90 compliance for loading age
 /// `t_prime` \[days\], at the increasing durations `durations` \[days\] (all > 0), by the
-/// step-by-step midpoint method of MODEL.md §4.3 (jump ΔR_0 = 1/J(t', t') = E_ci(t') at
+/// step-by-step midpoint method of docs/theory-time.md §2 (jump ΔR_0 = 1/J(t', t') = E_ci(t') at
 /// loading, then the grid given by `durations`; accuracy depends on that grid — about
 /// 0.3 % with 30 points per decade from 1e-3 d).
 pub fn relaxation_function(p: &CreepShrinkageParams, t_prime: f64, durations: &[f64]) -> Vec<f64> {
@@ -481,8 +482,9 @@ fn beta_lambda(dt: f64, tau: f64) -> (f64, f64) {
 }
 
 /// Quantities of the step from concrete age `t_from` to `t_to` \[days\] that do not depend on
-/// the strain increment: E'' and Δε'' (MODEL.md §4.5), with the unit moduli at the mid-step
-/// age ½(t_from + t_to). `nu` = Poisson ratio (constant). Panics if `t_to < t_from`.
+/// the strain increment: E'' and Δε'' (docs/theory-time.md §2, exponential algorithm), with the
+/// unit moduli at the mid-step age ½(t_from + t_to). `nu` = Poisson ratio (constant). Panics if
+/// `t_to < t_from`.
 pub fn chain_predictor(
     chain: &MaxwellChain,
     nu: f64,
@@ -514,8 +516,8 @@ pub fn chain_predictor(
     }
 }
 
-/// One exponential-algorithm step (MODEL.md §4.5) from age `t_from` to `t_to` \[days\] for a
-/// total-strain increment `d_strain` \[-\] (Voigt, engineering shear) with an imposed
+/// One exponential-algorithm step (docs/theory-time.md §2) from age `t_from` to `t_to` \[days\] for
+/// a total-strain increment `d_strain` \[-\] (Voigt, engineering shear) with an imposed
 /// stress-free strain increment `d_imposed` \[-\] (shrinkage, temperature, …):
 ///
 /// Δσ = E'' D1 (Δε − Δε'' − Δε_imp),  σ_μ ← β_μ σ_μ + λ_μ E_μ D1 (Δε − Δε_imp).
@@ -589,7 +591,7 @@ pub fn chain_step(
 }
 
 // ---------------------------------------------------------------------------------------
-// Non-ageing uniaxial chain for prestressing-steel relaxation (MODEL.md §4.6)
+// Non-ageing uniaxial chain for prestressing-steel relaxation (docs/theory-time.md §3)
 // ---------------------------------------------------------------------------------------
 
 /// Non-ageing uniaxial Maxwell chain for the relaxation of prestressing steel, fitted to the
@@ -597,7 +599,7 @@ pub fn chain_step(
 /// initial stress ratio (the paper: "the same rheological model … for the prestressing
 /// steel relaxation"). Linear: under a varying strain the loss follows by superposition.
 ///
-/// **\[DECISION\]** MODEL.md §4.6 notes that five units represent the power law poorly
+/// **\[DECISION\]** (docs/theory-time.md §3) five units represent the power law poorly
 /// (≈ 35 % error on the 1000 h loss). Since the chain is uniaxial and cheap, the default uses
 /// two units per decade, τ = 10^(k/2) × 1e-3 d up to 1e5 d, plus a spring, and fits the loss
 /// with relative weights on 1e-3 … 2e4 d (≈ 1.4 min … 5·10⁵ h) under the constraint
@@ -751,7 +753,7 @@ mod tests {
     use super::super::mc90_time::{compliance, relaxation_loss, CementClass};
     use super::*;
 
-    /// MODEL.md check data: fcm 45 MPa, RH 70 %, h = 200 mm, cement N.
+    /// The check case of docs/theory-time.md §2: fcm 45 MPa, RH 70 %, h = 200 mm, cement N.
     fn params() -> CreepShrinkageParams {
         CreepShrinkageParams::new(45.0e6, 0.70, 0.200, CementClass::N, 7.0)
     }
@@ -770,9 +772,10 @@ mod tests {
         assert!(ChainSettings::with_units(1).is_err());
     }
 
-    /// Check 13: R(t, 28) by the step-by-step method against MODEL.md §4.3 (200-step,
-    /// 1e-3 d grid). Tolerance 1 %: the reference itself is converged only to ≈ 0.3 % and
-    /// our grid (30/decade) differs slightly; a wrong jump or midpoint gives > 5 %.
+    /// Check 13: R(t, 28) by the step-by-step method of docs/theory-time.md §2 against a
+    /// reference solution of the same method (200-step, 1e-3 d grid). Tolerance 1 %: the reference
+    /// itself is converged only to ≈ 0.3 % and our grid (30/decade) differs slightly; a wrong jump
+    /// or midpoint gives > 5 %.
     #[test]
     fn check_13_relaxation_function() {
         let p = params();
@@ -841,8 +844,9 @@ mod tests {
     }
 
     /// Check 15: all E_μ(t') > 0 for τ = {1, 10, 100, 1000, ∞} and t' from 3 to 365 d; the
-    /// 28-day fit approximates MODEL.md §4.4 (procedure-dependent ±1 %, so 5 % on the sum and
-    /// on the spring) and reproduces R within the quoted maximum fit error (1.6 % → 2.5 %).
+    /// 28-day fit approximates the reference fit quoted in docs/theory-time.md §2
+    /// (procedure-dependent ±1 %, so 5 % on the sum and on the spring) and reproduces R within the
+    /// quoted maximum fit error (1.6 % → 2.5 %).
     #[test]
     fn check_15_unit_moduli_positive() {
         let p = params();
@@ -922,8 +926,8 @@ mod tests {
             .collect()
     }
 
-    /// Check 14 (MODEL.md §4.5): unit stress at t0 = 28, 61 log steps 1e-2 … 1e4 d.
-    /// Tolerances 1 % for t − t0 ≥ 1 d and 2 % at 0.1 d as MODEL.md §9 (the 5-unit fit
+    /// Check 14 (docs/theory-time.md §2 and §5): unit stress at t0 = 28, 61 log steps 1e-2 … 1e4 d.
+    /// Tolerances 1 % for t − t0 ≥ 1 d and 2 % at 0.1 d as docs/theory-time.md §5 (the 5-unit fit
     /// misses the very fast creep); a wrong E'' or β/λ gives errors of tens of %.
     #[test]
     fn check_14_creep_reproduction_28d() {
@@ -945,7 +949,8 @@ mod tests {
     }
 
     /// Brief: constant-stress creep against MC90 J within 2 % from 1 to 1e4 days for
-    /// t0 = 7, 28, 365 d (2 %: fit error of the 5-unit chain at young ages, MODEL.md §4.4).
+    /// t0 = 7, 28, 365 d (2 %: fit error of the 5-unit chain at young ages, docs/theory-time.md
+    /// §2).
     #[test]
     fn creep_reproduction_several_loading_ages() {
         let p = params();

@@ -1,4 +1,4 @@
-//! CEB-FIP Model Code 1990 short-term concrete functions (MODEL.md §1.1, §1.3, §2.1, §2.2).
+//! CEB-FIP Model Code 1990 short-term concrete functions (docs/theory-concrete.md §1).
 //!
 //! Units: stresses and moduli in Pa, strains dimensionless, time in days. All functions are
 //! pure; none of them panics for finite input (out-of-domain input gives NaN or is clamped,
@@ -14,7 +14,7 @@ pub const EPS_C1: f64 = 0.0022;
 /// [`f_tm`]].
 pub const C_MEAN: f64 = 0.14;
 
-/// Which compressive strength enters the tensile-strength formula (MODEL.md §1.1).
+/// Which compressive strength enters the tensile-strength formula (docs/theory-concrete.md §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TensileRef {
     /// f_ref = f_cm (what the seed paper states; default).
@@ -25,7 +25,7 @@ pub enum TensileRef {
 
 /// Mean tensile strength f_tm [Pa] from the mean compressive strength `fcm` [Pa].
 ///
-/// Seed eq. 19 with the exponent corrected to 2/3 (MODEL.md §1.1):
+/// Seed eq. 19 with the exponent corrected to 2/3 (docs/theory-concrete.md §1):
 /// f_tm [kN/cm²] = C · (f_ref [kN/cm²])^(2/3), i.e. f_tm = 10 MPa · C · (f_ref/10 MPa)^(2/3).
 /// `c` is dimensionless in this form (0.095 lower, 0.14 mean, 0.185 upper characteristic).
 /// Returns 0 if f_ref ≤ 0.
@@ -64,7 +64,8 @@ pub fn eci_t(fcm: f64, t: f64, s: f64) -> f64 {
     beta_cc(t, s).sqrt() * eci(fcm)
 }
 
-/// Ottosen four-parameter criterion constants (dimensionless), MC90 expressions (MODEL.md §1.3).
+/// Ottosen four-parameter criterion constants (dimensionless), MC90 expressions
+/// (docs/theory-concrete.md §1).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OttosenParams {
     /// α (coefficient of J2/f_cm²) [-].
@@ -93,7 +94,8 @@ impl OttosenParams {
     }
 }
 
-/// MC90 uniaxial compression curve (MODEL.md §2.2) in magnitudes: ε, σ > 0 in compression.
+/// MC90 uniaxial compression curve (docs/theory-concrete.md §1) in magnitudes: ε, σ > 0 in
+/// compression.
 ///
 /// Ascending branch (η = ε/ε_c1 ≤ η_lim): σ = f_cm (k_p η − η²)/(1 + (k_p − 2) η),
 /// k_p = E ε_c1 / f_cm; descending branch (η > η_lim):
@@ -202,8 +204,8 @@ mod tests {
         ((a - b) / b).abs()
     }
 
-    /// MODEL.md §9 check 1: f_tm table of §1.1 (tolerance 1e-5 rel: the table has 6
-    /// significant digits).
+    /// Check 1 (docs/theory-concrete.md §7): f_tm by the formula of §1 (tolerance 1e-5 rel:
+    /// the hand values have 6 significant digits).
     #[test]
     fn check1_ftm_table() {
         let fcm = 45e6;
@@ -224,7 +226,7 @@ mod tests {
         assert!(f_tm(fcm, 0.14, TensileRef::Fcm) < 5e6);
     }
 
-    /// MODEL.md §9 check 2: α, β, c1, c2 (1e-5 rel; table printed to 6 digits).
+    /// Check 2 (docs/theory-concrete.md §7): α, β, c1, c2 (1e-5 rel; hand values to 6 digits).
     #[test]
     fn check2_ottosen_params() {
         let table = [
@@ -242,8 +244,8 @@ mod tests {
         }
     }
 
-    /// MODEL.md §9 check 8: E_ci, β_cc, f_cm(t), E_ci(t) (1e-5 rel; table values have 5–6
-    /// significant digits, the t = 3 d β_cc only 5, hence 2e-5 there).
+    /// Check 8 (docs/theory-concrete.md §7): E_ci, β_cc, f_cm(t), E_ci(t) (1e-5 rel; hand values
+    /// have 5–6 significant digits, the t = 3 d β_cc only 5, hence 2e-5 there).
     #[test]
     fn check8_moduli_and_ageing() {
         let fcm = 45e6;
@@ -264,8 +266,8 @@ mod tests {
         }
     }
 
-    /// MODEL.md §9 check 9: MC90 σ–ε curve, η_lim, ξ, continuity at η_lim (1e-4 rel per
-    /// the checklist; values are printed to 6 digits).
+    /// Check 9 (docs/theory-concrete.md §7): MC90 σ–ε curve, η_lim, ξ, continuity at η_lim
+    /// (1e-4 rel; the hand values have 6 digits).
     #[test]
     fn check9_compression_curve() {
         let fcm = 45e6;

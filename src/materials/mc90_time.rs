@@ -1,7 +1,7 @@
 //! CEB-FIP Model Code 1990 time functions: creep coefficient φ(t, t0), creep compliance
 //! J(t, t0), shrinkage ε_cs(t, ts) and prestressing-steel relaxation ρ(t).
 //!
-//! Formulas follow `design/MODEL.md` §2.1, §3.1–§3.3 (MC90). Conventions of this module:
+//! Formulas follow docs/theory-time.md §1 (CEB-FIP Model Code 1990). Conventions of this module:
 //!
 //! * **time and ages in days** (t1 = 1 d), counted from casting of the concrete in question;
 //! * **stresses and moduli in Pa**, compliances in 1/Pa;
@@ -9,7 +9,7 @@
 //! * strains dimensionless, negative = shortening.
 //!
 //! Optional MC90 adjustments (cement type on the loading age, temperature) are off by default,
-//! as MODEL.md §3.1 recommends; with them off the check values of MODEL.md §3.1/§3.2 are
+//! a project decision (docs/theory-time.md §1); with them off the check values (checks 11–12) are
 //! reproduced to 1e-5 (tests below).
 
 use serde::{Deserialize, Serialize};
@@ -52,7 +52,7 @@ pub enum CementClass {
 }
 
 impl CementClass {
-    /// Strength-development coefficient s of β_cc(t) \[-\] (MODEL.md §2.1).
+    /// Strength-development coefficient s of β_cc(t) \[-\] (MC90; docs/theory-time.md §1).
     pub fn s(self) -> f64 {
         match self {
             CementClass::SL => 0.38,
@@ -60,7 +60,7 @@ impl CementClass {
             CementClass::RS => 0.20,
         }
     }
-    /// Shrinkage coefficient β_sc \[-\] (MODEL.md §3.2).
+    /// Shrinkage coefficient β_sc \[-\] (MC90 shrinkage; docs/theory-time.md §1).
     pub fn beta_sc(self) -> f64 {
         match self {
             CementClass::SL => 4.0,
@@ -68,7 +68,7 @@ impl CementClass {
             CementClass::RS => 8.0,
         }
     }
-    /// Exponent α of the cement-type adjustment of the loading age \[-\] (MODEL.md §3.1).
+    /// Exponent α of the cement-type adjustment of the loading age \[-\] (docs/theory-time.md §1).
     pub fn alpha(self) -> f64 {
         match self {
             CementClass::SL => -1.0,
@@ -141,7 +141,7 @@ impl CreepShrinkageParams {
         Ok(())
     }
 
-    /// 28-day tangent modulus E_ci = 21500 (fcm/10 MPa)^(1/3) MPa \[Pa\] (MODEL.md §2.1).
+    /// 28-day tangent modulus E_ci = 21500 (fcm/10 MPa)^(1/3) MPa \[Pa\] (docs/theory-time.md §1).
     pub fn eci(&self) -> f64 {
         21_500.0e6 * (self.fcm / FCMO).cbrt()
     }
@@ -299,7 +299,7 @@ pub fn high_stress_creep_factor(stress_ratio: f64) -> f64 {
 }
 
 // ---------------------------------------------------------------------------------------
-// Relaxation of prestressing steel (MODEL.md §3.3)
+// Relaxation of prestressing steel (docs/theory-time.md §1)
 // ---------------------------------------------------------------------------------------
 
 /// MC90 relaxation class of prestressing steel.
@@ -315,7 +315,7 @@ pub enum RelaxationClass {
 
 impl RelaxationClass {
     /// 1000-hour relaxation ρ1000 [fraction of the initial stress] at initial stress ratios
-    /// σ_pi/f_ptk = 0.6, 0.7, 0.8 (MODEL.md §3.3 table).
+    /// σ_pi/f_ptk = 0.6, 0.7, 0.8 (MC90 class table; docs/theory-time.md §1).
     pub fn rho1000_table(self) -> [f64; 3] {
         match self {
             RelaxationClass::Class1 => [0.045, 0.08, 0.12],
@@ -409,7 +409,8 @@ pub fn relaxation_loss_ec2(class: RelaxationClass, sigma_pi_over_fpk: f64, t_day
 mod tests {
     use super::*;
 
-    /// MODEL.md check data: fcm 45 MPa, RH 70 %, h = 200 mm, cement N (s = 0.25, β_sc = 5).
+    /// The check case of docs/theory-time.md §2: fcm 45 MPa, RH 70 %, h = 200 mm, cement N
+    /// (s = 0.25, β_sc = 5).
     fn check_params(ts: f64) -> CreepShrinkageParams {
         CreepShrinkageParams::new(45.0e6, 0.70, 0.200, CementClass::N, ts)
     }
@@ -418,8 +419,8 @@ mod tests {
         ((a - b) / b).abs()
     }
 
-    // Tolerance 1e-5 relative (MODEL.md §9 checks 11–12): the reference numbers are printed
-    // with 6 significant digits, so 1e-5 is the tightest the table supports while any wrong
+    // Tolerance 1e-5 relative (checks 11–12, docs/theory-time.md §5): the reference numbers are
+    // printed with 6 significant digits, so 1e-5 is the tightest the table supports while any wrong
     // exponent or constant changes them by far more.
 
     #[test]
@@ -557,7 +558,8 @@ mod tests {
 
     #[test]
     fn relaxation_mc90_values() {
-        // MODEL.md §4.6 check values, class 2 at 0.7 fptk, k = 0.19; 4 digits → 5e-4 rel.
+        // Hand values of ρ(t) (docs/theory-time.md §1), class 2 at 0.7 fptk, k = 0.19; 4 digits →
+        // 5e-4 rel.
         let c = RelaxationClass::Class2;
         let r = |d: f64| relaxation_loss(c, 0.7, d);
         assert!(rel(r(1.0), 0.01231) < 5e-4);

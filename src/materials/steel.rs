@@ -66,8 +66,8 @@ impl SteelParams {
         }
     }
 
-    /// Prestressing steel (seed + MODEL.md §2.3 decision): linear elastic up to 0.9 f_ptk,
-    /// then perfectly plastic. `ep` [Pa], `fptk` [Pa].
+    /// Prestressing steel (seed + a project decision, docs/theory-concrete.md §6): linear elastic
+    /// up to 0.9 f_ptk, then perfectly plastic. `ep` [Pa], `fptk` [Pa].
     pub fn prestressing(ep: f64, fptk: f64) -> Self {
         SteelParams {
             es: ep,

@@ -1,4 +1,4 @@
-//! Perzyna elasto-viscoplasticity helpers after Owen & Hinton (1980), `design/MODEL.md` §5.
+//! Perzyna elasto-viscoplasticity helpers after Owen & Hinton (1980), docs/theory-time.md §4.
 //!
 //! Pure functions that take the yield-function value F, the current yield stress F0 and the
 //! flow vector a = ∂F/∂σ (or ∂Q/∂σ) as inputs, so they work with any surface (Ottosen σ_e,
@@ -55,8 +55,8 @@ pub fn overstress_of_ratio(law: OverstressFunction, x: f64) -> (f64, f64) {
     }
 }
 
-/// Viscoplastic strain rate ε̇_vp = γ ⟨Φ(F)⟩ a \[1/time\] (MODEL.md §5.1) for fluidity `gamma`
-/// \[1/time\], yield-function value `f`, yield stress `f0` and flow vector `flow` = ∂Q/∂σ
+/// Viscoplastic strain rate ε̇_vp = γ ⟨Φ(F)⟩ a \[1/time\] (docs/theory-time.md §4) for fluidity
+/// `gamma` \[1/time\], yield-function value `f`, yield stress `f0` and flow vector `flow` = ∂Q/∂σ
 /// [per unit of F/stress; dimensionless when F is a stress].
 pub fn viscoplastic_strain_rate(
     law: OverstressFunction,
@@ -75,7 +75,7 @@ pub fn explicit_strain_increment(rate: &[f64; 3], dt: f64) -> [f64; 3] {
     [dt * rate[0], dt * rate[1], dt * rate[2]]
 }
 
-/// Θ-method strain increment Δε_vp = Δt [(1 − Θ) ε̇_n + Θ ε̇_{n+1}] \[-\] (MODEL.md §5.3),
+/// Θ-method strain increment Δε_vp = Δt [(1 − Θ) ε̇_n + Θ ε̇_{n+1}] \[-\] (docs/theory-time.md §4),
 /// `theta` ∈ [0, 1].
 pub fn theta_strain_increment(
     rate_n: &[f64; 3],
@@ -87,7 +87,7 @@ pub fn theta_strain_increment(
 }
 
 /// Work-hardening increment Δκ = σ · Δε_vp / σ_c \[-\] (effective plastic strain from plastic
-/// work equivalence, MODEL.md §2.2/§5.2), engineering shear in the dot product; `sigma_c` =
+/// work equivalence, docs/theory-time.md §4), engineering shear in the dot product; `sigma_c` =
 /// current uniaxial yield stress (> 0, same unit as σ). Returns 0 for non-positive work.
 pub fn hardening_increment(stress: &[f64; 3], d_eps_vp: &[f64; 3], sigma_c: f64) -> f64 {
     let w = stress[0] * d_eps_vp[0] + stress[1] * d_eps_vp[1] + stress[2] * d_eps_vp[2];
@@ -125,13 +125,13 @@ pub fn critical_dt_mohr_coulomb(e: f64, nu: f64, gamma: f64, f0: f64, phi: f64) 
 }
 
 /// Critical time step for the Ottosen surface **\[DECISION\]**: no closed form is known
-/// (MODEL.md §5.2); use the von Mises value times `safety` (recommended 0.5) \[time\].
+/// (docs/theory-time.md §4); use the von Mises value times `safety` (recommended 0.5) \[time\].
 pub fn critical_dt_ottosen_estimate(e: f64, nu: f64, gamma: f64, f0: f64, safety: f64) -> f64 {
     safety * critical_dt_von_mises(e, nu, gamma, f0)
 }
 
-/// Owen–Hinton time-step control (MODEL.md §5.2) \[time\]: the next step is the smallest of
-/// `growth` × `dt_prev` (k ≈ 1.5), `tau` × ε̄/‖ε̇_vp‖ (τ ≈ 0.01–0.15; ignored if the rate is
+/// Owen–Hinton time-step control (docs/theory-time.md §4) \[time\]: the next step is the smallest
+/// of `growth` × `dt_prev` (k ≈ 1.5), `tau` × ε̄/‖ε̇_vp‖ (τ ≈ 0.01–0.15; ignored if the rate is
 /// zero) and `dt_crit`.
 pub fn next_time_step(
     dt_prev: f64,
@@ -158,7 +158,7 @@ pub fn is_stationary(sum_step_increment_norm: f64, sum_total_vp_norm: f64, tol: 
 }
 
 /// Owen–Hinton number of forward-Euler sub-increments m = int[8 (σ̄_trial − F0)/F0] + 1 for
-/// the elastoplastic return (MODEL.md §5.4) \[-\]; 1 inside the surface.
+/// the elastoplastic return (docs/theory-time.md §4) \[-\]; 1 inside the surface.
 pub fn owen_hinton_substeps(sigma_trial: f64, f0: f64) -> usize {
     let x = 8.0 * (sigma_trial - f0) / f0;
     if x <= 0.0 {
@@ -176,8 +176,8 @@ mod tests {
         ((a - b) / b).abs()
     }
 
-    /// Check 16: critical Δt for E = 35495.72, ν = 0.2, γ = F0 = 1 (MODEL.md §5.2).
-    /// 1e-6 relative as MODEL.md §9 (values printed with 7 digits).
+    /// Check 16: critical Δt for E = 35495.72, ν = 0.2, γ = F0 = 1 (docs/theory-time.md §4).
+    /// 1e-6 relative as docs/theory-time.md §5 (values printed with 7 digits).
     #[test]
     fn check_16_critical_time_steps() {
         let (e, nu) = (35495.72, 0.2);

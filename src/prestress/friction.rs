@@ -1,4 +1,5 @@
-//! Friction losses at stressing and anchorage set (draw-in), MODEL.md §8.2 and seed eq. (27):
+//! Friction losses at stressing and anchorage set (draw-in), docs/theory-joints-tendons.md §3 and
+//! seed eq. (27):
 //!
 //! `σ_p(s) = σ_pi · exp[−μ (Σ Δα + k s)]`
 //!
@@ -503,7 +504,7 @@ impl StressProfile {
 mod tests {
     use super::*;
 
-    /// Check 19 (MODEL.md §8.2): μ = 0.2, Δα = 0.1 rad, s = 1000 cm → 0.960789;
+    /// Check 19 (docs/theory-joints-tendons.md §4): μ = 0.2, Δα = 0.1 rad, s = 1000 cm → 0.960789;
     /// μ = 0.05, Δα = 0.2 rad, s = 2500 cm → 0.977751. The table gives 6 digits, so the
     /// tolerance is 1e-6 rel (§9 #19).
     #[test]

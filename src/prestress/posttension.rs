@@ -207,9 +207,9 @@ mod tests {
         }
     }
 
-    /// Check 19 values (MODEL.md §8.2) through the tendon formula: a sample at s = 10 m with
-    /// α = 0.1 rad, μ = 0.2, seed wobble → 0.960789 σ_pi; jacked at the other end the same
-    /// sample sees α_L − α and L − s. Tolerance 1e-6 rel (table digits).
+    /// Check 19 values (docs/theory-joints-tendons.md §4) through the tendon formula: a sample at
+    /// s = 10 m with α = 0.1 rad, μ = 0.2, seed wobble → 0.960789 σ_pi; jacked at the other end the
+    /// same sample sees α_L − α and L − s. Tolerance 1e-6 rel (table digits).
     #[test]
     fn friction_at_samples_matches_check_values() {
         let smp = Samples {

@@ -1,5 +1,5 @@
 //! Uncracked concrete in compression: isotropic-hardening elastoplasticity on Ottosen-shaped
-//! loading surfaces with the MC90 uniaxial curve as hardening law (MODEL.md §1.4, §2.2, §5.4).
+//! loading surfaces with the MC90 uniaxial curve as hardening law (docs/theory-concrete.md §4).
 //!
 //! Loading surfaces: f(σ, ε̄) = σ̂_e(σ) − σ_c(ε̄) = 0 with σ̂_e = σ_e/q_c (or σ_e when the
 //! normalisation is switched off); σ_e is positively homogeneous of degree 1 so the surfaces
@@ -369,7 +369,7 @@ fn step(
 }
 
 // ---------------------------------------------------------------------------------------
-// Owen–Hinton elasto-viscoplastic option (MODEL.md §5, seed §5.5)
+// Owen–Hinton elasto-viscoplastic option (docs/theory-time.md §8, seed §5.5)
 // ---------------------------------------------------------------------------------------
 
 /// Perzyna viscoplasticity of the compression plasticity (Owen & Hinton 1980), an option of

@@ -1,4 +1,4 @@
-//! Smeared fixed orthogonal cracking (seed §5.3, MODEL.md §1.6, §2.4).
+//! Smeared fixed orthogonal cracking (seed §5.3, docs/theory-concrete.md §3, §5).
 //!
 //! After the first crack the point is orthotropic in the fixed crack axes (n, t), n = normal
 //! of crack 1 at angle φ from x, t = n rotated by +90°; the Poisson effect is neglected

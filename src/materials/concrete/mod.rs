@@ -1,4 +1,4 @@
-//! Plane-stress concrete material point (MODEL.md §1, §2.2, §2.4; seed §5.2–5.3).
+//! Plane-stress concrete material point (docs/theory-concrete.md §1–§5; seed §5.2–5.3).
 //!
 //! * Uncracked, compression-dominated states (largest principal trial stress
 //!   σ1 < r_d f_tm, r_d = ½ by default): isotropic-hardening elastoplasticity on
@@ -77,7 +77,8 @@ pub struct ShearRetention {
     pub k1: f64,
     /// Crack strain at which β would vanish ε_ref [-] (seed: 0.005).
     pub eps_ref: f64,
-    /// Floor β_min [-] keeping the tangent non-singular (MODEL.md §2.4 decision: 1e-3).
+    /// Floor β_min [-] keeping the tangent non-singular (a project decision,
+    /// docs/theory-concrete.md §5: 1e-3).
     pub beta_min: f64,
 }
 
@@ -171,7 +172,7 @@ pub struct ConcreteParams {
     /// [`compression`]).
     pub initial_yield_ratio: f64,
     /// Normalise σ_e by q_c so that uniaxial compression follows the MC90 curve exactly
-    /// (MODEL.md §1.4 decision; default true).
+    /// (a project decision, docs/theory-concrete.md §4; default true).
     pub normalize_equivalent_stress: bool,
     /// Crushing strain ε_cu [-]: when the equivalent curve strain ε̄ reaches it the point is
     /// crushed and carries no stress (default 0.0035; set ε_cu = ε_c1 for "crushed at the
@@ -239,7 +240,7 @@ impl ConcreteParams {
     /// f_tm = 10 MPa · 0.14 (f_cm/10 MPa)^(2/3) (eq. 19 corrected), E = E_ci, Ottosen
     /// parameters from k = f_tm/f_cm, ε_c1 = 0.0022, zero initial yield, normalised σ_e,
     /// ε_cu = 0.0035, Hinton tension stiffening with α = 5e-4 (the paper's value is unknown;
-    /// MODEL.md example), Cervenka shear retention k1 = 0.075.
+    /// docs/theory-concrete.md §5), Cervenka shear retention k1 = 0.075.
     pub fn from_mc90(fcm: f64, nu: f64) -> Self {
         Self::from_mc90_with(fcm, nu, mc90::C_MEAN, TensileRef::Fcm)
     }
@@ -351,8 +352,8 @@ impl ConcreteParams {
         }
     }
 
-    /// Compression-dominated stress state (routes to plasticity/crushing, MODEL.md §1.6):
-    /// largest principal stress σ1 < r_d f_tm and I1 = σx + σy < 0. The I1 condition keeps
+    /// Compression-dominated stress state (routes to plasticity/crushing, docs/theory-concrete.md
+    /// §3): largest principal stress σ1 < r_d f_tm and I1 = σx + σy < 0. The I1 condition keeps
     /// small tensile states out of the hardening model, whose loading surfaces pass
     /// through the origin when the initial yield stress is zero. I1 must be below
     /// −1e-9 f_tm: pure shear (I1 = 0) lies on the border, and round-off must not send some

@@ -1,11 +1,11 @@
-//! Ottosen four-parameter criterion in plane stress (MODEL.md §1.2–§1.5).
+//! Ottosen four-parameter criterion in plane stress (docs/theory-concrete.md §2).
 //!
 //! Stress vectors are Voigt plane-stress vectors (σx, σy, τxy) [Pa], tension positive,
 //! σz = τxz = τyz = 0 (the deviator still has s_z = −(σx + σy)/3).
 
 use crate::materials::mc90::OttosenParams;
 
-/// Largest c2 used in λ(θ): dλ/dc is singular at |c| = 1 when c2 = 1 (MODEL.md §1.3 note).
+/// Largest c2 used in λ(θ): dλ/dc is singular at |c| = 1 when c2 = 1 (docs/theory-concrete.md §2).
 const C2_MAX: f64 = 1.0 - 1e-12;
 
 /// Stress invariants of a plane-stress state.
@@ -71,8 +71,8 @@ pub fn lode_angle_owen_hinton(s: &[f64; 3]) -> f64 {
 
 /// λ(cos3θ) [-] and dλ/d(cos3θ) [-].
 ///
-/// The two branches of MODEL.md §1.3 / seed eq. 17 are the same analytic function, since
-/// π/3 − ⅓ arccos(−x) = ⅓ arccos(x): λ = c1 cos[⅓ arccos(c2 cos3θ)] for all θ. c2 is capped
+/// The two branches of seed eq. 17 (docs/theory-concrete.md §2) are the same analytic function,
+/// since π/3 − ⅓ arccos(−x) = ⅓ arccos(x): λ = c1 cos[⅓ arccos(c2 cos3θ)] for all θ. c2 is capped
 /// at 1 − 1e-12 so that the derivative stays finite at |cos3θ| = 1.
 pub fn lambda(p: &OttosenParams, c: f64) -> (f64, f64) {
     let c2 = p.c2.min(C2_MAX);
@@ -106,8 +106,8 @@ fn invariant_gradients(s: &[f64; 3], inv: &Invariants) -> ([f64; 3], [f64; 3], [
     (di1, dj2, dj3)
 }
 
-/// Gradient ∂F/∂(σx, σy, τxy) [1/Pa] of [`criterion`] (MODEL.md §1.5). At σ = 0 (J2 = 0)
-/// the deviatoric part is undefined and only the hydrostatic part β/f·∂I1 is returned.
+/// Gradient ∂F/∂(σx, σy, τxy) [1/Pa] of [`criterion`] (docs/theory-concrete.md §2). At σ = 0
+/// (J2 = 0) the deviatoric part is undefined and only the hydrostatic part β/f·∂I1 is returned.
 pub fn criterion_gradient(p: &OttosenParams, fcm: f64, s: &[f64; 3]) -> [f64; 3] {
     let inv = invariants(s);
     let (di1, dj2, dj3) = invariant_gradients(s, &inv);
@@ -124,8 +124,8 @@ pub fn criterion_gradient(p: &OttosenParams, fcm: f64, s: &[f64; 3]) -> [f64; 3]
     std::array::from_fn(|i| f_i1 * di1[i] + f_j2 * dj2[i] + f_j3 * dj3[i])
 }
 
-/// Equivalent stress σ_e(σ) [Pa]: the strength f for which F(σ; f) = 0 (MODEL.md §1.4),
-/// σ_e = ½[p + √(p² + 4αJ2)], p = λ√J2 + βI1. Positively homogeneous of degree 1;
+/// Equivalent stress σ_e(σ) [Pa]: the strength f for which F(σ; f) = 0 (docs/theory-concrete.md
+/// §2), σ_e = ½[p + √(p² + 4αJ2)], p = λ√J2 + βI1. Positively homogeneous of degree 1;
 /// σ_e ≥ f_cm ⇔ F(σ; f_cm) ≥ 0.
 pub fn equivalent_stress(p: &OttosenParams, s: &[f64; 3]) -> f64 {
     equivalent_stress_gradient(p, s).0
@@ -164,8 +164,8 @@ pub fn equivalent_stress_gradient(p: &OttosenParams, s: &[f64; 3]) -> (f64, [f64
     (se, g)
 }
 
-/// Uniaxial-compression factor q_c = σ_e(−1, 0, 0) [-] (MODEL.md §1.4): σ_e of a uniaxial
-/// compression of magnitude f is q_c f.
+/// Uniaxial-compression factor q_c = σ_e(−1, 0, 0) [-] (docs/theory-concrete.md §4): σ_e of a
+/// uniaxial compression of magnitude f is q_c f.
 pub fn q_c(p: &OttosenParams) -> f64 {
     equivalent_stress(p, &[-1.0, 0.0, 0.0])
 }
@@ -186,8 +186,8 @@ fn outer(a: &[f64; 3], b: &[f64; 3]) -> [[f64; 3]; 3] {
     std::array::from_fn(|i| std::array::from_fn(|j| a[i] * b[j]))
 }
 
-/// Hessian ∂²σ_e/∂σ² [1/Pa], analytic (MODEL.md §1.4 differentiated twice; derivation in
-/// docs/theory-concrete.md). With u = √J2, c = cos3θ = k J3 u⁻³ (k = 3√3/2),
+/// Hessian ∂²σ_e/∂σ² [1/Pa], analytic (σ_e differentiated twice; derivation in
+/// docs/theory-concrete.md §2). With u = √J2, c = cos3θ = k J3 u⁻³ (k = 3√3/2),
 /// p = λ(c) u + β I1 and R = √(p² + 4αJ2), σ_e = ½(p + R) has the gradient
 /// g = ½(1 + p/R) ∇p + (α/R) ∇J2 and the Hessian
 /// H = ∇p ⊗ α(2J2 ∇p − p ∇J2)/R³ + ½(1 + p/R) ∇²p − ∇J2 ⊗ α(p ∇p + 2α ∇J2)/R³ +
@@ -306,8 +306,8 @@ mod tests {
         [a, b, 0.0]
     }
 
-    /// MODEL.md §9 check 3: Lode angles, both conventions (1e-10 abs: exact states, only
-    /// round-off in acos/asin near ±1 — computed via clamp so exact).
+    /// Check 3 (docs/theory-concrete.md §7): Lode angles, both conventions (1e-10 abs: exact
+    /// states, only round-off in acos/asin near ±1 — computed via clamp so exact).
     #[test]
     fn check3_lode_angles() {
         let d = std::f64::consts::PI / 180.0;
@@ -343,8 +343,8 @@ mod tests {
         assert!((lode_angle_mc90(&rot(-1e6, 0.0)) - 60.0 * d).abs() < 1e-8);
     }
 
-    /// MODEL.md §9 check 4: I1, J2, cos3θ, λ, F at the §1.3 points (1e-5 abs on F and
-    /// cos3θ; λ to 1e-4 and J2 to 1e-3 MPa² because the table prints them to that many
+    /// Check 4 (docs/theory-concrete.md §7): I1, J2, cos3θ, λ, F at reference points (1e-5 abs
+    /// on F and cos3θ; λ to 1e-4 and J2 to 1e-3 MPa² because the hand values give them to that many
     /// decimals). Each principal triple (σ1, σ2, σ3) has one zero, so it is the plane-stress
     /// state with the two non-zero values in x, y and σz = 0.
     #[test]
@@ -377,8 +377,8 @@ mod tests {
         }
     }
 
-    /// MODEL.md §9 check 5: strength ratios along radial paths (1e-4 rel). Uses the
-    /// homogeneity of σ_e: the radial strength along a unit direction d is f_cm/σ_e(d).
+    /// Check 5 (docs/theory-concrete.md §7): strength ratios along radial paths (1e-4 rel). Uses
+    /// the homogeneity of σ_e: the radial strength along a unit direction d is f_cm/σ_e(d).
     #[test]
     fn check5_strength_ratios() {
         for (k, table) in [
@@ -403,8 +403,8 @@ mod tests {
         }
     }
 
-    /// MODEL.md §9 check 6: q_c, σ_e homogeneity (1e-9 rel: pure round-off), and the
-    /// uniaxial tension ratio σ_e/σ1 = 11.77698 (1e-6 rel, table has 7 digits).
+    /// Check 6 (docs/theory-concrete.md §7): q_c, σ_e homogeneity (1e-9 rel: pure round-off), and
+    /// the uniaxial tension ratio σ_e/σ1 = 11.77698 (1e-6 rel, table has 7 digits).
     #[test]
     fn check6_equivalent_stress() {
         let p = OttosenParams::from_k(0.084799);
@@ -419,8 +419,9 @@ mod tests {
         }
     }
 
-    /// MODEL.md §9 check 7: ∂F/∂σ vs the table (values in 1/MPa, 1e-6 rel) and gradient of
-    /// F and σ_e vs central differences (1e-6 rel: FD truncation with h = 1e-4 MPa is 1e-10).
+    /// Check 7 (docs/theory-concrete.md §7): ∂F/∂σ vs hand values (values in 1/MPa, 1e-6 rel) and
+    /// gradient of F and σ_e vs central differences (1e-6 rel: FD truncation with h = 1e-4 MPa is
+    /// 1e-10).
     #[test]
     fn check7_gradients() {
         let p = params();

@@ -1,4 +1,5 @@
-//! Material-point tests of the concrete model (MODEL.md §9 check 10 and the path tests).
+//! Material-point tests of the concrete model (check 10 of docs/theory-concrete.md §7 and the path
+//! tests).
 
 use super::cracking::tension_envelope;
 use super::*;
@@ -41,8 +42,8 @@ fn uniaxial_x(p: &ConcreteParams, st: &ConcreteState, ex: f64, guess: [f64; 2]) 
     (out, y)
 }
 
-/// MODEL.md §9 check 10: tension stiffening (seed eq. 21) and shear retention (eqs. 22–23)
-/// values (1e-4 rel per the checklist; the table prints 4–5 digits, so the MPa values are
+/// Check 10 (docs/theory-concrete.md §5, §7): tension stiffening (seed eq. 21) and shear retention
+/// (eqs. 22–23) values (1e-4 rel; the hand values have 4–5 digits, so the MPa values are
 /// compared at 5e-5 MPa absolute on top).
 #[test]
 fn check10_tension_stiffening_and_shear_retention() {
@@ -158,9 +159,9 @@ fn initial_yield_ratio_elastic_range() {
 }
 
 /// Uniaxial tension: linear up to cracking at the Ottosen tensile strength
-/// (0.08491 f_cm = 1.0013 f_tm, MODEL.md §1.3 table; 0.5 % tolerance = strain step
-/// resolution 0.4 %), crack normal along x, then the Hinton envelope exactly (1e-9 rel),
-/// secant unloading, and closing with compression stiffness E.
+/// (0.08491 f_cm = 1.0013 f_tm by the criterion of docs/theory-concrete.md §2; 0.5 % tolerance =
+/// strain step resolution 0.4 %), crack normal along x, then the Hinton envelope exactly (1e-9
+/// rel), secant unloading, and closing with compression stiffness E.
 #[test]
 fn uniaxial_tension_cracks_and_softens() {
     let p = params();
@@ -230,8 +231,8 @@ fn uniaxial_tension_cracks_and_softens() {
 }
 
 /// Equal biaxial compression: the peak stress is q_c · 1.19306 f_cm = 1.19948 f_cm
-/// (MODEL.md §1.3 table × normalisation; MC90's Ottosen fit — Kupfer's test value is
-/// ≈ 1.16). 0.5 % tolerance = peak resolution of the 200-step path near the flat top.
+/// (docs/theory-concrete.md §4: the criterion × normalisation; MC90's Ottosen fit — Kupfer's test
+/// value is ≈ 1.16). 0.5 % tolerance = peak resolution of the 200-step path near the flat top.
 #[test]
 fn equal_biaxial_compression_strength() {
     let p = params();
@@ -254,8 +255,8 @@ fn equal_biaxial_compression_strength() {
 }
 
 /// Compression with slight lateral tension below f_tm/2 stays in the plastic (crushing)
-/// regime and never cracks (discrimination rule, MODEL.md §1.6), and crushes (zero stress)
-/// once ε̄ reaches ε_cu.
+/// regime and never cracks (discrimination rule, docs/theory-concrete.md §3), and crushes (zero
+/// stress) once ε̄ reaches ε_cu.
 #[test]
 fn compression_dominated_crushes_not_cracks() {
     let p = params();

@@ -1,0 +1,200 @@
+//! What the step drivers (`steps`, `path`) share with each other and with observers: the
+//! converged-increment snapshot, the observer interface, the run options, the analysis error,
+//! the timings, and the two bookkeeping calls after a converged increment (`check_stop`,
+//! `note_limit_point`). The drivers point down to this module; it calls neither of them.
+
+use super::failure::FailureReport;
+use super::solver::SolverStats;
+use super::state::{DriverState, SystemState};
+use super::system::System;
+
+/// A converged increment, as observers see it.
+pub struct Snapshot<'a, 's> {
+    /// The system (displacements, committed states and Gauss outputs).
+    pub system: &'a System<'s>,
+    /// Step index.
+    pub step: usize,
+    /// Increment number within the step (1-based).
+    pub increment: usize,
+    /// True at the last increment of the step.
+    pub end_of_step: bool,
+    /// Current load-case factors.
+    pub factors: &'a [f64],
+    /// Internal force vector over all dofs [N] (reactions at constrained dofs).
+    pub f_int: &'a [f64],
+    /// External force vector over all dofs [N].
+    pub f_ext: &'a [f64],
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Negative pivots of the last tangent factorised (0 if positive definite; > 0 past a
+    /// limit point or bifurcation).
+    pub negative_pivots: usize,
+    /// Arc-length load factor λ of the step's reference load (arc-length steps).
+    pub arc_length_factor: Option<f64>,
+    /// Force [N] the displacement control applies at its dof (displacement steps).
+    pub control_force: Option<f64>,
+}
+
+/// Receives converged increments (history, field output, progress), step ends
+/// (checkpoints) and failures; may ask the analysis to stop.
+pub trait Observer {
+    /// Called after every converged increment.
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()>;
+
+    /// Called before the first step and after every step (also a failed step the run goes
+    /// on from), with the state a restart needs. Default: nothing.
+    fn step_end(&mut self, _end: &StepEnd) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    /// Called when a step failed and the run goes on with the next one. Default: nothing.
+    fn step_failed(&mut self, _report: &FailureReport) {}
+
+    /// Called when a step ends early (an increment failed after all cuts, a stop was asked,
+    /// an error), with the system at its last converged state and the timings so far.
+    /// Default: nothing.
+    fn step_stopped(&mut self, _system: &System, _timings: &Timings) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    /// Asked after every converged increment and every step end: `Some` stops the analysis
+    /// there. Default: never.
+    fn stop_requested(&self) -> Option<StopReason> {
+        None
+    }
+}
+
+/// The state at a step end, as observers see it (for checkpoints).
+pub struct StepEnd<'a, 's> {
+    /// The system (committed states).
+    pub system: &'a System<'s>,
+    /// The driver's state (next step, factors, clock, counters).
+    pub driver: &'a DriverState,
+}
+
+/// Why an observer stopped the analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum StopReason {
+    /// A termination signal arrived (its number: 2 SIGINT, 15 SIGTERM).
+    Signal(i32),
+    /// The run was asked to stop after this step (1-based).
+    AfterStep(usize),
+}
+
+/// Options of an analysis.
+#[derive(Debug, Default)]
+pub struct RunOptions {
+    /// When a step fails after all cuts, report it and go on with the next step from the
+    /// last converged state (load factors and time as reached) instead of stopping.
+    pub continue_on_failure: bool,
+    /// Start from this saved state instead of the beginning.
+    pub resume: Option<(DriverState, SystemState)>,
+}
+
+/// Why an analysis stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// An increment failed after all allowed cuts.
+    #[error("{0}")]
+    NotConverged(Box<FailureReport>),
+    /// The stiffness matrix is singular: a mechanism.
+    #[error("{0}")]
+    Mechanism(String),
+    /// Writing results failed.
+    #[error("writing results: {0}")]
+    Output(#[from] std::io::Error),
+    /// An observer asked to stop (signal, or stop after a step).
+    #[error("{}", stopped_message(*reason, *step, *increment, *resume_step))]
+    Stopped {
+        /// Why.
+        reason: StopReason,
+        /// Step index where the analysis stopped.
+        step: usize,
+        /// Last converged increment of that step (0 at a step end).
+        increment: usize,
+        /// Index of the step a restart from the last checkpoint begins with.
+        resume_step: usize,
+    },
+    /// The saved state does not fit the model.
+    #[error("{0}")]
+    Restore(String),
+}
+
+/// "interrupted by SIGINT at step 3 increment 5; a restart continues with step 3".
+fn stopped_message(reason: StopReason, step: usize, increment: usize, resume: usize) -> String {
+    let why = match reason {
+        StopReason::Signal(2) => "interrupted by SIGINT".to_string(),
+        StopReason::Signal(15) => "interrupted by SIGTERM".to_string(),
+        StopReason::Signal(n) => format!("interrupted by signal {n}"),
+        StopReason::AfterStep(_) => "stopped as asked".to_string(),
+    };
+    let at = if increment == 0 {
+        format!("after step {}", step + 1)
+    } else {
+        format!("at step {} increment {increment}", step + 1)
+    };
+    format!("{why} {at}; a restart continues with step {}", resume + 1)
+}
+
+/// Timings of the analysis phases [s].
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Timings {
+    /// Pattern, dof map and state set-up.
+    pub setup_s: f64,
+    /// Element loops and scatter.
+    pub assembly_s: f64,
+    /// Linear solver figures.
+    pub solver: SolverStats,
+    /// Observers (output writing).
+    pub output_s: f64,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations in all.
+    pub iterations: usize,
+    /// Limit points or bifurcations passed (the number of negative pivots changed), one
+    /// message each.
+    pub limit_points: Vec<String>,
+}
+
+/// After a converged increment inside a step: stop if an observer asks (the step end
+/// asks separately, after its checkpoint).
+pub(super) fn check_stop(
+    obs: &dyn Observer,
+    step: usize,
+    increment: usize,
+    end_of_step: bool,
+) -> Result<(), AnalysisError> {
+    if end_of_step {
+        return Ok(());
+    }
+    match obs.stop_requested() {
+        Some(reason) => Err(AnalysisError::Stopped {
+            reason,
+            step,
+            increment,
+            resume_step: step,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Record a change of the number of negative pivots between converged increments.
+pub(super) fn note_limit_point(
+    timings: &mut Timings,
+    last: &mut usize,
+    now: usize,
+    step: &str,
+    increment: usize,
+) {
+    if now != *last {
+        timings.limit_points.push(format!(
+            "step '{step}' increment {increment}: negative pivots {last} -> {now} ({})",
+            if now > *last {
+                "limit point or bifurcation passed"
+            } else {
+                "stiffness regained"
+            }
+        ));
+        *last = now;
+    }
+}
