@@ -273,6 +273,32 @@ fn bar(
     })
 }
 
+/// Refuse a bonded tendon whose name is a bar's (`clash` says why that matters) or that
+/// gives a key of another tendon kind (`refused`: key and whether it is given; `hint` names
+/// the keys this kind takes).
+#[allow(clippy::too_many_arguments)]
+fn refuse_clash_and_keys(
+    ctx: &Ctx,
+    key: &str,
+    named: &str,
+    t: &TendonIn,
+    bars: &[BarIn],
+    clash: &str,
+    refused: &[(&str, bool)],
+    hint: &str,
+) -> R<()> {
+    if bars.iter().any(|b| b.name == t.name) {
+        return Err(ctx.err(
+            format!("{key}.name"),
+            format!("{named}: a bar has the same name ({clash})"),
+        ));
+    }
+    match refused.iter().find(|(_, given)| *given) {
+        Some((f, _)) => Err(ctx.err(format!("{key}.{f}"), format!("{named}: {hint}"))),
+        None => Ok(()),
+    }
+}
+
 /// A bonded post-tensioned tendon (`kind = "bonded"`, `tendons[i]`): a bar whose stress
 /// after lock-off follows from the jacking stress, friction and anchorage set.
 #[allow(clippy::too_many_arguments)]
@@ -288,24 +314,20 @@ fn post_tensioned_tendon(
     let key = format!("tendons[{i}]");
     let k = |f: &str| format!("{key}.{f}");
     let named = format!("tendon '{}'", t.name);
-    if bars.iter().any(|b| b.name == t.name) {
-        return Err(ctx.err(
-            k("name"),
-            format!("{named}: a bar has the same name (bonded tendons are output and monitored as bars)"),
-        ));
-    }
-    for (f, given) in [
-        ("initial_stress", t.initial_stress.is_some()),
-        ("deviators", t.deviators.is_some()),
-        ("deviator_friction", t.deviator_friction.is_some()),
-    ] {
-        if given {
-            return Err(ctx.err(
-                k(f),
-                format!("{named}: not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is kind = \"pretensioned\" with initial_stress)"),
-            ));
-        }
-    }
+    refuse_clash_and_keys(
+        ctx,
+        &key,
+        &named,
+        t,
+        bars,
+        "bonded tendons are output and monitored as bars",
+        &[
+            ("initial_stress", t.initial_stress.is_some()),
+            ("deviators", t.deviators.is_some()),
+            ("deviator_friction", t.deviator_friction.is_some()),
+        ],
+        "not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is kind = \"pretensioned\" with initial_stress)",
+    )?;
     let (area, ep, fptk) = tendon_steel(ctx, &key, &named, t)?;
     let steel = tendon_law(ctx, &key, &named, t, ep, fptk)?;
     let sigma_pi = jacking_stress_of(ctx, i, t, area, fptk)?.ok_or_else(|| {
@@ -398,31 +420,27 @@ pub(super) fn pretensioned_tendon(
     let key = format!("tendons[{i}]");
     let k = |f: &str| format!("{key}.{f}");
     let named = format!("tendon '{}'", t.name);
-    if bars.iter().any(|b| b.name == t.name) {
-        return Err(ctx.err(
-            k("name"),
-            format!("{named}: a bar has the same name (bonded tendons are output as bars)"),
-        ));
-    }
-    for (f, given) in [
-        ("jacking_stress", t.jacking_stress.is_some()),
-        ("jacking_force", t.jacking_force.is_some()),
-        ("jacking", t.jacking.is_some()),
-        ("friction", t.friction.is_some()),
-        ("wobble", t.wobble.is_some()),
-        ("anchorage_set", t.anchorage_set.is_some()),
-        ("deviators", t.deviators.is_some()),
-        ("deviator_friction", t.deviator_friction.is_some()),
-        ("stressed_in_step", t.stressed_in_step.is_some()),
-        ("grouted_in_step", t.grouted_in_step.is_some()),
-    ] {
-        if given {
-            return Err(ctx.err(
-                k(f),
-                format!("{named}: not a key of a pre-tensioned tendon (bonded from the start with initial_stress, the stress before release)"),
-            ));
-        }
-    }
+    refuse_clash_and_keys(
+        ctx,
+        &key,
+        &named,
+        t,
+        bars,
+        "bonded tendons are output as bars",
+        &[
+            ("jacking_stress", t.jacking_stress.is_some()),
+            ("jacking_force", t.jacking_force.is_some()),
+            ("jacking", t.jacking.is_some()),
+            ("friction", t.friction.is_some()),
+            ("wobble", t.wobble.is_some()),
+            ("anchorage_set", t.anchorage_set.is_some()),
+            ("deviators", t.deviators.is_some()),
+            ("deviator_friction", t.deviator_friction.is_some()),
+            ("stressed_in_step", t.stressed_in_step.is_some()),
+            ("grouted_in_step", t.grouted_in_step.is_some()),
+        ],
+        "not a key of a pre-tensioned tendon (bonded from the start with initial_stress, the stress before release)",
+    )?;
     let (area, ep, fptk) = tendon_steel(ctx, &key, &named, t)?;
     let s0 = t.initial_stress.ok_or_else(|| {
         ctx.err(
