@@ -687,14 +687,23 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         &format!("field_{}", field.name()),
     )?);
     let joints = output_joint_profiles(&output, &g, &opts.dir)?;
-    extra_figures(&g, joints, &tag, &out_dir, &mut outcome)?;
+    let has_joints = expects_joints(&g, &opts.dir);
+    extra_figures(&g, joints, has_joints, &tag, &out_dir, &mut outcome)?;
     Ok(outcome)
 }
 
-/// Crack pattern and joint diagrams, or notes when their data is absent.
+/// Whether a run's model has joints: summary.json names some, or the grid has line cells.
+/// A model without joints gets no "joint diagrams: skipped" note (it would be noise).
+pub fn expects_joints(g: &Grid, dir: &Path) -> bool {
+    !units::joint_names(dir).is_empty() || (0..g.cells.len()).any(|i| g.is_line(i))
+}
+
+/// Crack pattern and joint diagrams, or notes when their data is absent (the joint note
+/// only when `has_joints`).
 fn extra_figures(
     g: &Grid,
     joints: Vec<JointProfile>,
+    has_joints: bool,
     tag: &str,
     out_dir: &Path,
     outcome: &mut PlotOutcome,
@@ -705,7 +714,8 @@ fn extra_figures(
     }
     match joint_figure(joints, tag, &mut outcome.notes) {
         Some(f) => outcome.files.extend(save(&f, out_dir, "joints")?),
-        None => outcome.notes.push(JOINT_NOTE.into()),
+        None if has_joints => outcome.notes.push(JOINT_NOTE.into()),
+        None => {}
     }
     Ok(())
 }

@@ -428,8 +428,9 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
             let tag = format!("output {n}, {}", run_name(&output.file));
             let joints = super::output_joint_profiles(&output, &g, &opts.dir)?;
             let from_points = output.joint_points.is_some();
+            let has_joints = super::expects_joints(&g, &opts.dir);
             fields_section(&mut html, &opts.dir, &g, &tag, &mut notes)?;
-            joints_section(&mut html, joints, from_points, &tag, &mut notes)?;
+            joints_section(&mut html, joints, from_points, has_joints, &tag, &mut notes)?;
         }
         Err(e) if opts.step.is_none() => notes.push(format!("model drawings: skipped ({e})")),
         Err(e) => return Err(e),
@@ -519,11 +520,14 @@ fn joints_section(
     html: &mut String,
     joints: Vec<JointProfile>,
     from_points: bool,
+    has_joints: bool,
     tag: &str,
     notes: &mut Vec<String>,
 ) -> Result<(), ViewError> {
     if joints.is_empty() {
-        notes.push(JOINT_NOTE.into());
+        if has_joints {
+            notes.push(JOINT_NOTE.into());
+        }
         return Ok(());
     }
     let source = if from_points {
