@@ -520,8 +520,9 @@ def creep_problem():
 CPU_TIMES = []
 
 
-def timed(cmd, cwd):
-    """Run cmd under /usr/bin/time -v; return (wall s, peak RSS bytes, stdout, stderr)."""
+def timed(cmd, cwd, ok=(0,)):
+    """Run cmd under /usr/bin/time -v; return (wall s, peak RSS bytes, stdout, stderr).
+    An exit status outside `ok` is an error."""
     t0 = time.perf_counter()
     p = subprocess.run(
         ["/usr/bin/time", "-v"] + [str(c) for c in cmd],
@@ -534,7 +535,7 @@ def timed(cmd, cwd):
     rss = int(m.group(1)) * 1024 if m else None
     cpu = sum(float(v) for v in re.findall(r"(?:User|System) time \(seconds\): (\S+)", p.stderr))
     CPU_TIMES.append(cpu)
-    if p.returncode != 0:
+    if p.returncode not in ok:
         raise RuntimeError(f"{cmd} in {cwd} failed ({p.returncode}):\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
     return wall, rss, p.stdout, p.stderr
 
