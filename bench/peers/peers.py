@@ -39,6 +39,10 @@ REPO = HERE.parent.parent
 WORK = HERE / "work"
 VENV_PY = HERE / ".venv" / "bin" / "python"
 
+# OpenSees' linear solver on the squares (--opensees-system): UmfPack is its fastest here up
+# to 5e5 dofs; at 1e6 dofs its analysis fails (the displacement stays 0), SparseSYM is used.
+OPENSEES_SYSTEM = "UmfPack"
+
 # Material and load of the linear square (ECOSYSTEM.md §B.2): E [Pa], nu, t [m], total
 # shear force on the right edge [N].
 E, NU, T = 30e9, 0.2, 0.2
@@ -209,9 +213,9 @@ loads = {{ shear = 1.0 }}
             "ops.timeSeries('Linear', 1)\nops.pattern('Plain', 1, 1)\n"
             "for i, fy in zip(right, forces):\n"
             "    if fy != 0.0:\n        ops.load(i + 1, 0.0, fy)\n"
-            "ops.system('UmfPack')\nops.numberer('Plain')\nops.constraints('Plain')\n"
+            f"ops.system('{OPENSEES_SYSTEM}')\nops.numberer('{'RCM' if OPENSEES_SYSTEM != 'UmfPack' else 'Plain'}')\nops.constraints('Plain')\n"
             "ops.integrator('LoadControl', 1.0)\nops.algorithm('Linear')\n"
-            "ops.analysis('Static')\nops.analyze(1)\n"
+            "ops.analysis('Static')\nassert ops.analyze(1) == 0, 'analysis failed'\n"
             "print('RESULT', repr(ops.nodeDisp(right[-1] + 1, 2)))\n"
         )
     files["OpenSees"] = d / "opensees.py"
@@ -632,7 +636,10 @@ def main():
     ap.add_argument(
         "--slow", type=float, default=60.0, help="a run slower than this [s] is not repeated"
     )
+    ap.add_argument("--opensees-system", default="UmfPack", help="OpenSees' system (UmfPack, SparseSYM, ...)")
     args = ap.parse_args()
+    global OPENSEES_SYSTEM
+    OPENSEES_SYSTEM = args.opensees_system
     if not segfem_bin().exists():
         sys.exit(f"{segfem_bin()} not found: cargo build --release first (CARGO_TARGET_DIR is honoured)")
     if not VENV_PY.exists() or not shutil.which("ccx"):
