@@ -10,6 +10,8 @@ yield and peak load) with their difference from segfem's.
     python3 bench/peers/nonlinear.py                       # panel and beam, 3 rounds
     python3 bench/peers/nonlinear.py --only beam --rounds 2 --refine 1
 
+OOFEM is not in it yet (docs/performance.md, "Not done").
+
 Problems (docs/performance.md, "Nonlinear side by side", lists every difference of laws):
   panel  Vecchio-Collins PV19 (890 mm, 70 mm thick, f_c 19 MPa, rho_x 1.79 % f_y 458 MPa,
          rho_y 0.71 % f_y 299 MPa) in pure shear, n x n Q4, smeared steel in both programs.

@@ -11,6 +11,10 @@ checked, not assumed.
     bench/peers/install.sh                      # once: ccx (apt), OpenSees and OOFEM (venv)
     python3 bench/peers/peers.py                # all problems, default sizes and rounds
     python3 bench/peers/peers.py --only q4 --sizes 1e4,1e5 --rounds 3
+    python3 bench/peers/peers.py --only q4 --sizes 1e6 --programs OpenSees --opensees-system SparseSYM
+
+The nonlinear side by side (RC panel and beam) is bench/peers/nonlinear.py; the scaling
+figure bench/peers/scaling.py.
 
 Problems (element formulations matched, see docs/performance.md):
   q4, q8     linear plane stress: unit square, left edge clamped, uniform shear load on the
