@@ -103,6 +103,11 @@ def main():
         series["segfem RC beam, per Newton iteration"] = [
             dict(r, wall=r["wall"] / r["iterations"], cpu=r["cpu"] / r["iterations"]) for r in data["nonlinear"]
         ]
+    if data.get("opensees_nonlinear"):
+        # From bench/peers/nonlinear.py runs, added to the JSON by hand.
+        series["OpenSees RC beam, per Newton iteration"] = [
+            dict(r, wall=r["wall"] / r["iterations"], cpu=r["cpu"] / r["iterations"]) for r in data["opensees_nonlinear"]
+        ]
     fits = {}
     for name, pts in series.items():
         use = [p for p in pts if p["dofs"] >= 1e4] if "linear" in name else pts
@@ -122,7 +127,7 @@ def main():
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(7, 5))
-        marks = iter("osD^vx")
+        marks = iter("osD^vxP")
         for name, pts in series.items():
             m = next(marks)
             xs = [p["dofs"] for p in pts]
