@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install the peer programs of the side-by-side benchmark into places git ignores:
 #   CalculiX ccx 2.20 from Debian (system package), OpenSees 3.7.1 (openseespy 3.7.1.2) and
-#   OOFEM 2.6.0.dev1 from PyPI into bench/peers/.venv. Needs root for apt-get (as on the
+#   OOFEM 2.6.0.dev1 from PyPI into bench/peers/.venv (and matplotlib for the figures). Needs root for apt-get (as on the
 #   project's machines). Idempotent: skips what is already there.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -21,5 +21,7 @@ if ! "$venv/bin/python" -c 'import openseespy.opensees, oofem' >/dev/null 2>&1; 
     # The oofem wheel's metadata also asks for pytest, which it does not need to run.
     "$venv/bin/pip" install -q --pre --no-deps 'oofem==2.6.0.dev1'
 fi
+# matplotlib: the figures of bench/peers/scaling.py.
+"$venv/bin/python" -c 'import matplotlib' >/dev/null 2>&1 || "$venv/bin/pip" install -q matplotlib
 "$venv/bin/python" -c 'import openseespy.opensees, oofem; print("peers: OpenSees and OOFEM import")'
 command -v ccx >/dev/null && echo "peers: $(ccx -v 2>/dev/null | grep -i version | head -1)"
