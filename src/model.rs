@@ -92,6 +92,8 @@ pub struct LoadCase {
     pub edge_loads: Vec<EdgeLoad>,
     /// Gravity acceleration [m/s²] applied to all regions' density, if any.
     pub gravity: Option<[f64; 2]>,
+    /// Temperature field of a thermal load case: imposed strains, no forces (None: none).
+    pub thermal: Option<crate::elements::thermal::ThermalAction>,
 }
 
 /// What a monitor records.

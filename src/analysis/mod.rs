@@ -14,4 +14,5 @@ pub mod staged;
 pub mod state;
 pub mod steps;
 pub mod system;
+pub mod thermal;
 pub mod time;

@@ -36,6 +36,9 @@ pub(super) struct HostChunk<'a> {
     bar_phase: &'a [BarPhase],
     bar_eps_ref: &'a [f64],
     bar_time: &'a [Option<BarPointTime>],
+    /// Imposed (thermal) strains of the chunk's Gauss points and bar points (empty: none).
+    imposed: &'a [f64],
+    bar_imposed: &'a [f64],
 }
 
 /// One element's own trial slices: element index, point states, Gauss outputs, bar steel
@@ -56,6 +59,7 @@ pub(super) fn split_chunk<'a>(
     gp_offset: &'a [usize],
     bar_gps: &'a [(usize, usize)],
     bar_offset: &'a [usize],
+    thermal: &'a super::thermal::Thermal,
     u: &'a [f64],
     time: &'a TimeContext,
     tangent: bool,
@@ -82,6 +86,8 @@ pub(super) fn split_chunk<'a>(
         bar_phase: &bars.phase,
         bar_eps_ref: &bars.eps_ref[b0..b1],
         bar_time: &bars.time[b0..b1],
+        imposed: thermal.points.get(g0..g1).unwrap_or(&[]),
+        bar_imposed: thermal.bars.get(b0..b1).unwrap_or(&[]),
     };
     let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
     // Per-element slices.
@@ -133,6 +139,8 @@ impl HostChunk<'_> {
             bar_phase,
             bar_eps_ref,
             bar_time,
+            imposed,
+            bar_imposed,
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -173,6 +181,7 @@ impl HostChunk<'_> {
             thickness: region.thickness,
             material: mat,
             time,
+            imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
         };
         element.response(
             ue,
@@ -209,6 +218,7 @@ impl HostChunk<'_> {
                     eps_ref: bar_eps_ref[bc0 + i],
                     prestrain: bar.bonding_stress(p) / bar.steel.es,
                     relax,
+                    thermal: bar_imposed.get(bc0 + i).copied().unwrap_or(0.0),
                 },
             };
             let r = bar_point_response(

@@ -90,6 +90,9 @@ pub fn run_with(
     for si in driver.next_step..model.steps.len() {
         let step = &model.steps[si];
         sys.stress_tendons(si);
+        // Thermal strains of the factors held at the start of the step (path steps keep
+        // them; load steps set them again per increment).
+        sys.set_thermal(&factors);
         // Every step starts as an instantaneous increment at the current clock: path steps
         // keep this context for all their increments (no creep, shrinkage or relaxation
         // while they run; their time is the clock), load steps set it again per increment,
@@ -204,6 +207,7 @@ fn load_step(
                 f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
             }
         }
+        ctx.sys.set_thermal(&lam);
         ctx.sys.begin_time_increment(match &step.time {
             Some(span) => TimeContext {
                 t_from: span.time_at(level),

@@ -63,6 +63,8 @@ pub struct System<'m> {
     pub bar_gps: Vec<(usize, usize)>,
     /// Offsets of each element's bar points in `bar_gps` and the bar state arrays.
     pub bar_offset: Vec<usize>,
+    /// Imposed strains of the thermal load cases at the current factors.
+    pub thermal: super::thermal::Thermal,
     /// Element force vectors and matrices of one chunk, kept between assemblies (every
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
@@ -295,6 +297,7 @@ impl<'m> System<'m> {
         }
         let n_bp = bar_gps.len();
         let n_tendons = model.tendons.len();
+        let thermal = super::thermal::Thermal::new(model, &bar_gps);
         let families = Families {
             continuum: ContinuumBlock {
                 points: Staged::new(committed),
@@ -343,6 +346,7 @@ impl<'m> System<'m> {
             tendons: vec![None; n_tendons],
             bar_gps,
             bar_offset,
+            thermal,
             elem_buf: (Vec::new(), Vec::new()),
         }
     }
@@ -450,6 +454,7 @@ impl<'m> System<'m> {
                 &self.gp_offset,
                 &self.bar_gps,
                 &self.bar_offset,
+                &self.thermal,
                 u,
                 &time,
                 tangent,

@@ -162,7 +162,8 @@ pub enum BarStage {
         /// Stress held [Pa].
         stress: f64,
     },
-    /// Bonded: strain ε = ε_b − `eps_ref` + `prestrain` − `relax` [-] through the steel law.
+    /// Bonded: strain ε = ε_b − `eps_ref` + `prestrain` − `relax` − `thermal` [-] through
+    /// the steel law.
     Bonded {
         /// Bond strain when the point became bonded [-].
         eps_ref: f64,
@@ -170,6 +171,9 @@ pub enum BarStage {
         prestrain: f64,
         /// Relaxation of a tendon's steel, a stress-free strain [-].
         relax: f64,
+        /// Thermal strain of the steel α_s ΔT, a stress-free strain [-] (the concrete's own
+        /// expansion reaches the bar through ε_b).
+        thermal: f64,
     },
 }
 
@@ -239,8 +243,9 @@ pub fn bar_point_response(
             eps_ref,
             prestrain,
             relax,
+            thermal,
         } => {
-            let eps = eps_b - eps_ref + prestrain - relax;
+            let eps = eps_b - eps_ref + prestrain - relax - thermal;
             let (state, sig, et) = update_uniaxial(steel, committed, eps);
             (
                 BarPointResult {

@@ -90,6 +90,7 @@ type ResponseFn = fn(
     &mut [PointState],
     &mut [GaussOutput],
     &TimeContext,
+    &[f64],
 ) -> Result<(), UpdateError>;
 
 /// A continuum element ready to answer: formulation, node coordinates [m], thickness [m],
@@ -105,6 +106,9 @@ pub struct ContinuumElement<'a> {
     pub material: &'a Material,
     /// Time increment (creep, shrinkage) [d].
     pub time: &'a TimeContext,
+    /// Imposed (stress-free) normal strain θ [-] of each Gauss point, ε_th = θ (1, 1, 0)
+    /// (thermal actions, [`super::thermal`]); empty: none.
+    pub imposed: &'a [f64],
 }
 
 impl super::ElementResponse for ContinuumElement<'_> {
@@ -129,7 +133,17 @@ impl super::ElementResponse for ContinuumElement<'_> {
             }
             Formulation::IncompatibleModes => {
                 super::incompatible::response_at(
-                    c, t, m, committed, u, f, k, trial, out, self.time,
+                    c,
+                    t,
+                    m,
+                    committed,
+                    u,
+                    f,
+                    k,
+                    trial,
+                    out,
+                    self.time,
+                    self.imposed,
                 )?;
                 return Ok(true);
             }
@@ -147,6 +161,7 @@ impl super::ElementResponse for ContinuumElement<'_> {
             trial,
             out,
             self.time,
+            self.imposed,
         )?;
         Ok(true)
     }
@@ -254,6 +269,7 @@ pub fn response_with_time(
         trial,
         out,
         time,
+        &[],
     )
 }
 
@@ -277,7 +293,9 @@ pub(crate) fn gauss_geometry(
 }
 
 /// As [`response_with_time`]; the tangent is formed only when `k` is given (a residual
-/// check or a stress recovery needs forces and stresses alone).
+/// check or a stress recovery needs forces and stresses alone). `imposed` holds the
+/// stress-free normal strain θ of each Gauss point (empty: none): the material sees
+/// ε − θ (1, 1, 0), the output keeps the total strain ε.
 #[allow(clippy::too_many_arguments)]
 pub fn response_at(
     kind: QuadKind,
@@ -292,11 +310,12 @@ pub fn response_at(
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
+    imposed: &[f64],
 ) -> Result<(), UpdateError> {
     if integration == Integration::Incompatible {
         debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
         return super::incompatible::response_at(
-            coords, thickness, mat, committed, u, f, k, trial, out, time,
+            coords, thickness, mat, committed, u, f, k, trial, out, time, imposed,
         );
     }
     let n = kind.n_nodes();
@@ -315,7 +334,8 @@ pub fn response_at(
             eps[1] += dn[a][1] * uy;
             eps[2] += dn[a][1] * ux + dn[a][0] * uy;
         }
-        let (st, sig, d) = update_with_time(mat, &committed[g], &eps, h, time)?;
+        let (st, sig, d) =
+            update_with_time(mat, &committed[g], &mechanical(eps, imposed, g), h, time)?;
         trial[g] = st;
         out[g] = GaussOutput {
             strain: eps,
@@ -356,6 +376,16 @@ pub fn response_at(
         }
     }
     Ok(())
+}
+
+/// The strain the material law sees at Gauss point `g`: the total strain `eps` less the
+/// imposed normal strain θ_g (1, 1, 0) when there is one (`imposed` empty: `eps` itself).
+#[inline]
+pub(crate) fn mechanical(eps: [f64; 3], imposed: &[f64], g: usize) -> [f64; 3] {
+    match imposed.get(g) {
+        Some(&t) if t != 0.0 => [eps[0] - t, eps[1] - t, eps[2]],
+        _ => eps,
+    }
 }
 
 /// Consistent nodal forces [N] of a body force b [N/m³] (e.g. ρ g) over the element.

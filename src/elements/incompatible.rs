@@ -126,6 +126,7 @@ pub fn response_at(
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
+    imposed: &[f64],
 ) -> Result<(), UpdateError> {
     let pts = rule_points(QuadKind::Q4, Integration::Full);
     let (n_pts, geo, h) = gauss_geometry(QuadKind::Q4, Integration::Full, coords);
@@ -149,7 +150,8 @@ pub fn response_at(
         for g in 0..n_pts {
             let (dn, wdet) = geo[g];
             let eps = strain(&dn, &gm[g], u, alpha);
-            let (st, s, d) = update_with_time(mat, &committed[g], &eps, h, time)?;
+            let mech = super::continuum::mechanical(eps, imposed, g);
+            let (st, s, d) = update_with_time(mat, &committed[g], &mech, h, time)?;
             trial[g] = st;
             out[g] = GaussOutput {
                 strain: eps,
@@ -305,6 +307,7 @@ mod tests {
             &mut trial,
             &mut out,
             &TimeContext::default(),
+            &[],
         )
         .unwrap();
         (f, k, out)

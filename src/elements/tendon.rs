@@ -234,6 +234,8 @@ pub struct ExternalTendon {
     initial_stress: Vec<f64>,
     initial_strain: Vec<f64>,
     deviation: Vec<f64>,
+    /// Thermal strain α_p ΔT of each span, a stress-free strain [-] (thermal actions).
+    thermal_strain: Vec<f64>,
 }
 
 /// Relative floor on a span's tangent stiffness inside the friction return mapping, so that
@@ -298,6 +300,7 @@ impl ExternalTendon {
             initial_stress: vec![],
             initial_strain: vec![],
             deviation,
+            thermal_strain: vec![0.0; m],
         };
         t.set_initial_stresses(vec![initial_stress; m])?;
         Ok(t)
@@ -386,6 +389,17 @@ impl ExternalTendon {
         );
         self.initial_strain.copy_from_slice(e);
     }
+    /// Replace the thermal strains α_p ΔT of the spans \[-\] (one per span), stress-free
+    /// strains subtracted from the span strains (`Frictionless`: their length-weighted mean
+    /// over the whole tendon). Panics on a length mismatch.
+    pub fn set_thermal_strains(&mut self, e: &[f64]) {
+        assert_eq!(
+            e.len(),
+            self.n_spans(),
+            "tendon: one thermal strain per span"
+        );
+        self.thermal_strain.copy_from_slice(e);
+    }
     /// Steel modulus E_p \[Pa\].
     pub fn modulus(&self) -> f64 {
         self.modulus
@@ -422,7 +436,8 @@ impl ExternalTendon {
         let m = self.n_spans();
         let s_left = if i >= 1 { s[i - 1] } else { 0.0 };
         let s_right = if i + 1 < m { s[i] } else { 0.0 };
-        self.initial_strain[i] + (l - self.ref_lengths[i] - s_right + s_left) / self.ref_lengths[i]
+        self.initial_strain[i] - self.thermal_strain[i]
+            + (l - self.ref_lengths[i] - s_right + s_left) / self.ref_lengths[i]
     }
 
     /// Response for displacements `u` \[m\] of the tendon points and the committed state.
@@ -454,7 +469,12 @@ impl ExternalTendon {
         match self.mode {
             DeviatorMode::Frictionless => {
                 let lt: f64 = self.ref_lengths.iter().sum();
-                let eps = self.initial_strain[0] + (len.iter().sum::<f64>() - lt) / lt;
+                let thermal: f64 = (self.thermal_strain.iter())
+                    .zip(&self.ref_lengths)
+                    .map(|(e, l)| e * l)
+                    .sum::<f64>()
+                    / lt;
+                let eps = self.initial_strain[0] - thermal + (len.iter().sum::<f64>() - lt) / lt;
                 let (sig, et, st) = self.law.update(self.modulus, eps, &committed.spans[0].law);
                 let kk = self.area * et / lt;
                 dndl.iter_mut().for_each(|x| *x = kk);

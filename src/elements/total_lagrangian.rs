@@ -61,6 +61,7 @@ pub fn response_tl(
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
+    imposed: &[f64],
 ) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
@@ -74,7 +75,9 @@ pub fn response_tl(
         let (dn, wdet) = geo[g];
         let h = displacement_gradient(&dn, u, n);
         let e = green_lagrange(&h);
-        let (st, s, d) = update_with_time(mat, &committed[g], &e, h_len, time)?;
+        // Small strains: the thermal strain is subtracted from the Green strain.
+        let mech = super::continuum::mechanical(e, imposed, g);
+        let (st, s, d) = update_with_time(mat, &committed[g], &mech, h_len, time)?;
         trial[g] = st;
         out[g] = GaussOutput {
             strain: e,
@@ -205,6 +208,7 @@ mod tests {
             &mut trial,
             &mut out,
             &TimeContext::default(),
+            &[],
         )
         .unwrap();
         (f, k, out)
@@ -294,6 +298,7 @@ mod tests {
                 &mut trial,
                 &mut out,
                 &TimeContext::default(),
+                &[],
             )
             .unwrap();
             assert!((out[0].strain[0] - (c - 1.0)).abs() < 1e-12);
@@ -327,6 +332,7 @@ mod tests {
                 &mut trial,
                 &mut out,
                 &TimeContext::default(),
+                &[],
             )
             .unwrap();
             let fmax = fl.iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -128,6 +128,7 @@ pub struct TendonIn {
     pub deviator_friction: Option<f64>,
     pub stressed_in_step: Option<String>,
     pub relaxation_class: Option<i64>,
+    pub thermal_expansion: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -168,6 +169,22 @@ pub struct LoadCaseIn {
     pub point_loads: Vec<PointLoadIn>,
     #[serde(default)]
     pub line_loads: Vec<LineLoadIn>,
+    pub temperature: Option<TemperatureIn>,
+}
+
+/// `[load_cases.temperature]`: a thermal action (docs/input.md, "Thermal actions").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureIn {
+    pub uniform: Option<f64>,
+    pub linear: Option<f64>,
+    pub top: Option<f64>,
+    pub bottom: Option<f64>,
+    pub profile: Option<Vec<[f64; 2]>>,
+    pub code_profile: Option<String>,
+    pub zone: Option<i64>,
+    pub negative_factor: Option<f64>,
+    pub tendons: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

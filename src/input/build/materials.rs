@@ -91,6 +91,8 @@ pub struct MaterialIn {
     // concrete: creep option (takes the elastic_creep keys above)
     pub creep: Option<String>,
     pub nonlinear_creep: Option<bool>,
+    // every kind: thermal actions
+    pub thermal_expansion: Option<f64>,
 }
 
 /// The kinds of `[[materials]]` (`kind = "..."`), one per material law the model file offers.
@@ -134,7 +136,7 @@ impl MaterialKind {
     /// listed here for a kind is an error in a table of that kind.
     pub fn keys(self) -> &'static [&'static str] {
         match self {
-            MaterialKind::Elastic => &["E", "nu", "density"],
+            MaterialKind::Elastic => &["E", "nu", "density", "thermal_expansion"],
             MaterialKind::ElasticCreep => &[
                 "fcm",
                 "nu",
@@ -145,6 +147,7 @@ impl MaterialKind {
                 "n_units",
                 "shrinkage",
                 "drying_start",
+                "thermal_expansion",
             ],
             MaterialKind::Concrete => &[
                 "fcm",
@@ -186,9 +189,10 @@ impl MaterialKind {
                 "shrinkage",
                 "drying_start",
                 "nonlinear_creep",
+                "thermal_expansion",
             ],
-            MaterialKind::Rebar => &["E", "fy", "Et"],
-            MaterialKind::PrestressingSteel => &["Ep", "fptk", "eps_uk"],
+            MaterialKind::Rebar => &["E", "fy", "Et", "thermal_expansion"],
+            MaterialKind::PrestressingSteel => &["Ep", "fptk", "eps_uk", "thermal_expansion"],
         }
     }
 

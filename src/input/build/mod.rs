@@ -107,6 +107,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .unwrap_or(DEFAULT_START_DAY);
     regions::check_ages(ctx, &model, start, w)?;
     tendons::assign_steps(ctx, &file.tendons, &external_of, &mut model)?;
+    loads::thermal_coefficients(ctx, &file, &mut model)?;
     controls::solver(ctx, file.solver.as_ref(), &mut model)?;
     Ok(Built { model, warnings })
 }
