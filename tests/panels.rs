@@ -155,3 +155,42 @@ fn fixed_crack_on_the_unequal_panel_stalls_below_the_rotating_truss_a_known_devi
         r.v_peak
     );
 }
+
+/// The PV panel series (validation/panels/panels.csv, 23 panels with a measured strength,
+/// one element each) under the option recommended for membranes (rotating cracks with
+/// Vecchio–Collins 1993 compression softening) against the seed's model (fixed cracks,
+/// seed β). A **known deviation** (docs/validation.md, "Panel series"): the target
+/// (mean test/predicted 1.00 ± 0.05, COV < 10 %) is not met — measured mean 0.957 and COV
+/// 15.6 % (scatter from PV2, PV12, PV23/PV25; the recalled strengths are unverified). The
+/// bands (mean 0.93–0.98, COV 14–17 %) are the measured values with the round-off of one
+/// more or less increment at a peak, so that a regression and an unexplained improvement
+/// both fail; and the rotating option must scatter less than the seed's model (26.7 %),
+/// whose fixed cracks stall near ρ_weak f_y on the unequally reinforced panels.
+#[test]
+fn panel_series_recommended_option_a_known_deviation() {
+    use segfem::materials::concrete::panel_bench::{mean_cov, options, read_panels};
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/panels/panels.csv");
+    let panels: Vec<Panel> = read_panels(&path)
+        .unwrap()
+        .into_iter()
+        .filter(|p| p.v_test.is_finite())
+        .collect();
+    assert!(panels.len() >= 15, "{} panels", panels.len());
+    let opts = options();
+    let key = |name: &str| opts.iter().find(|o| o.0 == name).unwrap().1;
+    let ratios = |keys: &str| -> Vec<f64> {
+        panels
+            .iter()
+            .map(|p| p.v_test / run_panel(p, keys, 1).unwrap().v_peak)
+            .collect()
+    };
+    let (m_rot, c_rot) = mean_cov(&ratios(key("rotating, VC93")));
+    let (m_fix, c_fix) = mean_cov(&ratios(key("fixed, seed β")));
+    eprintln!(
+        "rotating VC93: mean {m_rot:.3}, COV {c_rot:.3}; fixed seed β: {m_fix:.3}, {c_fix:.3}"
+    );
+    assert!((0.93..0.98).contains(&m_rot), "mean {m_rot:.3}");
+    assert!((0.14..0.17).contains(&c_rot), "COV {c_rot:.3}");
+    assert!(c_rot < c_fix, "COV rotating {c_rot:.3}, fixed {c_fix:.3}");
+}

@@ -73,6 +73,7 @@ pub struct MaterialIn {
     pub compression_reduction_min: Option<f64>,
     pub shear_retention: Option<String>,
     pub aggregate_size: Option<f64>,
+    pub crack_shear_limit: Option<String>,
     // steel
     pub fy: Option<f64>,
     #[serde(rename = "Et")]
@@ -181,6 +182,7 @@ impl MaterialKind {
                 "compression_reduction_min",
                 "shear_retention",
                 "aggregate_size",
+                "crack_shear_limit",
                 "creep",
                 "rh",
                 "h0",
@@ -430,6 +432,7 @@ pub(super) fn concrete_law(
 /// The concrete keys of shear behaviour: crack model, compression softening of cracked
 /// concrete, shear retention of fixed cracks (docs/input.md).
 fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) -> R<()> {
+    use crate::materials::concrete::cracking::CrackShearLimit;
     use crate::materials::concrete::{CompressionReduction, CrackModel, ShearRetentionLaw};
     let k = |f: &str| format!("materials[{i}].{f}");
     p.crack_model = match m.crack_model.as_deref() {
@@ -471,10 +474,10 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
     let seed_keys = m.shear_k1.is_some() || m.shear_eps_ref.is_some();
     p.shear_retention = match m.shear_retention.as_deref() {
         None | Some("seed") => {
-            if m.aggregate_size.is_some() {
+            if m.aggregate_size.is_some() && m.crack_shear_limit.is_none() {
                 return Err(ctx.err(
                     k("aggregate_size"),
-                    "used by shear_retention = \"aggregate\" only",
+                    "used by shear_retention = \"aggregate\" and crack_shear_limit only",
                 ));
             }
             ShearRetentionLaw::Seed
@@ -495,7 +498,25 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
             ))
         }
     };
+    p.crack_shear_limit = match m.crack_shear_limit.as_deref() {
+        None | Some("none") => CrackShearLimit::None,
+        Some("vecchio_collins_1986") => CrackShearLimit::VecchioCollins1986 {
+            d_agg: positive(ctx, &k("aggregate_size"), m.aggregate_size.unwrap_or(0.016))?,
+        },
+        Some(o) => {
+            return Err(ctx.err(
+                k("crack_shear_limit"),
+                format!("unknown value '{o}' (expected none or vecchio_collins_1986)"),
+            ))
+        }
+    };
     if p.crack_model == CrackModel::Rotating {
+        if m.crack_shear_limit.is_some() {
+            return Err(ctx.err(
+                k("crack_shear_limit"),
+                "rotating cracks carry no shear across cracks: crack_shear_limit belongs to crack_model = \"fixed\"",
+            ));
+        }
         if m.shear_retention.is_some() || seed_keys || m.shear_beta_min.is_some() {
             return Err(ctx.err(
                 k("shear_retention"),

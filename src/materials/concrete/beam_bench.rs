@@ -282,6 +282,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
             "crack_integration = \"implex\"\nshear_retention = \"aggregate\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),
         (
+            "fixed, seed β, VC86 limit, VC93",
+            "crack_integration = \"implex\"\ncrack_shear_limit = \"vecchio_collins_1986\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
+        ),
+        (
             "rotating, VC93",
             "crack_integration = \"implex\"\ncrack_model = \"rotating\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),

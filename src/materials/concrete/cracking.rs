@@ -26,6 +26,45 @@
 
 use super::{compression, ConcreteParams, ConcreteState, MaterialError, UpdateResult};
 
+/// Upper limit of the shear stress transferred across a fixed crack by aggregate interlock.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum CrackShearLimit {
+    /// No limit: τ_nt = β G γ_nt however large (the seed's model).
+    #[default]
+    None,
+    /// Vecchio & Collins (1986), from Walraven's aggregate-interlock tests:
+    /// |τ_nt| ≤ v_ci,max = 0.18 √f_cm / (0.31 + 24 w/(a + 16)) (MPa, mm), crack width
+    /// w = h ε_max (h the crack band width), a the largest aggregate size.
+    VecchioCollins1986 {
+        /// Largest aggregate size a [m].
+        d_agg: f64,
+    },
+}
+
+impl CrackShearLimit {
+    /// The largest shear stress v_max [Pa] a crack transfers and dv_max/dε_max [Pa], for
+    /// concrete strength `fcm` [Pa], largest crack-normal strain `eps` [-] and crack band
+    /// width `h` [m]; None without a limit.
+    pub fn limit(&self, fcm: f64, eps: f64, h: f64) -> Option<(f64, f64)> {
+        match *self {
+            CrackShearLimit::None => None,
+            CrackShearLimit::VecchioCollins1986 { d_agg } => {
+                // 24 w/(a + 16 mm) with w, a in metres: 24/(a + 0.016) per metre of width.
+                let c = 24.0 / (d_agg + 0.016);
+                let w = h * eps.max(0.0);
+                let top = 0.18 * (fcm / 1e6).sqrt() * 1e6;
+                let den = 0.31 + c * w;
+                let dv = if eps > 0.0 {
+                    -top * c * h / (den * den)
+                } else {
+                    0.0
+                };
+                Some((top / den, dv))
+            }
+        }
+    }
+}
+
 /// Strain transformation ε' = T ε to axes rotated by `phi` (engineering shear).
 pub fn strain_transform(phi: f64) -> [[f64; 3]; 3] {
     let (s, c) = phi.sin_cos();
@@ -330,8 +369,19 @@ pub fn update_cracked(
         } else {
             r1.loading_crack
         };
-        if loading && !p.secant_crack_tangent && !p.implex {
+        let consistent = loading && !p.secant_crack_tangent && !p.implex;
+        if consistent {
             dl[2][imax] = dbeta * g * el[2];
+        }
+        if let Some((vmax, dv)) = p.crack_shear_limit.limit(p.fcm, emax, char_length) {
+            if sl[2].abs() > vmax {
+                // On the limit τ follows v_max(w) alone; the shear tangent keeps β_min G so
+                // that a fully capped element is not a mechanism (not consistent there).
+                let sgn = sl[2].signum();
+                sl[2] = sgn * vmax;
+                dl[2][2] = p.shear.beta_min * g;
+                dl[2][imax] = if consistent { sgn * dv } else { 0.0 };
+            }
         }
     }
     let (s, d) = to_global(&t, &sl, &dl);

@@ -229,6 +229,9 @@ pub struct ConcreteParams {
     /// Shear retention law of fixed cracks (default the seed's β law).
     #[serde(default)]
     pub shear_retention: ShearRetentionLaw,
+    /// Upper limit of the shear stress a fixed crack transfers (default none, the seed's).
+    #[serde(default)]
+    pub crack_shear_limit: cracking::CrackShearLimit,
     /// MC90 creep and shrinkage in series with cracking and plasticity (None: the
     /// time-independent concrete, the default; see [`creep`]).
     #[serde(skip)]
@@ -273,6 +276,7 @@ impl ConcreteParams {
             crack_model: CrackModel::Fixed,
             compression_reduction: CompressionReduction::None,
             shear_retention: ShearRetentionLaw::Seed,
+            crack_shear_limit: cracking::CrackShearLimit::None,
             creep: None,
         }
     }
@@ -326,6 +330,11 @@ impl ConcreteParams {
             return bad("creep and the viscoplastic option are two time laws: choose one");
         }
         if let ShearRetentionLaw::Aggregate { d_agg } = self.shear_retention {
+            if !(d_agg > 0.0 && d_agg.is_finite()) {
+                return bad("the aggregate size must be > 0");
+            }
+        }
+        if let cracking::CrackShearLimit::VecchioCollins1986 { d_agg } = self.crack_shear_limit {
             if !(d_agg > 0.0 && d_agg.is_finite()) {
                 return bad("the aggregate size must be > 0");
             }

@@ -59,6 +59,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
             "fixed, aggregate β, VC93",
             "shear_retention = \"aggregate\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),
+        (
+            "fixed, seed β, VC86 limit, VC93",
+            "crack_shear_limit = \"vecchio_collins_1986\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
+        ),
         ("rotating", "crack_model = \"rotating\"\n"),
         (
             "rotating, VC93",
@@ -90,7 +94,7 @@ pub fn panel_toml(p: &Panel, keys: &str, n: usize) -> String {
     }
     let q = 1e6 * p.thickness;
     let (qx, qy) = (q * p.normal[0], q * p.normal[1]);
-    let agg = if keys.contains("aggregate") {
+    let agg = if keys.contains("aggregate") || keys.contains("crack_shear_limit") {
         format!("aggregate_size = {}\n", p.agg)
     } else {
         String::new()
@@ -448,6 +452,9 @@ pub fn shear_model_rates(rate: impl Fn(&dyn Fn(f64) -> f64) -> f64) -> Vec<(Stri
     rot.crack_model = CrackModel::Rotating;
     let mut rot_vc = fixed_vc.clone();
     rot_vc.crack_model = CrackModel::Rotating;
+    let mut fixed_lim = fixed_vc.clone();
+    fixed_lim.crack_shear_limit =
+        super::cracking::CrackShearLimit::VecchioCollins1986 { d_agg: 0.016 };
     let e0 = fixed.eps0();
     let crack = |p: &ConcreteParams| {
         update(p, &ConcreteState::new(), &[4.0 * e0, 0.0, 0.0], 0.1)
@@ -474,5 +481,9 @@ pub fn shear_model_rates(rate: impl Fn(&dyn Fn(f64) -> f64) -> f64) -> Vec<(Stri
             run(&fixed, &crack(&fixed), true),
         ),
         ("fixed+VC93, compressed".into(), run(&fixed_vc, &cfv, true)),
+        (
+            "fixed+VC86 limit+VC93, compressed".into(),
+            run(&fixed_lim, &crack(&fixed_lim), true),
+        ),
     ]
 }

@@ -404,3 +404,44 @@ fn rotating_implex_tension_follows_the_envelope_to_first_order() {
         p.ftm
     );
 }
+
+/// Crack shear limit of Vecchio & Collins (1986) through a cracked point (crack normal x,
+/// h = 0.1 m, a = 16 mm): at ε_max = 2.1e-3 (w = 0.21 mm) a large slip γ = 1e-2 carries
+/// exactly v_max = 0.18 √f_cm/(0.31 + 24·0.21/32) MPa (round-off), a small slip γ = 1e-4
+/// the retained β G γ unchanged; ∂τ/∂ε_n on the limit against central differences (1e-6
+/// relative: the step error of a smooth closed form).
+#[test]
+fn crack_shear_limit_caps_the_retained_shear() {
+    let mut p = params();
+    p.crack_shear_limit = cracking::CrackShearLimit::VecchioCollins1986 { d_agg: 0.016 };
+    let st = upd(&p, &ConcreteState::new(), [2e-3, 0.0, 0.0]).0;
+    assert_eq!(st.n_cracks(), 1);
+    let vmax = 0.18 * (FCM / 1e6).sqrt() / (0.31 + 24.0 * 0.21 / 32.0) * 1e6;
+    let big = upd(&p, &st, [2.1e-3, 0.0, 1e-2]);
+    assert!(
+        (big.1[2] - vmax).abs() < 1e-9 * vmax,
+        "{} vs {vmax}",
+        big.1[2]
+    );
+    let neg = upd(&p, &st, [2.1e-3, 0.0, -1e-2]);
+    assert!((neg.1[2] + vmax).abs() < 1e-9 * vmax, "{}", neg.1[2]);
+    let g = 0.5 * p.ec / (1.0 + p.nu);
+    let beta = p.shear_beta(2.1e-3, 0.1).0;
+    let small = upd(&p, &st, [2.1e-3, 0.0, 1e-4]);
+    let want = beta * g * 1e-4;
+    assert!(want < vmax);
+    assert!(
+        (small.1[2] - want).abs() < 1e-9 * want,
+        "{} vs {want}",
+        small.1[2]
+    );
+    let h = 1e-9;
+    let fd = (upd(&p, &st, [2.1e-3 + h, 0.0, 1e-2]).1[2]
+        - upd(&p, &st, [2.1e-3 - h, 0.0, 1e-2]).1[2])
+        / (2.0 * h);
+    assert!(
+        (fd - big.2[2][0]).abs() < 1e-6 * fd.abs(),
+        "{fd} vs {}",
+        big.2[2][0]
+    );
+}
