@@ -27,7 +27,9 @@ def read_history(path: "str | Path") -> pd.DataFrame:
     """history.csv as a DataFrame: columns named without their unit (``Q``,
     ``midspan_uy``, ``factor:Q``, ``time``), the units in ``df.attrs["units"]``
     (column → SI unit, as in the header). Every number equals the file's exactly."""
-    df = pd.read_csv(path, float_precision="round_trip")
+    # pandas 3 parses floats exactly by default (and deprecates the option).
+    exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+    df = pd.read_csv(path, **exact)
     names, units = [], {}
     for h in df.columns:
         m = _HEADER.match(h)

@@ -251,7 +251,8 @@ class Sweep:
                 if parent is not None:
                     get_path(self._data, parent)
             except KeyError as e:
-                raise SweepError(f"{label}: parameters.{p.name}.path: {e.args[0]}") from None
+                why = str(e.args[0]).removeprefix(f"{parent}: ")
+                raise SweepError(f"{label}: parameters.{p.name}.path: {p.path}: {why}") from None
         self._cases: Optional[pd.DataFrame] = None
 
     def _model(self, m: Any) -> Model:
