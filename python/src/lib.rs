@@ -74,6 +74,8 @@ fn snapshot_dict<'py>(py: Python<'py>, s: &Snapshot) -> PyResult<Bound<'py, PyDi
 /// signals (Ctrl-C) are checked there too: a KeyboardInterrupt, or an exception raised by
 /// `progress`, stops the run after the current increment (results so far are written) and
 /// is returned as the second item. Returns (outcome, that exception or None).
+// The keyword arguments of the Python call, one per `segfem run` option.
+#[allow(clippy::too_many_arguments)]
 #[pyfunction]
 #[pyo3(signature = (model, out_dir, progress=None, verbose=false, continue_on_failure=false, stop_after_step=None, restart=false))]
 fn run(
@@ -179,12 +181,13 @@ fn json_to_toml(text: &str) -> PyResult<String> {
     toml::to_string(&t).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// The field outputs listed in `out_dir/results.pvd`: (time, continuum .vtu, tendons and
-/// joints .vtu or None, joint integration points .vtu or None), in output order.
+/// One field output: (time, continuum .vtu, tendons and joints .vtu or None, joint
+/// integration points .vtu or None).
+type FieldFiles = (f64, PathBuf, Option<PathBuf>, Option<PathBuf>);
+
+/// The field outputs listed in `out_dir/results.pvd`, in output order.
 #[pyfunction]
-fn field_outputs(
-    out_dir: PathBuf,
-) -> PyResult<Vec<(f64, PathBuf, Option<PathBuf>, Option<PathBuf>)>> {
+fn field_outputs(out_dir: PathBuf) -> PyResult<Vec<FieldFiles>> {
     let outs = read_pvd(&out_dir).map_err(|e| PyOSError::new_err(e.to_string()))?;
     Ok(outs
         .into_iter()
