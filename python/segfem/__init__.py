@@ -23,6 +23,8 @@ from .errors import (
 )
 from .model import Model, get_path, load, restart, set_path
 from .result import FieldOutput, Grid, Result, read_history
+from . import sweep
+from .sweep import Sweep
 
 __version__: str = _segfem.__version__
 
@@ -37,10 +39,12 @@ __all__ = [
     "RestartError",
     "Result",
     "SegfemError",
+    "Sweep",
     "get_path",
     "load",
     "read_history",
     "restart",
     "set_path",
+    "sweep",
     "__version__",
 ]
