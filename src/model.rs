@@ -2,11 +2,13 @@
 //! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
 
 pub mod element_data;
+pub mod stages;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
 use serde::Serialize;
+pub use stages::{Lifetime, Staging};
 
 /// A continuum element.
 #[derive(Debug, Clone, Serialize)]
@@ -528,6 +530,8 @@ pub struct Model {
     pub geometry: Geometry,
     /// Embedded bars and bonded tendons.
     pub bars: Vec<Bar>,
+    /// Construction stages (empty: everything acts from the start).
+    pub staging: Staging,
 }
 
 impl Model {
