@@ -613,7 +613,11 @@ impl<'m> System<'m> {
                         bar_green_strain(el.kind, &coords, &gp.point, &ue).0
                     } else {
                         let g = bar_strain_row(el.kind, &coords, &gp.point);
-                        g.iter().zip(&ue).map(|(a, b)| a * b).sum()
+                        // Node by node, x and y paired (the arithmetic of the unstaged
+                        // formula, so unstaged results stay bit-identical).
+                        (0..el.nodes.len())
+                            .map(|a| g[2 * a] * ue[2 * a] + g[2 * a + 1] * ue[2 * a + 1])
+                            .sum()
                     };
                 }
                 bars.phase[b] = BarPhase::Bonded;
