@@ -457,7 +457,7 @@ h0 = 0.2
 shrinkage = false
 "#;
 
-/// Two 3.9 m spans, 0.4 m deep, joined over the piers at x = 3.9 and 4.1 m by a 0.2 m
+/// Two 3.8 m spans, 0.4 m deep, on piers at x = 3.8 and 4.2 m joined by a 0.4 m
 /// closure (`closure`, activated by the steps or present from the start); q on both spans.
 fn spans_with_closure(steps: &str) -> String {
     format!(
