@@ -608,6 +608,9 @@ fn check(model: PathBuf) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
+            if let Some(t) = segfem::input::stage_table(m) {
+                out!("{t}");
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -1,13 +1,14 @@
 //! The validated model as plain data: what input produces and the analysis consumes, so that
 //! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
 
-use crate::elements::continuum::Integration;
-use crate::elements::interface::InterfaceParams;
-use crate::elements::tendon::DeviatorMode;
-use crate::fem::shape::QuadKind;
+pub mod element_data;
+pub mod stages;
+
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
+pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
 use serde::Serialize;
+pub use stages::{Lifetime, Staging};
 
 /// A continuum element.
 #[derive(Debug, Clone, Serialize)]
@@ -531,6 +532,8 @@ pub struct Model {
     pub geometry: Geometry,
     /// Embedded bars and bonded tendons.
     pub bars: Vec<Bar>,
+    /// Construction stages (empty: everything acts from the start).
+    pub staging: Staging,
 }
 
 impl Model {
@@ -551,7 +554,7 @@ pub struct BarGaussPoint {
     /// Host element index.
     pub element: usize,
     /// Position in the host (natural coordinates), direction, weight [m], arc length [m].
-    pub point: crate::elements::bar::BarPoint,
+    pub point: BarPoint,
 }
 
 /// An embedded bar or bonded tendon, cut through the mesh at input.

@@ -94,6 +94,7 @@ fn model_from_mesh(
         controls: SolverControls::default(),
         geometry: Default::default(),
         bars: Vec::new(),
+        staging: Default::default(),
     }
 }
 

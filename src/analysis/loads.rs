@@ -5,6 +5,12 @@ use crate::model::{LoadCase, Model};
 
 /// Full-dof external force vector [N] of one load case at factor 1.
 pub fn load_vector(model: &Model, case: &LoadCase) -> Vec<f64> {
+    load_vector_of(model, case, None)
+}
+
+/// As [`load_vector`] with gravity on the active elements only (`active[e]`; all if None):
+/// a part not yet placed, or removed, carries no self-weight.
+pub fn load_vector_of(model: &Model, case: &LoadCase, active: Option<&[bool]>) -> Vec<f64> {
     let mut f = vec![0.0; model.n_dofs()];
     for &(n, [fx, fy]) in &case.point_forces {
         f[2 * n] += fx;
@@ -19,7 +25,10 @@ pub fn load_vector(model: &Model, case: &LoadCase) -> Vec<f64> {
         }
     }
     if let Some(g) = case.gravity {
-        for e in &model.elements {
+        for (i, e) in model.elements.iter().enumerate() {
+            if active.is_some_and(|a| !a[i]) {
+                continue;
+            }
             let region = &model.regions[e.region];
             let rho = model.materials[region.material].law.density();
             if rho == 0.0 {

@@ -11,6 +11,7 @@ pub mod path;
 mod responses;
 pub mod solver;
 pub mod staged;
+pub mod stages;
 pub mod state;
 pub mod steps;
 pub mod system;

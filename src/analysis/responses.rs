@@ -3,6 +3,7 @@
 //! response written into the caller's buffers ([`ElementResponse`]).
 
 use super::families::{BarOutput, BarPhase, Families};
+use super::stages::StageState;
 use crate::analysis::bonded_time::BarPointTime;
 use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
 use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput};
@@ -39,6 +40,8 @@ pub(super) struct HostChunk<'a> {
     /// Imposed (thermal) strains of the chunk's Gauss points and bar points (empty: none).
     imposed: &'a [f64],
     bar_imposed: &'a [f64],
+    /// Construction stages (reference displacements of elements born late), if any.
+    stages: Option<&'a StageState>,
 }
 
 /// One element's own trial slices: element index, point states, Gauss outputs, bar steel
@@ -64,6 +67,7 @@ pub(super) fn split_chunk<'a>(
     time: &'a TimeContext,
     tangent: bool,
     (start, end): (usize, usize),
+    stages: Option<&'a StageState>,
 ) -> (HostChunk<'a>, Vec<HostPiece<'a>>) {
     let g0 = gp_offset[start];
     let g1 = gp_offset[end];
@@ -88,6 +92,7 @@ pub(super) fn split_chunk<'a>(
         bar_time: &bars.time[b0..b1],
         imposed: thermal.points.get(g0..g1).unwrap_or(&[]),
         bar_imposed: thermal.bars.get(b0..b1).unwrap_or(&[]),
+        stages,
     };
     let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
     // Per-element slices.
@@ -141,6 +146,7 @@ impl HostChunk<'_> {
             bar_time,
             imposed,
             bar_imposed,
+            stages,
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -153,6 +159,10 @@ impl HostChunk<'_> {
             coords[a] = model.nodes[n];
             ue[2 * a] = u[2 * n];
             ue[2 * a + 1] = u[2 * n + 1];
+        }
+        // Born in a later stage: stress-free at the displacements it was placed at.
+        if let Some(r) = stages.and_then(|s| s.element_ref[e].as_deref()) {
+            ue.iter_mut().zip(r).for_each(|(a, b)| *a -= b);
         }
         let (coords, ue) = (&coords[..nn], &ue[..nd]);
         let (fe, ke) = (&mut fe[..nd], &mut ke[..nd * nd]);

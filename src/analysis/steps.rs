@@ -29,7 +29,7 @@ pub fn run_with(
 ) -> Result<Timings, AnalysisError> {
     let t0 = Instant::now();
     let mut sys = System::new(model);
-    let cases: Vec<Vec<f64>> = model
+    let mut cases: Vec<Vec<f64>> = model
         .load_cases
         .iter()
         .map(|c| load_vector(model, c))
@@ -55,6 +55,11 @@ pub fn run_with(
         limit_points: Vec::new(),
     };
     match options.resume {
+        Some(_) if sys.stages.is_some() => {
+            return Err(AnalysisError::Restore(
+                "resuming a model with construction stages from a checkpoint is not supported yet: run it from the start".into(),
+            ));
+        }
         Some((d, s)) => {
             if d.factors.len() != driver.factors.len() || d.next_step > model.steps.len() {
                 return Err(AnalysisError::Restore(format!(
@@ -89,6 +94,9 @@ pub fn run_with(
     let mut factored_linear = false;
     for si in driver.next_step..model.steps.len() {
         let step = &model.steps[si];
+        if sys.stages.is_some() {
+            enter_stage(&mut sys, si, clock, &mut cases, &factors)?;
+        }
         sys.stress_tendons(si);
         // Thermal strains of the factors held at the start of the step (path steps keep
         // them; load steps set them again per increment).
@@ -208,6 +216,10 @@ fn load_step(
             }
         }
         ctx.sys.set_thermal(&lam);
+        // Reactions of supports removed at the start of the step, released over it.
+        if let Some(st) = &ctx.sys.stages {
+            st.add_release(&mut f_ext, target);
+        }
         ctx.sys.begin_time_increment(match &step.time {
             Some(span) => TimeContext {
                 t_from: span.time_at(level),
@@ -294,6 +306,36 @@ fn load_step(
                 d_level *= 0.5;
             }
         }
+    }
+    Ok(())
+}
+
+/// Enter the construction stage of step `si` at time `clock` [d]: the external forces of
+/// the previous stage (its load vectors `cases` at `factors`) give the reactions of removed
+/// supports; then the load vectors are those of the parts active now.
+fn enter_stage(
+    sys: &mut System,
+    si: usize,
+    clock: f64,
+    cases: &mut [Vec<f64>],
+    factors: &[f64],
+) -> Result<(), AnalysisError> {
+    let model = sys.model;
+    let mut f_ext = vec![0.0; model.n_dofs()];
+    for (c, l) in cases.iter().zip(factors) {
+        f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
+    }
+    sys.begin_time_increment(TimeContext::at(clock));
+    sys.enter_stage(si, &f_ext).map_err(|(e, err)| {
+        AnalysisError::Mechanism(format!(
+            "entering the stage of step '{}': element {} failed at the committed state: {err:?}",
+            model.steps[si].name,
+            e + 1
+        ))
+    })?;
+    let active = sys.stages.as_ref().map(|s| s.element_active.as_slice());
+    for (c, case) in cases.iter_mut().zip(&model.load_cases) {
+        *c = super::loads::load_vector_of(model, case, active);
     }
     Ok(())
 }

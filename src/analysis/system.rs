@@ -16,6 +16,7 @@ use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBloc
 pub use super::families::{BarOutput, BarPhase};
 use super::responses;
 use super::staged::Staged;
+use super::stages::StageState;
 use crate::fem::numbering::{ElementNumbers, Family};
 use rayon::prelude::*;
 
@@ -65,6 +66,9 @@ pub struct System<'m> {
     pub bar_offset: Vec<usize>,
     /// Imposed strains of the thermal load cases at the current factors.
     pub thermal: super::thermal::Thermal,
+    /// Construction stages: active elements, their reference displacements, held equations
+    /// (None: the model has no stages).
+    pub stages: Option<StageState>,
     /// Element force vectors and matrices of one chunk, kept between assemblies (every
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
@@ -207,10 +211,13 @@ pub struct Assembled {
 impl<'m> System<'m> {
     /// Build dof map, pattern and initial states.
     pub fn new(model: &'m Model) -> Self {
+        // Supports activated or removed by a stage are equations, held while they act.
         let constrained: Vec<(usize, f64)> = model
             .supports
             .iter()
-            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+            .enumerate()
+            .filter(|(i, _)| !model.staging.support_is_staged(*i))
+            .flat_map(|(_, s)| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
             .collect();
         let dofs = DofMap::new(model.nodes.len(), &constrained);
         // The node lists in family order: the assembler's element numbers are the blocks of
@@ -264,7 +271,8 @@ impl<'m> System<'m> {
         let linear = model.materials.iter().all(|m| m.law.is_linear())
             && model.interfaces.is_empty()
             && model.bars.is_empty()
-            && model.geometry == Geometry::Linear;
+            && model.geometry == Geometry::Linear
+            && !model.staging.is_staged();
         let n_gp = committed.len();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
@@ -347,6 +355,7 @@ impl<'m> System<'m> {
             bar_gps,
             bar_offset,
             thermal,
+            stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
         }
     }
@@ -443,6 +452,7 @@ impl<'m> System<'m> {
         let numbers = &self.numbers;
         let mut buf = std::mem::take(&mut self.elem_buf);
         let time = self.time;
+        let stages = self.stages.as_ref();
         // Continuum elements with the bars they host.
         let n_el = model.elements.len();
         let mut start = 0;
@@ -459,8 +469,12 @@ impl<'m> System<'m> {
                 &time,
                 tangent,
                 (start, end),
+                stages,
             );
             let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
+                if stages.is_some_and(|s| !s.element_acts(p.0)) {
+                    return Ok(None);
+                }
                 chunk.element(p, fe, ke).map(|()| Some(true))
             });
             sc.add_chunk(results, start, responses::ND, &mut buf, |e| {
@@ -476,11 +490,18 @@ impl<'m> System<'m> {
         for (start, pieces) in chunks(pieces) {
             let results = compute_chunk(pieces, nd, &mut buf, |(i, trial), fe, ke| {
                 let data = &model.interfaces[i];
-                let ue: Vec<f64> = data
+                if stages.is_some_and(|s| !s.interface_active[i]) {
+                    return Ok(None);
+                }
+                let mut ue: Vec<f64> = data
                     .nodes
                     .iter()
                     .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
                     .collect();
+                // Born in a later stage: closed and stress-free where it was placed.
+                if let Some(r) = stages.and_then(|s| s.interface_ref[i].as_deref()) {
+                    ue.iter_mut().zip(r).for_each(|(a, b)| *a -= b);
+                }
                 let joint = Joint {
                     element: &self.interfaces[i],
                     params: &data.params,
@@ -521,6 +542,9 @@ impl<'m> System<'m> {
             })?;
         }
         self.elem_buf = buf;
+        if let (Some(st), Some(k)) = (stages, sc.k_values.as_mut()) {
+            st.hold_tangent(&self.asm.pattern, k);
+        }
         self.symmetrised = sc.symmetrised;
         let force_scale = sc.f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
         Ok(Assembled {
@@ -576,21 +600,28 @@ impl<'m> System<'m> {
                     let gp = &bar.points[p];
                     let el = &model.elements[gp.element];
                     let coords = model.element_coords(el);
+                    // Measured as the host measures its strains (from its reference when
+                    // it was born in a later stage).
+                    let mut ue: Vec<f64> = el
+                        .nodes
+                        .iter()
+                        .flat_map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+                        .collect();
+                    if let Some(r) = self
+                        .stages
+                        .as_ref()
+                        .and_then(|s| s.element_ref[gp.element].as_deref())
+                    {
+                        ue.iter_mut().zip(r).for_each(|(a, b)| *a -= b);
+                    }
                     bars.eps_ref[i] = if model.geometry == Geometry::Nonlinear {
-                        let ue: Vec<f64> = el
-                            .nodes
-                            .iter()
-                            .flat_map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
-                            .collect();
                         bar_green_strain(el.kind, &coords, &gp.point, &ue).0
                     } else {
                         let g = bar_strain_row(el.kind, &coords, &gp.point);
-                        el.nodes
-                            .iter()
-                            .enumerate()
-                            .map(|(a, &n)| {
-                                g[2 * a] * self.u[2 * n] + g[2 * a + 1] * self.u[2 * n + 1]
-                            })
+                        // Node by node, x and y paired (the arithmetic of the unstaged
+                        // formula, so unstaged results stay bit-identical).
+                        (0..el.nodes.len())
+                            .map(|a| g[2 * a] * ue[2 * a] + g[2 * a + 1] * ue[2 * a + 1])
                             .sum()
                     };
                 }
@@ -628,7 +659,8 @@ impl<'m> System<'m> {
         self.families.commit();
     }
 
-    /// Gather the free-equation part of a full dof vector.
+    /// Gather the free-equation part of a full dof vector (zero on the equations a
+    /// construction stage holds).
     pub fn to_free(&self, full: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.dofs.n_eq];
         for (d, &q) in self.dofs.eq.iter().enumerate() {
@@ -636,6 +668,39 @@ impl<'m> System<'m> {
                 r[q] = full[d];
             }
         }
+        if let Some(st) = &self.stages {
+            st.hold_free(&mut r);
+        }
         r
+    }
+
+    /// Enter the construction stage of step `step` (nothing for a model without stages):
+    /// elements and joints that start to act are stress-free at the current displacements,
+    /// removed supports leave their reactions to be released over the step. `f_ext` are the
+    /// external forces at the end of the previous step (all dofs) [N].
+    pub fn enter_stage(&mut self, step: usize, f_ext: &[f64]) -> Result<(), (usize, UpdateError)> {
+        let Some(entered) = self.stages.as_ref().map(|s| s.step.is_some()) else {
+            return Ok(());
+        };
+        let reaction = if entered && StageState::removes_support(self.model, step) {
+            let u = self.u.clone();
+            // The committed state at the committed displacements: internal forces only.
+            let a = self.assemble(&u, false);
+            self.families.revert();
+            Some(
+                a?.f_int
+                    .iter()
+                    .zip(f_ext)
+                    .map(|(i, e)| i - e)
+                    .collect::<Vec<_>>(),
+            )
+        } else {
+            None
+        };
+        let (model, u, eq) = (self.model, &self.u, &self.dofs.eq);
+        if let Some(st) = self.stages.as_mut() {
+            st.enter(model, step, u, eq, reaction.as_deref());
+        }
+        Ok(())
     }
 }

@@ -97,6 +97,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         controls: SolverControls::default(),
         geometry: Default::default(),
         bars: Vec::new(),
+        staging: Default::default(),
     };
     let wall: Vec<(usize, Dir, f64)> = model
         .nodes

@@ -12,24 +12,9 @@
 
 use crate::fem::shape::{cartesian_derivatives, jacobian, QuadKind, MAX_NODES};
 use crate::materials::steel::{update_uniaxial, SteelParams, SteelState};
-use serde::{Deserialize, Serialize};
 
-/// One integration point of a bar piece.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct BarPoint {
-    /// Natural coordinate ξ in the host element [-].
-    pub xi: f64,
-    /// Natural coordinate η in the host element [-].
-    pub eta: f64,
-    /// Unit bar direction (cos φ, sin φ) [-].
-    pub dir: [f64; 2],
-    /// Integration weight |dx/dr|·w [m]: the sum over a piece is its length.
-    pub weight_length: f64,
-    /// Arc length from the path start [m].
-    pub s: f64,
-    /// Global position [m].
-    pub x: [f64; 2],
-}
+/// A bar point (plain model data, defined in [`crate::model`]).
+pub use crate::model::element_data::BarPoint;
 
 // ------------------------------------------------------------------------------------------
 // Element-level functions

@@ -6,19 +6,8 @@ use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, QuadKind, M
 use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
 use serde::{Deserialize, Serialize};
 
-/// Integration rule of a continuum element.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Integration {
-    /// 2×2 Gauss for Q4, 3×3 for Q8 and Q9.
-    #[default]
-    Full,
-    /// 2×2 Gauss for Q8 and Q9 (Q4 stays 2×2).
-    Reduced,
-    /// Q4 only: 2×2 Gauss with Wilson–Taylor incompatible bending modes (QM6), condensed
-    /// in the element ([`super::incompatible`]).
-    Incompatible,
-}
+/// Integration rule (plain model data, defined in [`crate::model`]).
+pub use crate::model::element_data::Integration;
 
 /// The Gauss points of an element kind under a rule.
 pub fn rule(kind: QuadKind, integration: Integration) -> Vec<Point2> {

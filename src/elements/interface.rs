@@ -19,32 +19,8 @@
 use crate::fem::quadrature::{gauss, lobatto};
 use crate::fem::shape::line_shape;
 
-/// Constitutive and integration parameters of a joint.
-#[derive(Debug, Clone, PartialEq)]
-pub struct InterfaceParams {
-    /// Normal penalty stiffness K_n \[Pa/m\] (normal stress per unit penetration), > 0.
-    pub kn: f64,
-    /// Tangential (shear) penalty stiffness K_t \[Pa/m\], ≥ 0.
-    pub kt: f64,
-    /// Coulomb friction coefficient μ \[-\], ≥ 0.
-    pub friction: f64,
-    /// Cohesion c \[Pa\]: shear strength at zero normal stress, ≥ 0. For a joint with
-    /// `tensile_strength > 0` (epoxy) it is lost together with the bond; otherwise (dry keyed
-    /// joint, key shear term) it is kept while the point is closed.
-    pub cohesion: f64,
-    /// Tensile strength f_t \[Pa\] of a bonded (epoxy) joint, ≥ 0; 0 = dry joint. While the bond
-    /// is intact the normal law is linear in tension too; when the tensile stress exceeds f_t
-    /// the point debonds for good and behaves as a dry joint (no tension, no cohesion).
-    pub tensile_strength: f64,
-    /// Shear-keyed joint: a closed (or bonded) point never slips (no Coulomb limit).
-    pub keyed: bool,
-    /// `true`: Gauss–Lobatto (nodal) integration; `false`: Gauss–Legendre. Both use as many
-    /// points as face A has nodes.
-    pub lobatto: bool,
-    /// Residual stiffness ratio r \[-\] of an open point (tractions r·K·(λ, g_t − s_p)), 0 ≤ r < 1;
-    /// e.g. 1e-6 keeps the global matrix non-singular when a joint is fully open.
-    pub residual_ratio: f64,
-}
+/// Joint parameters (plain model data, defined in [`crate::model`]).
+pub use crate::model::element_data::InterfaceParams;
 
 impl InterfaceParams {
     /// Dry joint with Coulomb friction μ and penalties `kn`, `kt` \[Pa/m\]; Gauss integration,

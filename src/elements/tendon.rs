@@ -30,19 +30,8 @@ use std::sync::Arc;
 
 use crate::materials::steel::{update_uniaxial, HardeningRule, SteelParams, SteelState};
 
-/// How the tendon interacts with the deviators.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum DeviatorMode {
-    /// No slip at deviators: each span deforms independently (dummy-mesh behaviour).
-    Held,
-    /// Free sliding: one strain and one force for the whole tendon.
-    Frictionless,
-    /// Stick/slip with capstan friction coefficient `mu` \[-\] over each deviator's angle.
-    Friction {
-        /// Friction coefficient μ between tendon and deviator saddle \[-\].
-        mu: f64,
-    },
-}
+/// Deviator behaviour (plain model data, defined in [`crate::model`]).
+pub use crate::model::element_data::DeviatorMode;
 
 /// Uniaxial stress–strain function σ(ε) → (σ \[Pa\], dσ/dε \[Pa\]) of total mechanical strain.
 pub type StressFn = Arc<dyn Fn(f64) -> (f64, f64) + Send + Sync>;

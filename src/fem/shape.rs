@@ -5,21 +5,11 @@
 //! starting at (−1, −1), then mid-side nodes of edges 0–1, 1–2, 2–3, 3–0, then (Q9) the centre.
 //! Lines: the two ends, then (3-node) the middle.
 
-use serde::{Deserialize, Serialize};
-
 /// Maximum number of nodes of any element kind.
 pub const MAX_NODES: usize = 9;
 
-/// The quadrilateral element kinds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum QuadKind {
-    /// 4-node bilinear quadrilateral.
-    Q4,
-    /// 8-node serendipity quadrilateral.
-    Q8,
-    /// 9-node Lagrange quadrilateral.
-    Q9,
-}
+/// The quadrilateral element kinds (plain model data, defined in [`crate::model`]).
+pub use crate::model::element_data::QuadKind;
 
 /// Natural coordinates of the nodes of a Q9 (the first 4 / 8 are those of Q4 / Q8).
 pub const NODE_XI: [[f64; 2]; 9] = [

@@ -8,6 +8,7 @@ pub mod locate;
 pub mod schema;
 pub mod units;
 
+pub use build::stage_table;
 pub use build::Built;
 use error::Ctx;
 pub use error::InputError;

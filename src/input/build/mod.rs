@@ -14,6 +14,7 @@ mod materials;
 mod mesh;
 mod monitors;
 mod regions;
+mod stages;
 mod steps;
 mod supports;
 mod tendons;
@@ -21,6 +22,7 @@ mod time;
 
 pub use materials::{MaterialIn, MaterialKind, ViscoplasticIn};
 pub(in crate::input) use mesh::integration;
+pub use stages::table as stage_table;
 pub use time::{DEFAULT_FIRST_SUBSTEP, SUBSTEPS_PER_DECADE};
 
 use super::error::{Ctx, InputError};
@@ -82,6 +84,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         controls: SolverControls::default(),
         geometry: Default::default(),
         bars: Vec::new(),
+        staging: Default::default(),
     };
     units::model_size(w, ctx, locate::model_size(&model));
     if !joints.is_empty() {
@@ -105,9 +108,12 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         .iter()
         .find_map(|s| s.time.map(|t| t.from))
         .unwrap_or(DEFAULT_START_DAY);
-    regions::check_ages(ctx, &model, start, w)?;
+    stages::build(ctx, &file.steps, &mut model)?;
+    let placed = |r: usize| stages::clock_at(&model, model.staging.region(r).from);
+    regions::check_ages(ctx, &model, start, placed, w)?;
     tendons::assign_steps(ctx, &file.tendons, &external_of, &mut model)?;
     loads::thermal_coefficients(ctx, &file, &mut model)?;
+    stages::check_tendons(ctx, &model)?;
     controls::solver(ctx, file.solver.as_ref(), &mut model)?;
     Ok(Built { model, warnings })
 }

@@ -146,11 +146,13 @@ pub(super) fn assign_cast_days(
     Ok(())
 }
 
-/// Check that every creep region exists (is cast) when the analysis starts at `start` [d].
+/// Check that every creep region exists (is cast) when the analysis starts at `start` [d],
+/// or, in a staged model, when the step that activates it starts (`start_of(region)` [d]).
 pub(super) fn check_ages(
     ctx: &Ctx,
     model: &Model,
     start: f64,
+    start_of: impl Fn(usize) -> f64,
     warnings: &mut Vec<String>,
 ) -> R<()> {
     let mut used = vec![false; model.regions.len()];
@@ -160,7 +162,17 @@ pub(super) fn check_ages(
             continue;
         }
         if let Some(cast_day) = model.materials[r.material].law.cast_day() {
-            let age = start - cast_day;
+            let placed = start_of(i);
+            let age = placed - cast_day;
+            if age < 0.0 && placed > start {
+                return Err(ctx.err(
+                    format!("regions[{i}].cast_day"),
+                    format!(
+                        "region '{}' is cast on day {cast_day} but activated on day {placed} (the start of the step that activates it)",
+                        r.name
+                    ),
+                ));
+            }
             if age < 0.0 {
                 return Err(ctx.err(
                     format!("regions[{i}].cast_day"),

@@ -1,0 +1,162 @@
+//! Construction stages in the analysis (docs/theory-stages.md): which elements act in the
+//! current step, the displacements they were born at, the equations held because no active
+//! element (or an active staged support) moves them, and the reactions of removed supports
+//! released as loads over the removal step.
+//!
+//! An element activated after the first step is stress-free where the structure stands when
+//! it is placed: its strains are measured from the nodal displacements at activation
+//! (`element_ref`), subtracted when the assembly gathers its displacements. Dofs touched by
+//! no active element are held where they are, as are the dofs of an active staged support:
+//! their rows and columns of the tangent are replaced by a unit diagonal and their residual
+//! by zero, so the equation numbering and sparsity pattern stay those of the whole model.
+
+use crate::fem::dofs::CONSTRAINED;
+use crate::fem::pattern::LowerPattern;
+use crate::model::Model;
+
+/// The stage the analysis is in and what it implies for the assembly.
+#[derive(Debug, Clone, Default)]
+pub struct StageState {
+    /// Index of the step whose stage is set (None before the first).
+    pub step: Option<usize>,
+    /// Whether each continuum element acts.
+    pub element_active: Vec<bool>,
+    /// Displacements of each element's nodes when it was activated after the first step
+    /// (interleaved x, y per node) [m]; None: born with the structure (reference zero).
+    pub element_ref: Vec<Option<Vec<f64>>>,
+    /// Whether each joint contact element acts (all its nodes on active elements).
+    pub interface_active: Vec<bool>,
+    /// Displacements of each contact element's nodes when it was activated after the first
+    /// step [m] (None: from the start).
+    pub interface_ref: Vec<Option<Vec<f64>>>,
+    /// Equations held where they are in this stage (index = equation).
+    pub held: Vec<bool>,
+    /// Reactions of the supports removed at the start of this step (all dofs) [N], released
+    /// linearly over the step: the load (1 − level) · release is added to the external
+    /// forces.
+    pub release: Vec<f64>,
+}
+
+/// Displacements [m] of `nodes` in `u`, interleaved.
+fn gather(nodes: &[usize], u: &[f64]) -> Vec<f64> {
+    nodes
+        .iter()
+        .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
+        .collect()
+}
+
+impl StageState {
+    /// Whether continuum element `e` acts.
+    pub fn element_acts(&self, e: usize) -> bool {
+        self.element_active[e]
+    }
+
+    /// Set the stage of step `step` at displacements `u` [m]; `eq` maps dofs to equations.
+    /// Elements and contact elements that start to act take `u` as their reference;
+    /// supports removed now leave `reaction` (f_int − f_ext at their dofs, all dofs [N]) as
+    /// the load to release over the step.
+    pub fn enter(
+        &mut self,
+        model: &Model,
+        step: usize,
+        u: &[f64],
+        eq: &[usize],
+        reaction: Option<&[f64]>,
+    ) {
+        let st = &model.staging;
+        let first = self.step.is_none();
+        let n_el = model.elements.len();
+        self.element_active.resize(n_el, false);
+        self.element_ref.resize(n_el, None);
+        for (e, el) in model.elements.iter().enumerate() {
+            let acts = st.region(el.region).active_in(step);
+            if acts && !self.element_active[e] && !first {
+                self.element_ref[e] = Some(gather(&el.nodes, u));
+            }
+            self.element_active[e] = acts;
+        }
+        let mut alive = vec![false; model.nodes.len()];
+        for (e, el) in model.elements.iter().enumerate() {
+            if self.element_active[e] {
+                el.nodes.iter().for_each(|&n| alive[n] = true);
+            }
+        }
+        let n_if = model.interfaces.len();
+        self.interface_active.resize(n_if, false);
+        self.interface_ref.resize(n_if, None);
+        for (i, itf) in model.interfaces.iter().enumerate() {
+            let acts = itf.nodes.iter().all(|&n| alive[n]);
+            if acts && !self.interface_active[i] && !first {
+                self.interface_ref[i] = Some(gather(&itf.nodes, u));
+            }
+            self.interface_active[i] = acts;
+        }
+        let n_eq = eq.iter().filter(|&&q| q != CONSTRAINED).count();
+        self.held = vec![false; n_eq];
+        for (d, &q) in eq.iter().enumerate() {
+            if q != CONSTRAINED && !alive[d / 2] {
+                self.held[q] = true;
+            }
+        }
+        self.release = vec![0.0; u.len()];
+        for (s, sp) in model.supports.iter().enumerate() {
+            let l = st.support(s);
+            if !st.support_is_staged(s) {
+                continue;
+            }
+            for &(n, dir, _) in &sp.dofs {
+                let d = 2 * n + dir.index();
+                let q = eq[d];
+                if q == CONSTRAINED {
+                    continue;
+                }
+                if l.active_in(step) {
+                    self.held[q] = true;
+                } else if l.until == Some(step) {
+                    if let Some(r) = reaction {
+                        self.release[d] = r[d];
+                    }
+                }
+            }
+        }
+        self.step = Some(step);
+    }
+
+    /// Whether a support is removed at the start of step `step` (the reactions must then be
+    /// computed before [`StageState::enter`]).
+    pub fn removes_support(model: &Model, step: usize) -> bool {
+        (0..model.supports.len()).any(|s| model.staging.support(s).until == Some(step))
+    }
+
+    /// Replace the rows and columns of the held equations in the lower-triangle tangent
+    /// `k` of `pattern` by a unit diagonal (their corrections are then zero).
+    pub fn hold_tangent(&self, pattern: &LowerPattern, k: &mut [f64]) {
+        for j in 0..pattern.n {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let i = pattern.row_idx[p];
+                if self.held[i] || self.held[j] {
+                    k[p] = if i == j { 1.0 } else { 0.0 };
+                }
+            }
+        }
+    }
+
+    /// Zero the free-equation entries of the held equations (their residuals).
+    pub fn hold_free(&self, free: &mut [f64]) {
+        for (v, &h) in free.iter_mut().zip(&self.held) {
+            if h {
+                *v = 0.0;
+            }
+        }
+    }
+
+    /// Add the released reactions at `level` ∈ [0, 1] of the step to `f_ext` [N].
+    pub fn add_release(&self, f_ext: &mut [f64], level: f64) {
+        let s = 1.0 - level;
+        if s > 0.0 {
+            for (f, r) in f_ext.iter_mut().zip(&self.release) {
+                *f += s * r;
+            }
+        }
+    }
+}
