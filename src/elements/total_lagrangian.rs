@@ -16,7 +16,7 @@
 
 use super::continuum::{GaussOutput, Integration};
 use crate::fem::shape::{QuadKind, MAX_NODES};
-use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
+use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
 /// `h[i][j] = ∂u_i/∂X_j` [-].
@@ -74,8 +74,7 @@ pub fn response_tl(
         let (dn, wdet) = geo[g];
         let h = displacement_gradient(&dn, u, n);
         let e = green_lagrange(&h);
-        let (st, s, d) = update_with_time(mat, &committed[g], &e, h_len, time)?;
-        trial[g] = st;
+        let (s, d) = update_into(mat, &committed[g], &e, h_len, time, &mut trial[g])?;
         out[g] = GaussOutput {
             strain: e,
             stress: s,
