@@ -367,15 +367,18 @@ pub fn update_into(
     Ok((sig, d))
 }
 
+/// New concrete state, stress (σx, σy, τxy) [Pa] and tangent [Pa].
+type ConcreteUpdate = (ConcreteState, [f64; 3], [[f64; 3]; 3]);
+
 /// The concrete point's update (with creep in series where the law has it) and its
 /// symmetrised tangent.
 fn concrete_update(
     params: &concrete::ConcreteParams,
-    c: &concrete::ConcreteState,
+    c: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
     time: &TimeContext,
-) -> Result<(concrete::ConcreteState, [f64; 3], [[f64; 3]; 3]), UpdateError> {
+) -> Result<ConcreteUpdate, UpdateError> {
     let res = match &params.creep {
         // Creep and shrinkage in series with the crack laws (concrete/creep.rs).
         Some(cr) => concrete::creep::update(
