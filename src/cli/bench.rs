@@ -339,6 +339,21 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
     })
 }
 
+/// CPU time of this process so far, user + system, all threads [s] (Linux /proc/self/stat,
+/// in clock ticks of 1/100 s, the kernel's USER_HZ); 0 where unknown. Less sensitive than
+/// wall time to other work on a shared machine.
+pub fn process_cpu_s() -> f64 {
+    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which may hold spaces) in parentheses: utime and
+    // stime are the 12th and 13th of them.
+    let rest = s.rsplit_once(')').map_or("", |x| x.1);
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
+
 /// Figures of a run of the seed beam to failure.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FailureRow {
@@ -352,6 +367,8 @@ pub struct FailureRow {
     pub iterations: usize,
     /// Whole run, including any failed last increment [s].
     pub total_s: f64,
+    /// CPU time of the whole run, user + system, all threads [s].
+    pub cpu_s: f64,
     /// Largest load Q reached [kN].
     pub q_max: f64,
     /// Midspan deflection at the last converged increment [m] (downward negative).
@@ -453,6 +470,7 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
     text.push('\n');
     text.push_str(step);
     let t0 = Instant::now();
+    let cpu0 = process_cpu_s();
     let model = segfem::input::parse(&text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
@@ -489,6 +507,7 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         increments: obs.increments,
         iterations: obs.iterations,
         total_s: t0.elapsed().as_secs_f64(),
+        cpu_s: process_cpu_s() - cpu0,
         q_max: obs.q_max,
         deflection: obs.deflection,
         tendon_stress: obs.tendon_stress,
@@ -570,6 +589,8 @@ pub struct RcRow {
     pub iterations: usize,
     /// Whole run, including a failed last increment [s].
     pub total_s: f64,
+    /// CPU time of the whole run, user + system, all threads [s].
+    pub cpu_s: f64,
     /// Largest load per load point reached [N].
     pub p_max: f64,
     /// Midspan deflection at the last converged increment [m].
@@ -615,6 +636,7 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         return Err("rc-beam.toml changed: cannot refine its mesh".into());
     }
     let t0 = Instant::now();
+    let cpu0 = process_cpu_s();
     let model = segfem::input::parse(&text, "rc-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
@@ -630,6 +652,7 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         increments: obs.increments,
         iterations: obs.iterations,
         total_s: t0.elapsed().as_secs_f64(),
+        cpu_s: process_cpu_s() - cpu0,
         p_max: obs.p_max,
         deflection: obs.deflection,
         end,

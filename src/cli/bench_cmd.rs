@@ -63,12 +63,13 @@ pub(crate) fn bench_bare(path: &std::path::Path) -> ExitCode {
 
 pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode {
     outln!(
-        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
+        "{:>28} {:>9} {:>5} {:>6} {:>8} {:>7} {:>8} {:>10} {:>10} {:>9} {:>7}  failure; end",
         "case",
         "equations",
         "incs",
         "iters",
         "total s",
+        "CPU s",
         "Q max",
         "uy [m]",
         "σp [MPa]",
@@ -79,12 +80,13 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
         match super::bench::seed_failure_case(r, concrete) {
             Ok(x) => {
                 outln!(
-                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
+                    "{:>28} {:>9} {:>5} {:>6} {:>8.3} {:>7.2} {:>8.1} {:>10.4e} {:>10.1} {:>9.2} {:>7}  {}; {}",
                     x.case,
                     x.equations,
                     x.increments,
                     x.iterations,
                     x.total_s,
+                    x.cpu_s,
                     x.q_max,
                     x.deflection,
                     x.tendon_stress / 1e6,
@@ -118,24 +120,26 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
 /// Print one row per refinement factor of a seed-beam benchmark `case`.
 pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
     outln!(
-        "{:>18} {:>9} {:>5} {:>6} {:>8} {:>9} {:>9}  end",
+        "{:>18} {:>9} {:>5} {:>6} {:>8} {:>8} {:>9} {:>9}  end",
         "case",
         "equations",
         "incs",
         "iters",
         "total s",
+        "CPU s",
         "P max kN",
         "w [mm]"
     );
     for r in refine {
         match super::bench::rc_case(r) {
             Ok(x) => outln!(
-                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>9.1} {:>9.2}  {}",
+                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>8.2} {:>9.1} {:>9.2}  {}",
                 x.case,
                 x.equations,
                 x.increments,
                 x.iterations,
                 x.total_s,
+                x.cpu_s,
                 x.p_max / 1e3,
                 x.deflection * 1e3,
                 x.end

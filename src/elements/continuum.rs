@@ -3,7 +3,7 @@
 
 use crate::fem::quadrature::{gauss, gauss_square, Point2};
 use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, QuadKind, MAX_NODES};
-use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
+use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 use serde::{Deserialize, Serialize};
 
 /// Integration rule (plain model data, defined in [`crate::model`]).
@@ -323,9 +323,9 @@ pub fn response_at(
             eps[1] += dn[a][1] * uy;
             eps[2] += dn[a][1] * ux + dn[a][0] * uy;
         }
-        let (st, sig, d) =
-            update_with_time(mat, &committed[g], &mechanical(eps, imposed, g), h, time)?;
-        trial[g] = st;
+        // Into the trial slot: no allocation of a new boxed concrete state per point.
+        let mech = mechanical(eps, imposed, g);
+        let (sig, d) = update_into(mat, &committed[g], &mech, h, time, &mut trial[g])?;
         out[g] = GaussOutput {
             strain: eps,
             stress: sig,

@@ -16,7 +16,7 @@
 
 use super::continuum::{gauss_geometry, rule_points, GaussOutput, Integration};
 use crate::fem::shape::{jacobian, QuadKind, MAX_NODES};
-use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
+use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
 /// Local Newton iterations allowed for α.
 const MAX_LOCAL: usize = 30;
@@ -151,8 +151,7 @@ pub fn response_at(
             let (dn, wdet) = geo[g];
             let eps = strain(&dn, &gm[g], u, alpha);
             let mech = super::continuum::mechanical(eps, imposed, g);
-            let (st, s, d) = update_with_time(mat, &committed[g], &mech, h, time)?;
-            trial[g] = st;
+            let (s, d) = update_into(mat, &committed[g], &mech, h, time, &mut trial[g])?;
             out[g] = GaussOutput {
                 strain: eps,
                 stress: s,

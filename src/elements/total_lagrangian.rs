@@ -16,7 +16,7 @@
 
 use super::continuum::{GaussOutput, Integration};
 use crate::fem::shape::{QuadKind, MAX_NODES};
-use crate::materials::point::{update_with_time, Material, PointState, TimeContext, UpdateError};
+use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
 /// `h[i][j] = ∂u_i/∂X_j` [-].
@@ -77,8 +77,7 @@ pub fn response_tl(
         let e = green_lagrange(&h);
         // Small strains: the thermal strain is subtracted from the Green strain.
         let mech = super::continuum::mechanical(e, imposed, g);
-        let (st, s, d) = update_with_time(mat, &committed[g], &mech, h_len, time)?;
-        trial[g] = st;
+        let (s, d) = update_into(mat, &committed[g], &mech, h_len, time, &mut trial[g])?;
         out[g] = GaussOutput {
             strain: e,
             stress: s,

@@ -285,38 +285,7 @@ pub fn update_with_time(
             Ok((PointState::Elastic, mul3(&d, strain), d))
         }
         (Material::Concrete { params, .. }, PointState::Concrete(c)) => {
-            let res = match &params.creep {
-                // Creep and shrinkage in series with the crack laws (concrete/creep.rs).
-                Some(cr) => concrete::creep::update(
-                    params,
-                    cr,
-                    c,
-                    strain,
-                    char_length,
-                    time.t_from,
-                    time.t_to,
-                    time.extrapolation,
-                ),
-                None => concrete::update_full(
-                    params,
-                    c,
-                    strain,
-                    char_length,
-                    time.dt(),
-                    time.extrapolation,
-                ),
-            };
-            let (st, sig, mut d) = res.map_err(UpdateError::from)?;
-            // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
-            // the symmetric solvers take its symmetric part (same converged answer, possibly
-            // more iterations).
-            for i in 0..3 {
-                for j in 0..i {
-                    let m = 0.5 * (d[i][j] + d[j][i]);
-                    d[i][j] = m;
-                    d[j][i] = m;
-                }
-            }
+            let (st, sig, d) = concrete_update(params, c, strain, char_length, time)?;
             Ok((PointState::Concrete(Box::new(st)), sig, d))
         }
         (
@@ -372,6 +341,77 @@ pub fn update_with_time(
             st.kind_name()
         ),
     }
+}
+
+/// As [`update_with_time`], writing the new state into `trial` (the slot of the previous
+/// iterate's state): a concrete point reuses the slot's box instead of allocating one per
+/// point and assembly. Same state, stress and tangent.
+pub fn update_into(
+    mat: &Material,
+    committed: &PointState,
+    strain: &[f64; 3],
+    char_length: f64,
+    time: &TimeContext,
+    trial: &mut PointState,
+) -> Result<([f64; 3], [[f64; 3]; 3]), UpdateError> {
+    if let (Material::Concrete { params, .. }, PointState::Concrete(c)) = (mat, committed) {
+        let (st, sig, d) = concrete_update(params, c, strain, char_length, time)?;
+        match trial {
+            PointState::Concrete(slot) => **slot = st,
+            other => *other = PointState::Concrete(Box::new(st)),
+        }
+        return Ok((sig, d));
+    }
+    let (st, sig, d) = update_with_time(mat, committed, strain, char_length, time)?;
+    *trial = st;
+    Ok((sig, d))
+}
+
+/// New concrete state, stress (σx, σy, τxy) [Pa] and tangent [Pa].
+type ConcreteUpdate = (ConcreteState, [f64; 3], [[f64; 3]; 3]);
+
+/// The concrete point's update (with creep in series where the law has it) and its
+/// symmetrised tangent.
+fn concrete_update(
+    params: &concrete::ConcreteParams,
+    c: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    time: &TimeContext,
+) -> Result<ConcreteUpdate, UpdateError> {
+    let res = match &params.creep {
+        // Creep and shrinkage in series with the crack laws (concrete/creep.rs).
+        Some(cr) => concrete::creep::update(
+            params,
+            cr,
+            c,
+            strain,
+            char_length,
+            time.t_from,
+            time.t_to,
+            time.extrapolation,
+        ),
+        None => concrete::update_full(
+            params,
+            c,
+            strain,
+            char_length,
+            time.dt(),
+            time.extrapolation,
+        ),
+    };
+    let (st, sig, mut d) = res.map_err(UpdateError::from)?;
+    // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
+    // the symmetric solvers take its symmetric part (same converged answer, possibly
+    // more iterations).
+    for i in 0..3 {
+        for j in 0..i {
+            let m = 0.5 * (d[i][j] + d[j][i]);
+            d[i][j] = m;
+            d[j][i] = m;
+        }
+    }
+    Ok((st, sig, d))
 }
 
 /// The state an update should start from for the rest of an increment once a crack has

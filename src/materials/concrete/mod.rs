@@ -673,7 +673,7 @@ pub fn update_full(
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let s_tr = matvec(&d, &ee);
-    let (_, phi) = principal_max(&s_tr);
+    let (s1, phi) = principal_max(&s_tr);
     // Plastic (compression) branch: if the trial stress is compression-dominated, or if the
     // trial would yield and the returned stress is compression-dominated. Routing on the
     // returned stress as well avoids sending a plastically flowing point to the elastic
@@ -683,7 +683,8 @@ pub fn update_full(
     // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
     let ebar0 = compression::initial_yield(p).0;
     let ebar_n = committed.ebar.max(ebar0);
-    let yields = compression::sigma_hat(p, &s_tr).0
+    // σ̂_e alone (the value of `compression::sigma_hat`, without its gradient).
+    let yields = ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
         > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
     if trial_cd || yields || committed.hold_plastic {
         let res = compression::update_rate(
@@ -725,7 +726,6 @@ pub fn update_full(
         }
     }
     // Tension-dominated: elastic until the Ottosen failure surface, then crack.
-    let (s1, _) = principal_max(&s_tr);
     if s1 >= p.crack_ratio * p.ftm && ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
         let mut st = committed.clone();
         st.n_cracks = 1;

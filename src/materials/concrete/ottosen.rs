@@ -128,7 +128,16 @@ pub fn criterion_gradient(p: &OttosenParams, fcm: f64, s: &[f64; 3]) -> [f64; 3]
 /// §2), σ_e = ½[p + √(p² + 4αJ2)], p = λ√J2 + βI1. Positively homogeneous of degree 1;
 /// σ_e ≥ f_cm ⇔ F(σ; f_cm) ≥ 0.
 pub fn equivalent_stress(p: &OttosenParams, s: &[f64; 3]) -> f64 {
-    equivalent_stress_gradient(p, s).0
+    // The value alone, in the operations of [`equivalent_stress_gradient`] (same bits): the
+    // routing check of every elastic point calls it.
+    let inv = invariants(s);
+    if inv.j2 <= 0.0 {
+        return (p.beta * inv.i1).max(0.0);
+    }
+    let (lam, _) = lambda(p, inv.cos3theta);
+    let pp = lam * inv.j2.sqrt() + p.beta * inv.i1;
+    let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
+    0.5 * (pp + root)
 }
 
 /// σ_e [Pa] and its gradient ∂σ_e/∂(σx, σy, τxy) [-]. At σ = 0 the gradient is that of
@@ -167,17 +176,34 @@ pub fn equivalent_stress_gradient(p: &OttosenParams, s: &[f64; 3]) -> (f64, [f64
 /// Uniaxial-compression factor q_c = σ_e(−1, 0, 0) [-] (docs/theory-concrete.md §4): σ_e of a
 /// uniaxial compression of magnitude f is q_c f.
 pub fn q_c(p: &OttosenParams) -> f64 {
-    equivalent_stress(p, &[-1.0, 0.0, 0.0])
+    // Memoised per thread for the last parameter set: the return mapping normalises σ_e by
+    // q_c at every residual, and one evaluation costs an arccos (a sixth of a plastic run).
+    thread_local! {
+        static LAST: std::cell::Cell<Option<(OttosenParams, f64)>> =
+            const { std::cell::Cell::new(None) };
+    }
+    LAST.with(|last| match last.get() {
+        Some((k, q)) if k == *p => q,
+        _ => {
+            let q = equivalent_stress(p, &[-1.0, 0.0, 0.0]);
+            last.set(Some((*p, q)));
+            q
+        }
+    })
 }
 
 /// λ [-], dλ/dc [-] and d²λ/dc² [-] at c = cos3θ (see [`lambda`]): with x = c2 c,
 /// ψ = arccos x, d²λ/dx² = (c1/3)[x sin(ψ/3)/√(1 − x²) − cos(ψ/3)/3]/(1 − x²).
 fn lambda_d2(p: &OttosenParams, c: f64) -> (f64, f64, f64) {
-    let (lam, dlam) = lambda(p, c);
+    // The operations of [`lambda`] (same bits) sharing its arccos and sine/cosine.
     let c2 = p.c2.min(C2_MAX);
     let x = (c2 * c).clamp(-1.0, 1.0);
-    let (psi3, s2) = (x.acos() / 3.0, 1.0 - x * x);
-    let d2 = p.c1 / 3.0 * (x * psi3.sin() / s2.sqrt() - psi3.cos() / 3.0) / s2;
+    let psi3 = x.acos() / 3.0;
+    let (sin3, cos3) = psi3.sin_cos();
+    let lam = p.c1 * cos3;
+    let dlam = p.c1 * c2 * sin3 / (3.0 * (1.0 - x * x).sqrt());
+    let s2 = 1.0 - x * x;
+    let d2 = p.c1 / 3.0 * (x * sin3 / s2.sqrt() - cos3 / 3.0) / s2;
     (lam, dlam, c2 * c2 * d2)
 }
 
@@ -195,13 +221,44 @@ fn outer(a: &[f64; 3], b: &[f64; 3]) -> [[f64; 3]; 3] {
 /// Symmetrised (it is symmetric up to round-off). Zero at σ = 0, the apex of the surface
 /// (J2 = 0), where σ_e is not twice differentiable; no loading surface passes through it.
 pub fn equivalent_stress_hessian(p: &OttosenParams, s: &[f64; 3]) -> [[f64; 3]; 3] {
+    equivalent_stress_derivatives(p, s).2
+}
+
+/// σ_e [Pa], its gradient [-] and its Hessian [1/Pa] in one pass: the values of
+/// [`equivalent_stress_gradient`] and [`equivalent_stress_hessian`] to the bit (the same
+/// operations), with the invariants, the arccos and the sine/cosine of λ(θ) evaluated once
+/// instead of four times (the return mapping needs all three at every Newton iterate).
+pub fn equivalent_stress_derivatives(
+    p: &OttosenParams,
+    s: &[f64; 3],
+) -> (f64, [f64; 3], [[f64; 3]; 3]) {
     let inv = invariants(s);
-    if inv.j2 <= 0.0 {
-        return [[0.0; 3]; 3];
-    }
     let (di1, dj2, dj3) = invariant_gradients(s, &inv);
+    if inv.j2 <= 0.0 {
+        let v = (p.beta * inv.i1).max(0.0);
+        let g = if v > 0.0 { p.beta } else { 0.0 };
+        return (v, [g, g, 0.0], [[0.0; 3]; 3]);
+    }
     let (j2, c) = (inv.j2, inv.cos3theta);
     let (lam, dlam, d2lam) = lambda_d2(p, c);
+    // Value and gradient, as in `equivalent_stress_gradient`.
+    let (se, grad) = {
+        let sj2 = inv.j2.sqrt();
+        let pp = lam * sj2 + p.beta * inv.i1;
+        let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
+        let se = 0.5 * (pp + root);
+        let d_p = 0.5 * (1.0 + pp / root);
+        let d_j2_direct = p.alpha / root;
+        let dc_dj2 = -1.5 * c / inv.j2;
+        let dc_dj3 = 1.5 * 3f64.sqrt() / inv.j2.powf(1.5);
+        let p_j2 = lam / (2.0 * sj2) + sj2 * dlam * dc_dj2;
+        let p_j3 = sj2 * dlam * dc_dj3;
+        let g_i1 = d_p * p.beta;
+        let g_j2 = d_p * p_j2 + d_j2_direct;
+        let g_j3 = d_p * p_j3;
+        let g: [f64; 3] = std::array::from_fn(|i| g_i1 * di1[i] + g_j2 * dj2[i] + g_j3 * dj3[i]);
+        (se, g)
+    };
     let u = j2.sqrt();
     let k = 1.5 * 3f64.sqrt();
     // c(J2, J3): first and second partial derivatives.
@@ -259,7 +316,7 @@ pub fn equivalent_stress_hessian(p: &OttosenParams, s: &[f64; 3]) -> [[f64; 3]; 
         h[i][j] = v;
         h[j][i] = v;
     }
-    h
+    (se, grad, h)
 }
 
 /// Hessian ∂²σ_e/∂σ² [1/Pa] by central differences of the analytic gradient, step
