@@ -47,7 +47,7 @@ VENV_PY = HERE / ".venv" / "bin" / "python"
 # to 5e5 dofs; at 1e6 dofs its analysis fails (the displacement stays 0), SparseSYM is used.
 OPENSEES_SYSTEM = "UmfPack"
 
-# Material and load of the linear square (ECOSYSTEM.md §B.2): E [Pa], nu, t [m], total
+# Material and load of the linear square (docs/performance.md, side by side): E [Pa], nu, t [m], total
 # shear force on the right edge [N].
 E, NU, T = 30e9, 0.2, 0.2
 P_TOTAL = -1.0e5
@@ -654,8 +654,8 @@ def main():
     for kind in ("Q4", "Q8"):
         if kind.lower() in only:
             for s in args.sizes.split(","):
-                # CalculiX's plane-stress elements are 3D bricks underneath (ECOSYSTEM.md
-                # §B.2): its answers differ by ~1e-3; OpenSees' quad/quad8n are segfem's.
+                # CalculiX's plane-stress elements are 3D bricks underneath (see
+                # docs/performance.md): its answers differ by ~1e-3; OpenSees' quad/quad8n are segfem's.
                 problems.append((linear_problem(kind, int(float(s))), {"*": 1e-6, "CalculiX": 3e-3}))
     if "contact" in only:
         # Sliding force / normal force = mu once the whole joint slides; CalculiX's
