@@ -863,3 +863,269 @@ duration = 1e4
         }
     }
 }
+
+/// The seed beam over its life, built from the bundled examples: creep-beam.toml's model
+/// (MC90 creep and shrinkage, segments cast 30–90 days before the clock's day 0, class 2
+/// relaxation), seed-beam.toml's geometrically nonlinear analysis, the prestress step, then
+/// — with `long_term` — creep-beam.toml's 10⁴ days under prestress and self weight, and
+/// seed-beam.toml's steps to failure (service, ultimate, arc length to L/60).
+fn seed_beam_life(long_term: bool) -> String {
+    let creep = include_str!("../examples/creep-beam.toml");
+    let seed = include_str!("../examples/seed-beam.toml");
+    let model = &creep[..creep.find("[[steps]]").unwrap()];
+    let analysis = &seed[seed.find("[analysis]").unwrap()..seed.find("[[steps]]").unwrap()];
+    let prestress = &creep[creep.find("[[steps]]\nname = \"prestress\"").unwrap()
+        ..creep.find("[[steps]]\nname = \"long_term\"").unwrap()];
+    let time = &creep[creep.find("[[steps]]\nname = \"long_term\"").unwrap()
+        ..creep.find("[[steps]]\nname = \"service\"").unwrap()];
+    let to_failure = &seed[seed.find("[[steps]]\nname = \"service\"").unwrap()..];
+    assert!(analysis.contains("geometry = \"nonlinear\"") && time.contains("to = 10000.0"));
+    let time = if long_term { time } else { "" };
+    format!("{model}{analysis}{prestress}{time}{to_failure}")
+}
+
+/// One converged increment of the seed beam's life.
+#[derive(Debug, Clone)]
+struct LifeRow {
+    /// Step index (0-based: 0 is the prestress step).
+    step: usize,
+    /// Q [kN] (load factor of case "Q").
+    q: f64,
+    /// Span forces of the tendon [N]; span 1 lies between the deviators, over the midspan
+    /// joints.
+    forces: Vec<f64>,
+    /// Smallest normal stress over the joints' integration points, compression positive [Pa].
+    sigma_min: f64,
+    /// x [m] of that point.
+    x_min: f64,
+    /// Some joint point open.
+    open: bool,
+    /// Creep + shrinkage and relaxation losses (length-weighted mean) [Pa].
+    losses: [f64; 2],
+}
+
+#[derive(Default)]
+struct Life {
+    rows: Vec<LifeRow>,
+    watch: segfem::results::ultimate::UltimateWatch,
+}
+
+impl Observer for Life {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        self.watch.increment(s);
+        let sys = s.system;
+        let (mut sigma_min, mut x_min, mut open) = (f64::INFINITY, 0.0, false);
+        for j in 0..sys.model.joints.len() {
+            for p in segfem::results::joints::summarise(sys, j).profile {
+                open |= !p.closed;
+                if p.normal_stress < sigma_min {
+                    (sigma_min, x_min) = (p.normal_stress, p.x[0]);
+                }
+            }
+        }
+        let t = sys.families.tendons.time[0].as_ref();
+        self.rows.push(LifeRow {
+            step: s.step,
+            q: s.factors[1],
+            forces: sys.families.tendons.states.committed[0]
+                .as_ref()
+                .map_or_else(Vec::new, |t| t.forces()),
+            sigma_min,
+            x_min,
+            open,
+            losses: t.map_or([0.0; 2], |t| {
+                [
+                    t.loss(LossPart::CreepShrinkage),
+                    t.loss(LossPart::Relaxation),
+                ]
+            }),
+        });
+        Ok(())
+    }
+}
+
+/// Decompression of the first joint: Q [kN], middle-span tendon force [N] and x [m] of the
+/// joint point, extrapolated linearly to zero contact stress from the last two increments
+/// with every joint closed (the response is linear elastic until a joint opens).
+fn decompression(rows: &[LifeRow]) -> (f64, f64, f64) {
+    let i = rows
+        .iter()
+        .position(|r| r.q > 0.0 && (r.open || r.sigma_min <= 0.0))
+        .expect("no joint opens");
+    let (a, b) = (&rows[i - 2], &rows[i - 1]);
+    assert!(
+        a.q > 0.0 && b.q > a.q,
+        "two closed increments under Q before opening"
+    );
+    let s = b.sigma_min / (a.sigma_min - b.sigma_min); // fraction of (b − a) past b
+    let q = b.q + s * (b.q - a.q);
+    assert!(
+        q > b.q && q <= rows[i].q,
+        "decompression {q} kN outside ({}, {}]",
+        b.q,
+        rows[i].q
+    );
+    (q, b.forces[1] + s * (b.forces[1] - a.forces[1]), b.x_min)
+}
+
+/// The seed beam pushed to failure from its long-term state (10⁴ days of creep, shrinkage
+/// and relaxation after prestress and self weight) against the same beam pushed at once
+/// (without a time step the clock stays at its default 28 d: the segments are 28 days older
+/// and a little stiffer, which moves deflections but none of the statics checked here).
+#[test]
+fn seed_beam_fails_from_its_long_term_state_as_statics_says() {
+    use segfem::materials::mc90_time::creep_coefficient;
+    let run_life = |long_term: bool| {
+        let model = segfem::input::parse(&seed_beam_life(long_term), "seed-beam-life.toml")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .model;
+        let mut life = Life::default();
+        let done = steps::run(&model, &mut life);
+        let ultimate = life.watch.finish(&model, done.is_ok()).expect("a verdict");
+        done.unwrap();
+        (life.rows, ultimate)
+    };
+    let (short, u_short) = run_life(false);
+    let (long, u_long) = run_life(true);
+
+    // (a) Losses at 10⁴ d against EC2 5.10.6 (2) with the MC90 functions, as
+    // `seed_beam_long_term_loss_matches_the_ec2_estimate`, here for creep-beam.toml's data:
+    // h0 = 0.15 m, drying from day 7, each segment with its own age at loading (cast on days
+    // −90 … −30, prestressed on day 0), means along the unbonded tendon, each span's force.
+    let end = long.iter().rposition(|r| r.step == 1).unwrap(); // end of the time step
+    let [fe_cs, fe_rel] = long[end].losses;
+    let p = CreepShrinkageParams::new(45e6, 0.70, 0.15, CementClass::N, 7.0);
+    let (ep, ap, l) = (195e9, 560e-6, 7.2);
+    let alpha = ep / p.eci();
+    let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
+    let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for (b, h) in bands {
+        ac += b * h;
+        sy += b * h * (y0 + h / 2.0);
+        y0 += h;
+    }
+    let yc = sy / ac;
+    let (mut ic, mut y0) = (0.0, 0.0);
+    for (b, h) in bands {
+        ic += b * h * h * h / 12.0 + b * h * (y0 + h / 2.0 - yc).powi(2);
+        y0 += h;
+    }
+    let q_sw = ac * 2548.4 * 9.81; // self weight [N/m]
+    let m_sw = |x: f64| q_sw * x * (l - x) / 2.0;
+    let yp = |x: f64| {
+        if x < 2.4 {
+            0.30 - 0.2 * x / 2.4
+        } else if x > 4.8 {
+            0.10 + 0.2 * (x - 4.8) / 2.4
+        } else {
+            0.10
+        }
+    };
+    // Span forces after prestress and self weight [N] (the instantaneous step).
+    let spans = &long[0].forces;
+    let n = 7200;
+    let (mut phi_sc, mut phi_m, mut eps_cs, mut z2) = (0.0, 0.0, 0.0, 0.0);
+    for i in 0..=n {
+        let x = l * i as f64 / n as f64;
+        let w = if i == 0 || i == n { 0.5 } else { 1.0 } / n as f64;
+        let seg = ((x / (l / 7.0)) as usize).min(6);
+        let t0 = 90.0 - 10.0 * seg as f64; // age at prestressing [d]
+        let t = t0 + 1e4;
+        let phi = creep_coefficient(&p, t, t0);
+        let pf = spans[((x / 2.4) as usize).min(2)];
+        let z = yc - yp(x);
+        let sc = pf / ac + pf * z * z / ic - m_sw(x) * z / ic; // compression positive
+        phi_sc += w * phi * sc;
+        phi_m += w * phi;
+        eps_cs += w * -(shrinkage_strain(&p, t) - shrinkage_strain(&p, t0));
+        z2 += w * z * z;
+    }
+    // At σp0 = 0.46 f_ptk MC90 class 2 gives no relaxation (none below 0.5 f_ptk).
+    let s0 = spans[1] / ap;
+    let rho = segfem::materials::mc90_time::relaxation_loss(
+        segfem::materials::mc90_time::RelaxationClass::Class2,
+        s0 / 1900e6,
+        1e4,
+    ) * s0;
+    assert!(rho == 0.0 && fe_rel == 0.0, "relaxation {rho}, FE {fe_rel}");
+    let hand = (eps_cs * ep + alpha * phi_sc)
+        / (1.0 + alpha * ap / ac * (1.0 + ac * z2 / ic) * (1.0 + 0.8 * phi_m));
+    eprintln!(
+        "seed beam life: spans {spans:?} N; loss at 1e4 d FE {:.1} MPa vs EC2 {:.1} MPa (mean φ {phi_m:.3}, ε_cs {eps_cs:.3e})",
+        fe_cs / 1e6,
+        hand / 1e6
+    );
+    // 15 %, the band of the EC2 check on the seed beam and for the same reasons: a fixed
+    // ageing coefficient 0.8, a sectional formula with the eccentricity and stress averaged
+    // along the unbonded tendon, no shear lag or joints.
+    assert!(
+        (fe_cs / hand - 1.0).abs() < 0.15,
+        "FE {fe_cs} vs EC2 {hand}"
+    );
+
+    // (b) Decompression. At a joint the concrete carries the middle span's force P at the
+    // tendon's eccentricity and the moment of the loads (statically determinate beam, free
+    // body cut through the joint and the middle span), so the contact stress at a point of the
+    // joint vanishes at M_dec = P (k + e) with k, e fixed by the section and the tendon: M_dec
+    // ∝ P. With M = M_sw(x_J) + a Q (a = 2.4 m, the point loads' lever between them) the long-
+    // term decompression load follows from the short-term one:
+    // Q_dec,L = [(a Q_dec,S + M_sw) P_L/P_S − M_sw]/a, so ΔQ_dec/Q_dec is Δσ_p/σ_p amplified
+    // by M_dec/(M_dec − M_sw) — self weight takes part of the decompression moment.
+    let (qs, ps, xs) = decompression(&short);
+    let (ql, pl, xl) = decompression(&long);
+    let a = 2.4e3; // lever arm [m] × 1 kN per unit of Q [N]
+    assert!((xs - xl).abs() < 1e-9, "first opening at x = {xs} vs {xl}");
+    let m_dec_s = a * qs + m_sw(xs);
+    let ql_beam = (m_dec_s * pl / ps - m_sw(xl)) / a;
+    let dp = 1.0 - pl / ps;
+    eprintln!(
+        "decompression: short Q = {qs:.2} kN (P = {:.1} kN), long Q = {ql:.2} kN (P = {:.1} kN) at x = {xs:.3} m; \
+         ΔP/P = {:.2} %, ΔQ/Q = {:.2} % (beam theory {:.2} %, amplification M_dec/(M_dec − M_sw) = {:.3})",
+        ps / 1e3,
+        pl / 1e3,
+        100.0 * dp,
+        100.0 * (1.0 - ql / qs),
+        100.0 * (1.0 - ql_beam / qs),
+        m_dec_s / (m_dec_s - m_sw(xs))
+    );
+    // 1 % of Q_dec (≈ 0.5 kN): the proportionality is exact for the section forces; what is
+    // not is the local stress field at the joint, 0.7 m (1.1 depths) from the deviator and
+    // load point, whose share from the deviator forces changes with the ratio of span forces
+    // (held deviators: the spans lose differently, < 1 % here), and the nonlinear geometry
+    // (the tendon's eccentricity at the joint moves with the sag between deviators, < 0.1 mm
+    // of 0.25 m). The linear extrapolation is exact for a linear response.
+    assert!(
+        (ql - ql_beam).abs() < 0.01 * ql_beam,
+        "long-term decompression at Q = {ql:.2} kN vs beam theory {ql_beam:.2} kN"
+    );
+    assert!(dp > 0.05, "the prestress must have dropped: ΔP/P = {dp}");
+
+    // (c) Ultimate load. The tendon yields at f_py = 0.9 f_ptk whatever its initial stress:
+    // Q_u = (T_y z − M_sw)/a depends on T_y = f_py A_p and the lever arm z at the opened
+    // joint, not on P0. What the 10⁴ days change is z: the contact block's depth (the aged
+    // concrete is stiffer) and the camber (≈ 1 mm, of which the sag between the deviators is
+    // a fraction), each well under 1 mm of z ≈ 0.49 m: 1 %.
+    let (qu_s, qu_l) = (u_short.peak_factor, u_long.peak_factor);
+    eprintln!(
+        "ultimate: short {qu_s:.2} kN ({}), long {qu_l:.2} kN ({}); {:+.2} %",
+        u_short.mode,
+        u_long.mode,
+        100.0 * (qu_l / qu_s - 1.0)
+    );
+    assert!((qu_l / qu_s - 1.0).abs() < 0.01, "Q_u {qu_l} vs {qu_s}");
+    // And both against statics of the opened midspan joint (as tests/seed_beam.rs: tendon
+    // at d_p = 0.50 m below the top, rectangular block in the 1.20 m top flange), within its
+    // 3 % (elastic triangular block, eccentricity lost between the deviators, increments).
+    let t_y = 0.9 * 1900e6 * ap;
+    let m_u = t_y * (0.50 - t_y / (0.85 * 45e6 * 1.20) / 2.0);
+    let q_statics = (m_u - m_sw(l / 2.0)) / a;
+    for qu in [qu_s, qu_l] {
+        assert!((qu / q_statics - 1.0).abs() < 0.03, "{qu} vs {q_statics}");
+    }
+    // (d) The same failure: the tendon yields, in the step to failure, and the runs end.
+    for u in [&u_short, &u_long] {
+        assert_eq!(u.mode, "tendon yield", "{u}");
+        assert_eq!(u.ended, "completed", "{u}");
+        assert_eq!(u.peak_step, "failure", "{u}");
+    }
+}
