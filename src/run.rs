@@ -11,6 +11,7 @@ use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
 use crate::results::plausibility::Plausibility;
 use crate::results::recorder::Recorder;
+use crate::results::stages::{self as stage_results, StageResult};
 use crate::results::sustained::SustainedStress;
 use crate::results::ultimate::{Ultimate, UltimateWatch};
 use serde::Serialize;
@@ -140,6 +141,9 @@ pub struct Summary {
     pub regions: Vec<String>,
     /// Joint names, in model order (the .vtu `joint` arrays count from 1 in this order).
     pub joints: Vec<String>,
+    /// Construction stages of a staged model, as in stages.csv (absent without stages).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<StageResult>,
     /// Runs to failure (a displacement or arc-length step, or a failure met): which
     /// failure was reached first and at what load, and the peak load.
     pub ultimate: Option<Ultimate>,
@@ -200,13 +204,13 @@ pub fn monitor_info(model: &Model) -> Vec<MonitorInfo> {
         .collect()
 }
 
-/// Names of the files a run writes into its output directory: history.csv, results.pvd,
-/// summary.json, the checkpoint, report.html and the field files
-/// `[lines_|bars_|gauss_|joints_]stepNNN_incNNNN.vtu`.
+/// Names of the files a run writes into its output directory: history.csv, stages.csv,
+/// results.pvd, summary.json, the checkpoint, report.html and the field files
+/// `[lines_|bars_|gauss_|joints_]stepNNN[_<stage name>]_incNNNN.vtu`.
 pub fn is_run_file(name: &str) -> bool {
     if matches!(
         name,
-        "history.csv" | "results.pvd" | "summary.json" | "report.html"
+        "history.csv" | "stages.csv" | "results.pvd" | "summary.json" | "report.html"
     ) || name == crate::results::checkpoint::FILE
     {
         return true;
@@ -219,9 +223,18 @@ pub fn is_run_file(name: &str) -> bool {
         .find_map(|p| stem.strip_prefix(p))
         .unwrap_or(stem);
     let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    // The stage name of a staged run (file-safe: letters, digits, `-`, `_`) may follow
+    // the step number.
+    let slug = |s: &str| {
+        s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
+    };
     stem.strip_prefix("step")
-        .and_then(|r| r.split_once("_inc"))
-        .is_some_and(|(a, b)| digits(a) && digits(b))
+        .and_then(|r| r.rsplit_once("_inc"))
+        .is_some_and(|(a, b)| {
+            let (n, name) = a.split_once('_').unwrap_or((a, ""));
+            digits(n) && slug(name) && digits(b)
+        })
 }
 
 /// Remove the files an earlier run left in `out` (only the names of [`is_run_file`]; other
@@ -394,7 +407,7 @@ pub fn run_file_opts(
         let n = clear_stale(out)?;
         if n > 0 {
             built.warnings.push(format!(
-                "{}: removed {n} files of an earlier run (history.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
+                "{}: removed {n} files of an earlier run (history.csv, stages.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
                 out.display()
             ));
         }
@@ -473,6 +486,12 @@ pub fn run_file_opts(
     // History is written whatever happened: every converged increment is kept.
     rec.write_history()
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("history.csv").display())))?;
+    let stages = stage_results::stage_results(&model, &rec.rows, &rec.openings);
+    if !stages.is_empty() {
+        let p = out.join("stages.csv");
+        write_atomic(&p, stage_results::render_csv(&stages).as_bytes())
+            .map_err(|e| RunError::Io(format!("{}: {e}", p.display())))?;
+    }
     let final_monitors = rec
         .rows
         .last()
@@ -559,6 +578,7 @@ pub fn run_file_opts(
         monitors: monitor_info(&model),
         regions: model.regions.iter().map(|r| r.name.clone()).collect(),
         joints: model.joints.iter().map(|j| j.name.clone()).collect(),
+        stages,
         ultimate,
         plausibility,
         warnings,

@@ -7,6 +7,7 @@ pub mod gauss_points;
 pub mod joints;
 pub mod plausibility;
 pub mod recorder;
+pub mod stages;
 pub mod sustained;
 pub mod ultimate;
 pub mod vtu;

@@ -54,6 +54,10 @@ pub struct Recorder<'m> {
     dir: PathBuf,
     /// Recorded rows.
     pub rows: Vec<Row>,
+    /// Per row: the largest opening of an open joint point [m] and its joint (staged models
+    /// only, else (0, None); not a history.csv column and not in the checkpoint, as staged
+    /// runs are not restarted: stages.csv reports it per stage).
+    pub openings: Vec<(f64, Option<usize>)>,
     pvd: Vec<(f64, usize, String)>,
     /// Displacements at the end of each step some monitor measures from.
     step_end_u: std::collections::HashMap<usize, Vec<f64>>,
@@ -89,6 +93,7 @@ impl<'m> Recorder<'m> {
             model,
             dir,
             rows: Vec::new(),
+            openings: Vec::new(),
             pvd: Vec::new(),
             step_end_u: Default::default(),
             write_fields,
@@ -115,6 +120,7 @@ impl<'m> Recorder<'m> {
     /// Continue from a saved state (rows and field files recorded before a restart).
     pub fn restore(&mut self, s: RecorderState) {
         self.rows = s.rows;
+        self.openings = vec![(0.0, None); self.rows.len()];
         self.pvd = s.pvd;
         self.step_end_u = s.step_end_u.into_iter().collect();
         self.history = None;
@@ -458,40 +464,29 @@ impl<'m> Recorder<'m> {
                 },
             ],
         );
-        let name = format!("step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
+        let tag = field_tag(model, snap.step);
+        let name = format!("{tag}_inc{:04}.vtu", snap.increment);
         write_atomic(&self.dir.join(&name), doc.as_bytes())?;
         let t = self.rows.len() as f64;
         self.pvd.push((t, 0, name));
         if let Some(lines) = render_lines(snap, &disp) {
-            let name = format!(
-                "lines_step{:03}_inc{:04}.vtu",
-                snap.step + 1,
-                snap.increment
-            );
+            let name = format!("lines_{tag}_inc{:04}.vtu", snap.increment);
             write_atomic(&self.dir.join(&name), lines.as_bytes())?;
             self.pvd.push((t, 1, name));
         }
         if !model.bars.is_empty() {
-            let bname = format!("bars_step{:03}_inc{:04}.vtu", snap.step + 1, snap.increment);
+            let bname = format!("bars_{tag}_inc{:04}.vtu", snap.increment);
             write_atomic(&self.dir.join(&bname), bars_vtu(snap).as_bytes())?;
             self.pvd.push((t, 2, bname));
         }
         if super::gauss_points::wanted(model) {
-            let gname = format!(
-                "gauss_step{:03}_inc{:04}.vtu",
-                snap.step + 1,
-                snap.increment
-            );
+            let gname = format!("gauss_{tag}_inc{:04}.vtu", snap.increment);
             let doc = super::gauss_points::render_gauss_points(snap);
             write_atomic(&self.dir.join(&gname), doc.as_bytes())?;
             self.pvd.push((t, 3, gname));
         }
         if let Some(doc) = super::joints::render_joint_points(snap.system) {
-            let jname = format!(
-                "joints_step{:03}_inc{:04}.vtu",
-                snap.step + 1,
-                snap.increment
-            );
+            let jname = format!("joints_{tag}_inc{:04}.vtu", snap.increment);
             write_atomic(&self.dir.join(&jname), doc.as_bytes())?;
             self.pvd.push((t, 4, jname));
         }
@@ -511,6 +506,11 @@ impl Observer for Recorder<'_> {
             self.step_end_u.insert(snap.step, snap.system.u.clone());
         }
         let monitors = self.monitor_values(snap);
+        let (joint_opening, opening_joint) = if self.model.staging.is_staged() {
+            super::stages::largest_opening(snap.system)
+        } else {
+            (0.0, None)
+        };
         self.rows.push(Row {
             step: snap.step,
             increment: snap.increment,
@@ -522,6 +522,7 @@ impl Observer for Recorder<'_> {
             arc_length_factor: snap.arc_length_factor.unwrap_or(f64::NAN),
             control_force: snap.control_force.unwrap_or(f64::NAN),
         });
+        self.openings.push((joint_opening, opening_joint));
         // The history first: results.pvd never lists an increment history.csv lacks.
         self.flush_history()?;
         let step = &self.model.steps[snap.step];
@@ -543,6 +544,22 @@ impl Observer for Recorder<'_> {
             });
         }
         Ok(())
+    }
+}
+
+/// The step part of the field file names: `stepNNN`, and for a staged model
+/// `stepNNN_<step name>` (the name made file-safe by [`super::stages::file_slug`]), so that
+/// the files of each construction stage carry its name.
+fn field_tag(model: &Model, step: usize) -> String {
+    let slug = if model.staging.is_staged() {
+        super::stages::file_slug(&model.steps[step].name)
+    } else {
+        String::new()
+    };
+    if slug.is_empty() {
+        format!("step{:03}", step + 1)
+    } else {
+        format!("step{:03}_{slug}", step + 1)
     }
 }
 

@@ -316,6 +316,64 @@ fn summary_section(dir: &Path) -> (String, String) {
     (title, s)
 }
 
+/// The construction stages of a staged run (summary.json `stages`, as in stages.csv): a
+/// table of the stages with their history rows and largest joint opening, and a warning in
+/// words for each joint that opened in a stage before the last one (during construction).
+/// Empty for a run without stages.
+fn stages_section(dir: &Path) -> String {
+    let Some(v) = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+    else {
+        return String::new();
+    };
+    let Ok(stages) =
+        serde_json::from_value::<Vec<crate::results::stages::StageResult>>(v["stages"].clone())
+    else {
+        return String::new();
+    };
+    if stages.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "<h2>Construction stages</h2>\n<table id=\"stages\">\n<tr><th>step</th><th>name</th><th>placed</th><th>removed</th><th>history rows</th><th>largest joint opening [mm]</th><th>joint</th></tr>\n",
+    );
+    for st in &stages {
+        let rows = st
+            .history_rows
+            .map_or("(not run)".to_string(), |(a, b)| format!("{a}–{b}"));
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            st.step,
+            esc(&st.name),
+            esc(&st.activated.join(", ")),
+            esc(&st.removed.join(", ")),
+            rows,
+            num(st.max_joint_opening * 1e3),
+            esc(st.joint.as_deref().unwrap_or("–")),
+        );
+    }
+    s.push_str("</table>\n");
+    let mut any = false;
+    for st in crate::results::stages::construction_openings(&stages) {
+        any = true;
+        let _ = writeln!(
+            s,
+            "<p class=\"bad\" id=\"stage-opening-{}\"><b>Joint '{}' opens during construction:</b> {} mm in stage {} '{}'.</p>",
+            st.step,
+            esc(st.joint.as_deref().unwrap_or("")),
+            num(st.max_joint_opening * 1e3),
+            st.step,
+            esc(&st.name)
+        );
+    }
+    if !any {
+        s.push_str("<p id=\"stage-openings\">No joint opens during construction (the stages before the last).</p>\n");
+    }
+    s
+}
+
 /// `segfem report`: write the HTML page; returns its path and the notes on skipped parts.
 pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError> {
     let h = read_history(&opts.dir)?;
@@ -342,6 +400,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         head = headline(&opts.dir, &h),
         d = esc(&opts.dir.display().to_string())
     );
+    html.push_str(&stages_section(&opts.dir));
     let _ = write!(
         html,
         "<h2>Key numbers of the history ({} converged increments)</h2>\n{}",

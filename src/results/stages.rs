@@ -1,0 +1,192 @@
+//! Results per construction stage (docs/input.md, "Output files"): for each step of a staged
+//! model, the parts it places and removes, the rows of history.csv it produced and the
+//! largest joint opening reached during it, written as `stages.csv` and listed in
+//! summary.json. A joint that opens in a stage before the last one opened during
+//! construction.
+
+use super::joints::summarise;
+use super::recorder::Row;
+use crate::analysis::system::System;
+use crate::model::Model;
+
+/// One construction stage (one step of a staged model), as reported.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StageResult {
+    /// Step number (1-based, as in history.csv).
+    pub step: usize,
+    /// Step name.
+    pub name: String,
+    /// Regions and supports placed at the start of the step (in the first step: those that
+    /// are removed later; parts that act throughout are not listed).
+    pub activated: Vec<String>,
+    /// Regions and supports removed at the start of the step.
+    pub removed: Vec<String>,
+    /// First and last data row of the step in history.csv (1-based, the header not
+    /// counted); None when the step produced no converged increment.
+    pub history_rows: Option<(usize, usize)>,
+    /// Largest opening of an open joint point during the step [m] (0 when none opens).
+    pub max_joint_opening: f64,
+    /// Name of the joint that reached it (None when none opens).
+    pub joint: Option<String>,
+}
+
+/// Largest opening [m] among the open (not in contact) points of all joints of the
+/// committed state, with the joint's index; (0, None) when no point is open.
+pub fn largest_opening(sys: &System) -> (f64, Option<usize>) {
+    let mut best = (0.0, None);
+    for j in 0..sys.model.joints.len() {
+        for p in summarise(sys, j).profile {
+            if !p.closed && p.opening > best.0 {
+                best = (p.opening, Some(j));
+            }
+        }
+    }
+    best
+}
+
+/// Names of the regions and supports whose lifetime satisfies `pick`.
+fn parts(model: &Model, pick: impl Fn(crate::model::Lifetime) -> bool) -> Vec<String> {
+    let st = &model.staging;
+    let regions = model
+        .regions
+        .iter()
+        .enumerate()
+        .filter(|(r, _)| pick(st.region(*r)))
+        .map(|(_, r)| r.name.clone());
+    let supports = model
+        .supports
+        .iter()
+        .enumerate()
+        .filter(|(s, _)| pick(st.support(*s)))
+        .map(|(_, s)| s.name.clone());
+    regions.chain(supports).collect()
+}
+
+/// The stages of a staged model from its history rows and, per row, the largest joint
+/// opening [m] with its joint ([`largest_opening`]); empty for a model without stages.
+pub fn stage_results(
+    model: &Model,
+    rows: &[Row],
+    openings: &[(f64, Option<usize>)],
+) -> Vec<StageResult> {
+    use crate::model::Lifetime;
+    if !model.staging.is_staged() {
+        return Vec::new();
+    }
+    model
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, step)| {
+            let mine: Vec<usize> = rows
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| r.step == i)
+                .map(|(k, _)| k)
+                .collect();
+            let history_rows = match (mine.first(), mine.last()) {
+                (Some(a), Some(b)) => Some((a + 1, b + 1)),
+                _ => None,
+            };
+            let (max_joint_opening, joint) = mine
+                .iter()
+                .filter_map(|&k| openings.get(k).and_then(|&(o, j)| j.map(|j| (o, j))))
+                .fold(
+                    (0.0, None),
+                    |best, (o, j)| {
+                        if o > best.0 {
+                            (o, Some(j))
+                        } else {
+                            best
+                        }
+                    },
+                );
+            StageResult {
+                step: i + 1,
+                name: step.name.clone(),
+                activated: parts(model, |l| l.from == i && l != Lifetime::ALWAYS),
+                removed: parts(model, |l| l.until == Some(i)),
+                history_rows,
+                max_joint_opening,
+                joint: joint.map(|j: usize| model.joints[j].name.clone()),
+            }
+        })
+        .collect()
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
+fn field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The text of stages.csv: a header with units, then one line per stage. Lists of parts
+/// are separated by `;`; an empty row range (a step that did not run) leaves its cells
+/// blank.
+pub fn render_csv(stages: &[StageResult]) -> String {
+    let mut s = String::from(
+        "step,name,activated,removed,first_row,last_row,max_joint_opening [m],joint\n",
+    );
+    for st in stages {
+        let (a, b) = st
+            .history_rows
+            .map_or((String::new(), String::new()), |(a, b)| {
+                (a.to_string(), b.to_string())
+            });
+        s.push_str(&format!(
+            "{},{},{},{},{a},{b},{:e},{}\n",
+            st.step,
+            field(&st.name),
+            field(&st.activated.join(";")),
+            field(&st.removed.join(";")),
+            st.max_joint_opening,
+            field(st.joint.as_deref().unwrap_or("")),
+        ));
+    }
+    s
+}
+
+/// The stages before the last one in which a joint opened (construction openings).
+pub fn construction_openings(stages: &[StageResult]) -> impl Iterator<Item = &StageResult> {
+    let n = stages.len();
+    stages
+        .iter()
+        .take(n.saturating_sub(1))
+        .filter(|s| s.max_joint_opening > 0.0 && s.joint.is_some())
+}
+
+/// A file-name-safe form of a step name: letters, digits, `-` and `_` kept, any other run
+/// of characters made one `-`, trimmed of `-` at both ends (empty if nothing is left).
+pub fn file_slug(name: &str) -> String {
+    let mut s = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() || c == '_' {
+            s.push(c);
+        } else if !s.ends_with('-') {
+            s.push('-');
+        }
+    }
+    s.trim_matches('-').to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slugs_are_file_safe() {
+        assert_eq!(file_slug("strike falsework"), "strike-falsework");
+        assert_eq!(file_slug(" span 1 / pier (temp) "), "span-1-pier-temp");
+        assert_eq!(file_slug("äö"), "");
+    }
+
+    #[test]
+    fn csv_fields_with_commas_are_quoted() {
+        assert_eq!(field("a,b"), "\"a,b\"");
+        assert_eq!(field("say \"x\""), "\"say \"\"x\"\"\"");
+        assert_eq!(field("plain"), "plain");
+    }
+}
