@@ -151,8 +151,21 @@ pub fn equivalent_stress_gradient(p: &OttosenParams, s: &[f64; 3]) -> (f64, [f64
         let g = if v > 0.0 { p.beta } else { 0.0 };
         return (v, [g, g, 0.0]);
     }
+    let (lam, dlam) = lambda(p, inv.cos3theta);
+    value_and_gradient(p, &inv, (&di1, &dj2, &dj3), lam, dlam)
+}
+
+/// σ_e [Pa] and ∂σ_e/∂σ [-] off the apex (J2 > 0) from the invariants, their gradients and
+/// λ, dλ/dc at c = cos3θ: shared by [`equivalent_stress_gradient`] and
+/// [`equivalent_stress_derivatives`] so the two give the same bits.
+fn value_and_gradient(
+    p: &OttosenParams,
+    inv: &Invariants,
+    (di1, dj2, dj3): (&[f64; 3], &[f64; 3], &[f64; 3]),
+    lam: f64,
+    dlam: f64,
+) -> (f64, [f64; 3]) {
     let c = inv.cos3theta;
-    let (lam, dlam) = lambda(p, c);
     let sj2 = inv.j2.sqrt();
     let pp = lam * sj2 + p.beta * inv.i1;
     let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
@@ -165,8 +178,7 @@ pub fn equivalent_stress_gradient(p: &OttosenParams, s: &[f64; 3]) -> (f64, [f64
     let dc_dj3 = 1.5 * 3f64.sqrt() / inv.j2.powf(1.5);
     let p_j2 = lam / (2.0 * sj2) + sj2 * dlam * dc_dj2;
     let p_j3 = sj2 * dlam * dc_dj3;
-    let p_i1 = p.beta;
-    let g_i1 = d_p * p_i1;
+    let g_i1 = d_p * p.beta;
     let g_j2 = d_p * p_j2 + d_j2_direct;
     let g_j3 = d_p * p_j3;
     let g = std::array::from_fn(|i| g_i1 * di1[i] + g_j2 * dj2[i] + g_j3 * dj3[i]);
@@ -241,24 +253,7 @@ pub fn equivalent_stress_derivatives(
     }
     let (j2, c) = (inv.j2, inv.cos3theta);
     let (lam, dlam, d2lam) = lambda_d2(p, c);
-    // Value and gradient, as in `equivalent_stress_gradient`.
-    let (se, grad) = {
-        let sj2 = inv.j2.sqrt();
-        let pp = lam * sj2 + p.beta * inv.i1;
-        let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
-        let se = 0.5 * (pp + root);
-        let d_p = 0.5 * (1.0 + pp / root);
-        let d_j2_direct = p.alpha / root;
-        let dc_dj2 = -1.5 * c / inv.j2;
-        let dc_dj3 = 1.5 * 3f64.sqrt() / inv.j2.powf(1.5);
-        let p_j2 = lam / (2.0 * sj2) + sj2 * dlam * dc_dj2;
-        let p_j3 = sj2 * dlam * dc_dj3;
-        let g_i1 = d_p * p.beta;
-        let g_j2 = d_p * p_j2 + d_j2_direct;
-        let g_j3 = d_p * p_j3;
-        let g: [f64; 3] = std::array::from_fn(|i| g_i1 * di1[i] + g_j2 * dj2[i] + g_j3 * dj3[i]);
-        (se, g)
-    };
+    let (se, grad) = value_and_gradient(p, &inv, (&di1, &dj2, &dj3), lam, dlam);
     let u = j2.sqrt();
     let k = 1.5 * 3f64.sqrt();
     // c(J2, J3): first and second partial derivatives.
