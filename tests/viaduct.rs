@@ -17,11 +17,12 @@ fn erection_text() -> String {
     text[..cut].to_string()
 }
 
-/// Per step end: the vertical reaction of every support [N] and the largest opening of an
-/// acting joint [m].
+/// Per step end: the vertical reaction of every support [N], the largest opening of an
+/// acting joint [m] and the Euclidean norm of the internal forces [N].
 struct Rec {
     reactions: Vec<f64>,
     opening: f64,
+    f_norm: f64,
 }
 
 struct Keep<'m> {
@@ -49,6 +50,7 @@ impl Observer for Keep<'_> {
         self.recs.push(Rec {
             reactions,
             opening: largest_opening(s.system).0,
+            f_norm: s.f_int.iter().map(|f| f * f).sum::<f64>().sqrt(),
         });
         Ok(())
     }
@@ -129,9 +131,10 @@ fn erection_reactions_follow_the_statics_of_the_stage_sequence() {
     // Equilibrium at every stage: the supports (falsework included while it stands) carry
     // the weight of the segments placed so far, no more (inactive segments weigh nothing),
     // no less (a struck falsework's reaction is released in full). Tendons are internal.
-    // 1e-4: Newton stops at a residual norm of 1e-6 of the internal forces, whose norm
-    // (tendon anchors of 28 MN, 12 m wide slabs) is of order 1e8 N: ≈ 100 N on a dof, 3e-5
-    // of a 3 MN reaction.
+    // Newton stops at a residual norm of 1e-6 ‖f_int‖ (docs/input.md, [solver]); ‖f_int‖
+    // is large here (tendon anchors of 40 MN, 12 m wide slabs), and the out-of-balance of
+    // the many free dofs adds up in a sum of reactions: tolerance 1e-5 ‖f_int‖ [N].
+    let tol = |r: &Rec| 1e-5 * r.f_norm;
     let placed = |k: usize| {
         if k < step(&m, "place and stress span 2") {
             42.0 // S1 … S12: x = −0.5 … 41.5 m
@@ -145,25 +148,30 @@ fn erection_reactions_follow_the_statics_of_the_stage_sequence() {
         let total: f64 = r.reactions.iter().sum();
         let want = w * placed(k);
         assert!(
-            (total / want - 1.0).abs() < 1e-4,
-            "step '{}': supports carry {total:.0} N, the placed segments weigh {want:.0} N",
-            m.steps[k].name
+            (total - want).abs() < tol(r),
+            "step '{}': supports carry {total:.0} N, the placed segments weigh {want:.0} N (tolerance {:.0} N)",
+            m.steps[k].name,
+            tol(r)
         );
     }
 
     // Span 1 (x = −0.5 … 41.5 m on bearings at 0 and 40 m) is statically determinate once
     // its falsework is struck: its tendon moves no reaction, nor does 14 days of creep.
-    // R_A1 = w · 42 m · (40 − 20.5)/40 whatever the prestress. Same 1e-4 as above.
+    // R_A1 = w · 42 m · (40 − 20.5)/40 whatever the prestress. 5e-4 of R_A1: the external
+    // tendon pulls along its deformed spans while the concrete is small-displacement
+    // (docs/input.md), so its 40 MN leave a moment of P times the ≈ 0.3 mm its spans move
+    // sideways, ≈ 12 kN·m over the 40 m span: 300 N, 1e-4 of the reaction.
     let r_a1 = w * 42.0 * (40.0 - 20.5) / 40.0;
+    let tol1 = 5e-4 * r_a1;
     for name in ["strike falsework 1", "span 1 creeps"] {
         let r = &rec[step(&m, name)];
         assert!(
-            (r.reactions[a1] / r_a1 - 1.0).abs() < 1e-4,
+            (r.reactions[a1] - r_a1).abs() < tol1,
             "{name}: R_A1 = {:.0} N, statics {r_a1:.0} N",
             r.reactions[a1]
         );
         assert!(
-            (r.reactions[p1] / (w * 42.0 - r_a1) - 1.0).abs() < 1e-4,
+            (r.reactions[p1] - (w * 42.0 - r_a1)).abs() < tol1,
             "{name}: R_P1 = {:.0} N, statics {:.0} N",
             r.reactions[p1],
             w * 42.0 - r_a1
