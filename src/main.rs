@@ -99,6 +99,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/rc-beam.toml"),
     ),
     (
+        "viaduct",
+        "three-span 3 x 40 m segmental viaduct built span by span on falsework: stages, 30 years, gradient, traffic to failure",
+        include_str!("../examples/viaduct.toml"),
+    ),
+    (
         "gmsh-tapered",
         "two segments meshed with Gmsh (prismatic and tapered), dry joint; -o also writes gmsh-tapered.msh",
         include_str!("../examples/gmsh-tapered.toml"),
@@ -182,7 +187,10 @@ enum Command {
         /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine),
         /// "seed-failure" (the seed beam on to failure by arc length, each --refine) or
         /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete), "rc" (the RC
-        /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations) or
+        /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations),
+        /// "viaduct" (the three-span viaduct example: all stages, 30 years, gradient and
+        /// traffic to failure, refined by each --refine; last column: deflection under the
+        /// tandem) or
         /// "material-point" (concrete material-point updates per second) or "panels" (the
         /// membrane-panel series of validation/panels/panels.csv, or of --model, under each
         /// concrete model option: test/predicted ratios, mean, COV) or "beams" (the
@@ -334,12 +342,13 @@ fn main() -> ExitCode {
             "long_term" => bench_seed(refine, cli::bench::seed_long_term_case),
             "seed-failure" => bench_seed_failure(refine, false),
             "rc" => bench_rc(refine),
+            "viaduct" => bench_seed(refine, cli::bench::viaduct_case),
             "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
             "panels" => bench_panels(model.as_deref()),
             "beams" => bench_beams(model.as_deref()),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, material-point, panels or beams)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, viaduct, material-point, panels or beams)");
                 ExitCode::from(2)
             }
         },

@@ -942,10 +942,10 @@ fn unit_warning_reaches_stderr_and_summary() {
     assert_eq!(text.matches("thickness = 0.1\n").count(), 1);
     std::fs::write(
         tmp.join("c.toml"),
-        text.replace("thickness = 0.1\n", "thickness = 10.0\n"),
+        text.replace("thickness = 0.1\n", "thickness = 30.0\n"),
     )
     .unwrap();
-    let want = "warning: c.toml: regions[0].thickness: thickness 10 m is outside 0.001–5 m; segfem works in metres (0.3 m, not 30 cm)";
+    let want = "warning: c.toml: regions[0].thickness: thickness 30 m is outside 0.001–20 m; segfem works in metres (0.3 m, not 30 cm)";
     let o = segfem(tmp.path(), &["check", "c.toml"]);
     assert_eq!(code(&o), 0);
     assert_eq!(stderr(&o).trim_end(), want);

@@ -339,6 +339,67 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
     })
 }
 
+/// Follows the deflection [m] at x = 15.375 m on the soffit of the viaduct example (under
+/// the tandem of its traffic pattern).
+struct TandemDeflection(f64);
+
+impl Observer for TandemDeflection {
+    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let m = snap.system.model;
+        if let Some(n) = m
+            .nodes
+            .iter()
+            .position(|p| (p[0] - 15.375).abs() < 1e-6 && p[1].abs() < 1e-9)
+        {
+            self.0 = snap.system.u[2 * n + 1];
+        }
+        Ok(())
+    }
+}
+
+/// The bundled three-span viaduct (examples/viaduct.toml, issue #20 item 8) with its mesh
+/// refined `refine` times in both directions (1: the example's 2 columns a segment and 6
+/// rows): erection span by span (11 stages), 30 years of creep, shrinkage and relaxation,
+/// the heating gradient and the traffic pattern to failure. Reports the final deflection
+/// under the tandem [m].
+pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
+    let r = refine.max(1);
+    let text = include_str!("../../examples/viaduct.toml")
+        .replace(
+            "nx_per_segment = 2 ",
+            &format!("nx_per_segment = {} ", 2 * r),
+        )
+        .replace(
+            "depth = 0.25, rows = 1 }",
+            &format!("depth = 0.25, rows = {r} }}"),
+        )
+        .replace(
+            "depth = 1.90, rows = 4 }",
+            &format!("depth = 1.90, rows = {} }}", 4 * r),
+        );
+    if r > 1 && !text.contains(&format!("depth = 1.90, rows = {} }}", 4 * r)) {
+        return Err("viaduct.toml changed: cannot refine its mesh".into());
+    }
+    let t0 = Instant::now();
+    let model = segfem::input::parse(&text, "viaduct.toml")
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = TandemDeflection(0.0);
+    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(NonlinearRow {
+        case: format!("viaduct, {} rows", 6 * r),
+        equations,
+        increments: t.increments,
+        iterations: t.iterations,
+        factorisations: t.solver.factorisations,
+        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
+        assembly_s: t.assembly_s,
+        total_s: t0.elapsed().as_secs_f64(),
+        result: obs.0,
+    })
+}
+
 /// CPU time of this process so far, user + system, all threads [s] (Linux /proc/self/stat,
 /// in clock ticks of 1/100 s, the kernel's USER_HZ); 0 where unknown. Less sensitive than
 /// wall time to other work on a shared machine.

@@ -11,8 +11,9 @@ use super::error::Ctx;
 pub const MIN_MODULUS: f64 = 1e6;
 /// Smallest plausible strength [Pa]: 1 kPa (a strength given in MPa, e.g. 500, falls below).
 pub const MIN_STRENGTH: f64 = 1e3;
-/// Plausible thickness range [m]: 1 mm to 5 m (a thickness in cm or mm falls above).
-pub const THICKNESS_RANGE: (f64, f64) = (1e-3, 5.0);
+/// Plausible thickness range [m]: 1 mm to 20 m (a bridge deck slab is up to ~20 m wide; a
+/// web or slab thickness in cm or mm falls above).
+pub const THICKNESS_RANGE: (f64, f64) = (1e-3, 20.0);
 /// Largest plausible model size (bounding-box diagonal) [m]: 1 km (a mesh in mm falls above).
 pub const MAX_MODEL_SIZE: f64 = 1000.0;
 

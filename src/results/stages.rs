@@ -30,11 +30,20 @@ pub struct StageResult {
     pub joint: Option<String>,
 }
 
-/// Largest opening [m] among the open (not in contact) points of all joints of the
-/// committed state, with the joint's index; (0, None) when no point is open.
+/// Largest opening [m] among the open (not in contact) points of all acting joints of the
+/// committed state, with the joint's index; (0, None) when no point is open. A joint whose
+/// segments are not both placed yet does not act (its "opening" is round-off).
 pub fn largest_opening(sys: &System) -> (f64, Option<usize>) {
     let mut best = (0.0, None);
-    for j in 0..sys.model.joints.len() {
+    let acts = |j: usize| {
+        sys.stages.as_ref().is_none_or(|st| {
+            sys.model.joints[j]
+                .interfaces
+                .iter()
+                .all(|&i| st.interface_active.get(i).copied().unwrap_or(true))
+        })
+    };
+    for j in (0..sys.model.joints.len()).filter(|&j| acts(j)) {
         for p in summarise(sys, j).profile {
             if !p.closed && p.opening > best.0 {
                 best = (p.opening, Some(j));

@@ -269,7 +269,8 @@ pub(super) fn thermal_coefficients(ctx: &Ctx, file: &File, model: &mut Model) ->
     };
     let mut region_alpha = Vec::with_capacity(model.regions.len());
     for r in &model.regions {
-        let name = &model.materials[r.material].name;
+        // A creep material copied per casting day (segment_cast_days) is its file entry.
+        let name = super::regions::file_material_name(&model.materials[r.material].name);
         let Some((i, m)) = material(name) else {
             return Err(ctx.err(
                 "regions",

@@ -133,7 +133,7 @@ pub(super) fn assign_cast_days(
             m
         } else {
             let mut copy = materials[m].clone();
-            copy.name = format!("{} (cast day {day})", materials[m].name);
+            copy.name = format!("{}{CAST_DAY_COPY}{day})", materials[m].name);
             materials.push(copy);
             materials.len() - 1
         };
@@ -144,6 +144,14 @@ pub(super) fn assign_cast_days(
         region.material = idx;
     }
     Ok(())
+}
+
+/// What a per-cast-day copy of a creep material adds to its name: "concrete (cast day -90)".
+const CAST_DAY_COPY: &str = " (cast day ";
+
+/// The `[[materials]]` name a model material comes from (a cast-day copy names its source).
+pub(super) fn file_material_name(name: &str) -> &str {
+    name.split(CAST_DAY_COPY).next().unwrap_or(name)
 }
 
 /// Check that every creep region exists (is cast) when the analysis starts at `start` [d],
