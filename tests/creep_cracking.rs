@@ -165,7 +165,7 @@ fn uncracked_concrete_reproduces_elastic_creep() {
 /// held in x (free laterally): restrained shrinkage gives uniaxial tension σx.
 const STRIP_DATA: (f64, f64, f64, f64) = (45e6, 0.5, 0.1, 7.0);
 
-fn strip(to: f64) -> String {
+fn strip(to: f64, extra: &str) -> String {
     format!(
         r#"
 [[materials]]
@@ -207,6 +207,7 @@ from = 7.0
 to = {to}
 substeps = 60
 first_substep = 0.1
+{extra}
 "#
     )
 }
@@ -246,11 +247,23 @@ fn geometric(a: f64, b: f64, per_decade: usize) -> Vec<f64> {
 
 #[test]
 fn restrained_shrinkage_cracks_when_the_stress_reaches_ftm() {
+    check_restrained_strip("");
+}
+
+/// The same with error-controlled substeps: the crack forms inside a time step, the pairs
+/// around it are shortened until they agree, and the result meets the same closed forms.
+#[test]
+fn restrained_shrinkage_with_error_controlled_substeps() {
+    check_restrained_strip("substep_tolerance = 0.01");
+}
+
+fn check_restrained_strip(extra: &str) {
     let (fcm, rh, h0, ts) = STRIP_DATA;
     let p = CreepShrinkageParams::new(fcm, rh, h0, CementClass::N, ts);
     // f_tm of the concrete (MC90 mean, 28 days; the crack criterion does not age).
     let ftm = 1.4e6 * (fcm / 10e6).powf(2.0 / 3.0);
-    let rec = run(&strip(3000.0));
+    let rec = run(&strip(3000.0, extra));
+    eprintln!("{extra}: {} increments", rec.len());
     // Before cracking the FE stress follows the superposition integral: the chain
     // reproduces MC90 relaxation within ~1 % and the 60 log-spaced substeps add < 1 %; 3 %
     // of f_tm leaves room for both and fails without creep (the elastic stress

@@ -1402,3 +1402,91 @@ fn seed_beam_with_cracking_concrete_over_its_life() {
         assert_eq!(u.peak_step, "failure", "{u}");
     }
 }
+
+/// Error-controlled substeps (`substep_tolerance`, issue 19 item 2): the specimen under
+/// constant stress from day 28 held 10⁴ days. Each kept pair of substeps agrees with one
+/// substep over the same time to `tol` times the displacement change over the pair; those
+/// local errors add up to at most `tol` times the total (monotone) creep strain. The
+/// reference is the same chain with 400 log-spaced substeps (80 per decade: converged to
+/// ≪ 0.01 %, docs/theory-time.md §2, step-size table).
+#[test]
+fn substep_tolerance_bounds_the_creep_error() {
+    let sigma = -4e6;
+    let reference = run(&specimen(
+        false,
+        sigma,
+        28.0,
+        "duration = 1e4\nsubsteps = 400",
+    ));
+    let (e0, e_ref) = (reference[0].strain[0], reference.last().unwrap().strain[0]);
+    let creep = e_ref - e0;
+    let one_per_decade = run(&specimen(
+        false,
+        sigma,
+        28.0,
+        "duration = 1e4\nsubsteps = 6",
+    ));
+    let coarse_err = (one_per_decade.last().unwrap().strain[0] - e_ref).abs() / creep.abs();
+    eprintln!("1 substep per decade: error {coarse_err:.2e} of the creep strain");
+    let mut counts = Vec::new();
+    for tol in [3e-2, 1e-2, 1e-3] {
+        let rec = run(&specimen(
+            false,
+            sigma,
+            28.0,
+            &format!("duration = 1e4\nsubstep_tolerance = {tol}"),
+        ));
+        let last = rec.last().unwrap();
+        assert_eq!(last.time, 28.0 + 1e4);
+        let err = (last.strain[0] - e_ref).abs() / creep.abs();
+        eprintln!(
+            "substep_tolerance {tol:e}: {} kept pairs, error {err:.2e} of the creep strain",
+            rec.len() - 1
+        );
+        // The stated accuracy: the accumulated error is at most tol × the change.
+        assert!(err <= tol, "tol {tol}: error {err}");
+        counts.push(rec.len() - 1);
+    }
+    // Tighter tolerance, more substeps; and the coarse fixed substeps miss by more than the
+    // loosest tolerance allows (so the control is doing something).
+    assert!(counts[0] < counts[1] && counts[1] < counts[2], "{counts:?}");
+    assert!(coarse_err > 3e-2 / 3.0, "{coarse_err}");
+}
+
+#[test]
+fn substep_tolerance_bad_input_names_the_key() {
+    for (steps, key) in [
+        (
+            "duration = 1e4\nsubstep_tolerance = 0.0",
+            "substep_tolerance",
+        ),
+        (
+            "duration = 1e4\nsubstep_tolerance = 0.9",
+            "substep_tolerance",
+        ),
+        (
+            "duration = 1e4\nsubstep_tolerance = nan",
+            "substep_tolerance",
+        ),
+    ] {
+        let text = specimen(false, -4e6, 28.0, steps);
+        let err = match segfem::input::parse(&text, "time.toml") {
+            Ok(_) => panic!("{steps}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(key) && err.contains("time.toml"), "{err}");
+    }
+    // On a load step it belongs to a time step.
+    let text = specimen(false, -4e6, 28.0, "duration = 1e4").replace(
+        "kind = \"load\"\n",
+        "kind = \"load\"\nsubstep_tolerance = 0.01\n",
+    );
+    let err = match segfem::input::parse(&text, "time.toml") {
+        Ok(_) => panic!("substep_tolerance on a load step accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("substep_tolerance") && err.contains("time step"),
+        "{err}"
+    );
+}
