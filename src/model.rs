@@ -345,8 +345,13 @@ pub struct TimeSpan {
     pub to: f64,
     /// Duration of the first substep [d] (0 < first ≤ to − from).
     pub first: f64,
-    /// Number of substeps (≥ 1).
+    /// Number of substeps (≥ 1); with `tolerance`, the first pair of substeps lasts as long
+    /// as the first of these.
     pub substeps: usize,
+    /// Error-controlled substeps (`substep_tolerance`): each pair of substeps agrees with
+    /// one substep over the same time to within this fraction of the displacement change
+    /// over the pair (step doubling, max norm) [-]; None: the fixed log-spaced substeps.
+    pub tolerance: Option<f64>,
 }
 
 impl TimeSpan {

@@ -11,6 +11,7 @@ use super::newton::newton;
 use super::solver::{SolverError, SparseCholesky};
 use super::state::DriverState;
 use super::system::System;
+use super::time::{Pair, PairStart};
 use crate::materials::point::TimeContext;
 use crate::model::{Model, Step, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
@@ -202,8 +203,14 @@ fn load_step(
     let mut increment = 0;
     let mut cuts = 0;
     let mut prev_size: Option<f64> = None;
+    // Error-controlled substeps of a time step (`substep_tolerance`): `d_level` is then the
+    // length of a pair of substeps, solved once whole (the probe) and then as its two halves,
+    // which are kept if they agree with the probe (docs/theory-time.md §9).
+    let tolerance = step.time.and_then(|t| t.tolerance);
+    let min_pair = d_level / 1024.0;
+    let mut pair = Pair::Probe;
     while level < 1.0 - 1e-12 {
-        let target = (level + d_level).min(1.0);
+        let target = pair.target(level, d_level);
         let lam: Vec<f64> = start
             .iter()
             .zip(&step.factors)
@@ -239,7 +246,51 @@ fn load_step(
             factored_linear,
             step.kind,
         ) {
+            Ok((_, iterations)) if tolerance.is_some() && pair.is_probe() => {
+                // The whole pair as one substep: keep its displacements, throw its state
+                // away, and keep the committed state in case the halves are rejected.
+                ctx.timings.iterations += iterations;
+                let probe = ctx.u.clone();
+                discard_trial(ctx);
+                pair = Pair::First(Box::new(PairStart {
+                    level,
+                    end: target,
+                    probe,
+                    saved: ctx.sys.snapshot(),
+                    prev_size,
+                    reached_clock: *reached_clock,
+                }));
+            }
+            Ok((_, iterations)) if matches!(pair, Pair::First(_)) => {
+                // The first half: committed, reported with the second.
+                ctx.sys.commit(ctx.u);
+                ctx.timings.iterations += iterations;
+                prev_size = Some(target - level);
+                level = target;
+                *reached_clock = ctx.sys.time.t_to;
+                pair = pair.second();
+            }
+            Ok((_, iterations)) if pair.rejects(ctx.u, tolerance, d_level > min_pair) => {
+                // The halves disagree with the probe beyond the tolerance: back to the
+                // start of the pair, with a shorter one.
+                ctx.timings.iterations += iterations;
+                let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) else {
+                    unreachable!("rejects() is true only for a second half")
+                };
+                d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);
+                level = start.level;
+                prev_size = start.prev_size;
+                *reached_clock = start.reached_clock;
+                ctx.sys
+                    .restore(start.saved)
+                    .map_err(AnalysisError::Mechanism)?;
+                discard_trial(ctx);
+            }
             Ok((f_int, iterations)) => {
+                if let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) {
+                    // An accepted pair: the next one as long as the error allows.
+                    d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);
+                }
                 ctx.sys.commit(ctx.u);
                 prev_size = Some(target - level);
                 level = target;
@@ -293,21 +344,29 @@ fn load_step(
                         &failure,
                     )
                 });
-                // Throw the trial state away and retry with half the increment.
-                ctx.u.copy_from_slice(&ctx.sys.u);
-                for &(d, v) in &ctx.sys.dofs.prescribed {
-                    ctx.u[d] = v;
-                }
-                ctx.sys.unlatch();
+                // Throw the trial state away and retry with half the increment (a failed
+                // half of a substep pair: a new pair from the level reached).
+                discard_trial(ctx);
                 if let Some(rep) = rep {
                     return Err(AnalysisError::NotConverged(Box::new(rep)));
                 }
                 cuts += 1;
                 d_level *= 0.5;
+                pair = Pair::Probe;
             }
         }
     }
     Ok(())
+}
+
+/// Throw the trial state of a failed (or probing) increment away: the displacements back to
+/// the committed ones, prescribed values kept, the iteration holds released.
+fn discard_trial(ctx: &mut super::path::PathContext) {
+    ctx.u.copy_from_slice(&ctx.sys.u);
+    for &(d, v) in &ctx.sys.dofs.prescribed {
+        ctx.u[d] = v;
+    }
+    ctx.sys.unlatch();
 }
 
 /// Enter the construction stage of step `si` at time `clock` [d]: the external forces of

@@ -243,6 +243,7 @@ pub struct StepIn {
     pub duration: Option<f64>,
     pub substeps: Option<usize>,
     pub first_substep: Option<f64>,
+    pub substep_tolerance: Option<f64>,
     // construction stages
     #[serde(default)]
     pub activate: Vec<String>,

@@ -160,6 +160,7 @@ fn time_of(
             ("duration", s.duration.is_some()),
             ("substeps", s.substeps.is_some()),
             ("first_substep", s.first_substep.is_some()),
+            ("substep_tolerance", s.substep_tolerance.is_some()),
         ] {
             if given {
                 return Err(ctx.err(

@@ -14,6 +14,13 @@ pub const SUBSTEPS_PER_DECADE: f64 = 5.0;
 /// Default first substep of a time step [d].
 pub const DEFAULT_FIRST_SUBSTEP: f64 = 0.1;
 
+/// Smallest `substep_tolerance` accepted: below it the error estimate is at the level of
+/// the Newton tolerance and the substeps would shrink without end.
+const MIN_TOLERANCE: f64 = 1e-5;
+
+/// Largest `substep_tolerance` accepted (an error of half the change is no control).
+const MAX_TOLERANCE: f64 = 0.5;
+
 /// Latest analysis day accepted [d].
 const MAX_DAY: f64 = 1e6;
 
@@ -93,10 +100,24 @@ pub(super) fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) ->
         Some(n) => n,
         None => (SUBSTEPS_PER_DECADE * (d / first).log10()).ceil().max(0.0) as usize + 1,
     };
+    let tolerance = match s.substep_tolerance {
+        None => None,
+        Some(v) if (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&v) => Some(v),
+        Some(v) => {
+            return Err(ctx.err(
+                format!("{key}.substep_tolerance"),
+                format!(
+                    "must be a fraction between {MIN_TOLERANCE:e} and {MAX_TOLERANCE} (got {v}): \
+                     the error allowed per pair of substeps relative to its displacement change"
+                ),
+            ))
+        }
+    };
     Ok(TimeSpan {
         from,
         to,
         first,
         substeps,
+        tolerance,
     })
 }
