@@ -94,3 +94,35 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
         u.events
     );
 }
+
+/// Probe (not a check): OA1 under the option named in SEGFEM_PROBE_OPT (default the fixed
+/// aggregate option), rows from SEGFEM_PROBE_ROWS; prints the peak and the locking measure.
+#[test]
+#[ignore]
+fn probe_oa1() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
+    let beams = read_beams(&path).unwrap();
+    let id = std::env::var("SEGFEM_PROBE_BEAM").unwrap_or("OA1".into());
+    let b = beams.iter().find(|b| b.id == id).unwrap();
+    let name = std::env::var("SEGFEM_PROBE_OPT").unwrap_or("fixed, aggregate β, VC93".into());
+    let extra = std::env::var("SEGFEM_PROBE_KEYS").unwrap_or_default();
+    let rows: usize = std::env::var("SEGFEM_PROBE_ROWS").map_or(10, |s| s.parse().unwrap());
+    let opts = options();
+    let keys = format!(
+        "{}{}",
+        opts.iter().find(|o| o.0 == name).unwrap().1,
+        extra.replace("\\n", "\n")
+    );
+    let r = run_beam(b, &keys, rows, -0.02).unwrap();
+    eprintln!(
+        "PROBE {id} [{name}] + [{extra}] {rows} rows: peak {:.1} kN at {:.1} mm, test/pred {:.3}, end {:.2}, {:?}, {} inc, {:.1} s\nlocking at peak: {:?}",
+        r.p_peak / 1e3,
+        r.deflection * 1e3,
+        b.test.0 / r.p_peak,
+        r.end_ratio,
+        r.ultimate.as_ref().map(|u| (&u.mode, &u.events)),
+        r.increments,
+        r.seconds,
+        r.locking
+    );
+}
