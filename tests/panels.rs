@@ -194,32 +194,3 @@ fn panel_series_recommended_option_a_known_deviation() {
     assert!((0.14..0.17).contains(&c_rot), "COV {c_rot:.3}");
     assert!(c_rot < c_fix, "COV rotating {c_rot:.3}, fixed {c_fix:.3}");
 }
-
-/// Probe (not a check): the panel series under SEGFEM_PROBE_KEYS; prints each
-/// test/predicted ratio, the mean and the COV.
-#[test]
-#[ignore]
-fn probe_panel_series() {
-    use segfem::materials::concrete::panel_bench::{mean_cov, read_panels};
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/panels/panels.csv");
-    let keys = std::env::var("SEGFEM_PROBE_KEYS")
-        .unwrap_or_default()
-        .replace("\\n", "\n");
-    let mut rs = Vec::new();
-    for p in read_panels(&path)
-        .unwrap()
-        .iter()
-        .filter(|p| p.v_test.is_finite())
-    {
-        match run_panel(p, &keys, 1) {
-            Ok(r) => {
-                rs.push(p.v_test / r.v_peak);
-                eprintln!("PANEL {} {:.3} {}", p.id, p.v_test / r.v_peak, r.mode);
-            }
-            Err(e) => eprintln!("PANEL {} failed: {e}", p.id),
-        }
-    }
-    let (m, c) = mean_cov(&rs);
-    eprintln!("SERIES [{keys}]: n {}, mean {m:.3}, COV {c:.3}", rs.len());
-}

@@ -350,6 +350,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
             "crack_integration = \"implex\"\ncrack_shear_limit = \"vecchio_collins_1986\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),
         (
+            "fixed, seed β, Rankine cut-off",
+            "crack_integration = \"implex\"\nprincipal_stress_limit = \"tensile_strength\"\n",
+        ),
+        (
             "rotating, VC93",
             "crack_integration = \"implex\"\ncrack_model = \"rotating\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),
