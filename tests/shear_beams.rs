@@ -47,6 +47,15 @@ fn oa1_peaks_bracket_the_test_and_the_failure_is_brittle() {
         let ratio = p_u / r.p_peak;
         assert!((0.6..1.6).contains(&ratio), "test/predicted {ratio:.2}");
     }
+    // Stress locking (docs/theory-concrete.md §5.5b), measured at the fixed-crack peak:
+    // cracked points carry a principal tension well past f_tm at an angle of 15° or more to
+    // their crack axes (3.6 f_tm measured; asserted > 1.5 f_tm: a run without locking
+    // stays at f_tm up to the IMPL-EX overshoot of a few per cent).
+    assert!(
+        fixed.locking.max_ratio_inclined > 1.5,
+        "{:?}",
+        fixed.locking
+    );
     assert!(
         fixed.end_ratio < 0.8,
         "end of run {:.2} of the peak",
@@ -93,4 +102,43 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
         "{:?}",
         u.events
     );
+}
+
+/// OA1 with fixed cracks (seed β) and the Rankine tension cut-off
+/// (`principal_stress_limit = "tensile_strength"`, docs/theory-concrete.md §5.5b), coarse
+/// mesh, about 35 s of CPU: no cracked point carries a principal tension above f_tm at an
+/// angle to its crack axes (the cut-off's closed form, round-off 1e-9), and the peak falls
+/// from the seed model's 435 kN (test/predicted 0.76, docs/validation.md) into 0.8–1.2 of
+/// P_u. A known deviation: the run stops by Newton non-convergence soon after the peak
+/// (measured 366 kN, 0.91), so the figure is a lower bound of the model's strength; the
+/// band lets a regression (locking back, ratio < 0.8) and an unexplained change fail.
+#[test]
+fn oa1_rankine_cut_off_removes_stress_locking() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
+    let beams = read_beams(&path).unwrap();
+    let oa1 = beams
+        .iter()
+        .find(|b| b.id == "OA1")
+        .expect("OA1 in beams.csv");
+    let opts = options();
+    let keys = opts
+        .iter()
+        .find(|o| o.0 == "fixed, seed β, Rankine cut-off")
+        .unwrap()
+        .1;
+    let r = run_beam(oa1, keys, 10, -0.02).unwrap();
+    eprintln!(
+        "OA1 cut-off: {:.1} kN at {:.1} mm, {:?}; {:?}",
+        r.p_peak / 1e3,
+        r.deflection * 1e3,
+        r.ultimate.as_ref().map(|u| &u.mode),
+        r.locking
+    );
+    assert!(
+        r.locking.max_ratio_inclined <= 1.0 + 1e-9,
+        "{:?}",
+        r.locking
+    );
+    let ratio = oa1.test.0 / r.p_peak;
+    assert!((0.8..1.2).contains(&ratio), "test/predicted {ratio:.3}");
 }

@@ -74,6 +74,7 @@ pub struct MaterialIn {
     pub shear_retention: Option<String>,
     pub aggregate_size: Option<f64>,
     pub crack_shear_limit: Option<String>,
+    pub principal_stress_limit: Option<String>,
     // steel
     pub fy: Option<f64>,
     #[serde(rename = "Et")]
@@ -183,6 +184,7 @@ impl MaterialKind {
                 "shear_retention",
                 "aggregate_size",
                 "crack_shear_limit",
+                "principal_stress_limit",
                 "creep",
                 "rh",
                 "h0",
@@ -432,7 +434,7 @@ pub(super) fn concrete_law(
 /// The concrete keys of shear behaviour: crack model, compression softening of cracked
 /// concrete, shear retention of fixed cracks (docs/input.md).
 fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) -> R<()> {
-    use crate::materials::concrete::cracking::CrackShearLimit;
+    use crate::materials::concrete::cracking::{CrackShearLimit, PrincipalStressLimit};
     use crate::materials::concrete::{CompressionReduction, CrackModel, ShearRetentionLaw};
     let k = |f: &str| format!("materials[{i}].{f}");
     p.crack_model = match m.crack_model.as_deref() {
@@ -510,7 +512,23 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
             ))
         }
     };
+    p.principal_stress_limit = match m.principal_stress_limit.as_deref() {
+        None | Some("none") => PrincipalStressLimit::None,
+        Some("tensile_strength") => PrincipalStressLimit::TensileStrength,
+        Some(o) => {
+            return Err(ctx.err(
+                k("principal_stress_limit"),
+                format!("unknown value '{o}' (expected none or tensile_strength)"),
+            ))
+        }
+    };
     if p.crack_model == CrackModel::Rotating {
+        if m.principal_stress_limit.is_some() {
+            return Err(ctx.err(
+                k("principal_stress_limit"),
+                "rotating cracks follow the principal stress: principal_stress_limit belongs to crack_model = \"fixed\"",
+            ));
+        }
         if m.crack_shear_limit.is_some() {
             return Err(ctx.err(
                 k("crack_shear_limit"),

@@ -205,11 +205,72 @@ pub struct BeamRun {
     pub increments: usize,
     /// Wall time [s].
     pub seconds: f64,
+    /// Stress locking of the cracked concrete at the peak increment.
+    pub locking: Locking,
+}
+
+/// Stress locking measure of the cracked concrete points of one committed state: how far
+/// the largest principal stress of points that already have a crack exceeds f_tm, and at
+/// what angle to their crack axes (docs/theory-concrete.md §5.5).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Locking {
+    /// Cracked (not crushed) concrete points [-].
+    pub cracked: usize,
+    /// Largest principal stress of a cracked point over f_tm [-].
+    pub max_ratio: f64,
+    /// Angle between that point's largest principal stress direction and the nearest crack
+    /// axis (normal of crack 1 or its orthogonal) [deg].
+    pub angle_at_max: f64,
+    /// Largest σ1/f_tm [-] of the cracked points whose principal direction is inclined by
+    /// 15° or more to their crack axes (along the axes σ1 is a crack-law stress, which
+    /// IMPL-EX may let overshoot: not locking).
+    pub max_ratio_inclined: f64,
+    /// Cracked points with σ1 > 1.1 f_tm [-].
+    pub over: usize,
+    /// Mean angle of the principal direction to the nearest crack axis over the points
+    /// with σ1 > 1.1 f_tm [deg].
+    pub mean_angle_over: f64,
+}
+
+impl Locking {
+    /// The measure over the points `pts` for tensile strength `ftm` [Pa].
+    pub fn of(pts: &[crate::materials::point::PointState], ftm: f64) -> Locking {
+        let mut l = Locking::default();
+        let mut sum = 0.0;
+        for c in pts.iter().filter_map(|p| p.concrete()) {
+            if c.n_cracks() == 0 || c.is_crushed() {
+                continue;
+            }
+            l.cracked += 1;
+            let (s1, phi) = super::principal_max(&c.stress());
+            // Deviation from the crack axes, folded into [0, 45°].
+            let q = std::f64::consts::FRAC_PI_2;
+            let d = (phi - c.crack_angle()).rem_euclid(q);
+            let dev = d.min(q - d).to_degrees();
+            let r = s1 / ftm;
+            if r > l.max_ratio {
+                l.max_ratio = r;
+                l.angle_at_max = dev;
+            }
+            if dev >= 15.0 {
+                l.max_ratio_inclined = l.max_ratio_inclined.max(r);
+            }
+            if r > 1.1 {
+                l.over += 1;
+                sum += dev;
+            }
+        }
+        if l.over > 0 {
+            l.mean_angle_over = sum / l.over as f64;
+        }
+        l
+    }
 }
 
 struct Watch {
     mid: usize,
-    rows: Vec<(f64, f64)>,
+    ftm: f64,
+    rows: Vec<(f64, f64, Locking)>,
     ultimate: UltimateWatch,
 }
 
@@ -217,7 +278,8 @@ impl Observer for Watch {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         // Half model: the control force carries half the load.
         let p = -2.0 * s.control_force.unwrap_or(0.0);
-        self.rows.push((p, -s.system.u[2 * self.mid + 1]));
+        let lock = Locking::of(&s.system.families.continuum.points.committed, self.ftm);
+        self.rows.push((p, -s.system.u[2 * self.mid + 1], lock));
         self.ultimate.increment(s);
         Ok(())
     }
@@ -240,6 +302,7 @@ pub fn run_beam(beam: &Beam, keys: &str, rows: usize, push: f64) -> Result<BeamR
         .ok_or("no node at mid-span")?;
     let mut w = Watch {
         mid,
+        ftm: beam.concrete[2],
         rows: Vec::new(),
         ultimate: UltimateWatch::new(),
     };
@@ -252,7 +315,7 @@ pub fn run_beam(beam: &Beam, keys: &str, rows: usize, push: f64) -> Result<BeamR
         }
         Err(e) => return Err(e.to_string()),
     };
-    let &(p_peak, deflection) = w
+    let &(p_peak, deflection, locking) = w
         .rows
         .iter()
         .max_by(|a, b| a.0.total_cmp(&b.0))
@@ -265,6 +328,7 @@ pub fn run_beam(beam: &Beam, keys: &str, rows: usize, push: f64) -> Result<BeamR
         ultimate: w.ultimate.finish(model, converged),
         increments: w.rows.len(),
         seconds: t0.elapsed().as_secs_f64(),
+        locking,
     })
 }
 
@@ -284,6 +348,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
         (
             "fixed, seed β, VC86 limit, VC93",
             "crack_integration = \"implex\"\ncrack_shear_limit = \"vecchio_collins_1986\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
+        ),
+        (
+            "fixed, seed β, Rankine cut-off",
+            "crack_integration = \"implex\"\nprincipal_stress_limit = \"tensile_strength\"\n",
         ),
         (
             "rotating, VC93",

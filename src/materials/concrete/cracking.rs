@@ -65,6 +65,71 @@ impl CrackShearLimit {
     }
 }
 
+/// Limit on the largest principal stress of a point with fixed cracks: a remedy for stress
+/// locking (Rots 1988), where the shear retained across an inclined crack builds a
+/// principal tension at an angle to the crack axes that no crack check sees (the second
+/// crack is checked at 90° to the first only), so that cracked concrete carries tension
+/// well past f_tm (docs/theory-concrete.md §5.5b).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum PrincipalStressLimit {
+    /// No limit (the seed's model).
+    #[default]
+    None,
+    /// Rankine tension cut-off σ1 ≤ f_tm on the stress of the crack laws
+    /// ([`cap_principal_stress`]).
+    TensileStrength,
+}
+
+/// Rankine tension cut-off of a fixed-cracked point's stress: if the largest principal
+/// stress σ1 of `sl` = (σ_n, σ_t, τ_nt) [Pa] exceeds `f` [Pa], `sl` becomes
+/// f n1n1 + σ2 n2n2 (principal directions and σ2 kept; both set to f if σ2 > f too), the
+/// return of perfect Rankine plasticity with ν = 0; `dl` [Pa] (dσ'/dε' of the crack laws)
+/// becomes its consistent tangent Tᵀ A Q dl, with Q, T the stress and strain rotations to the
+/// principal axes and A = diag(0, 1, (f − σ2)/(σ1 − σ2)) (the last term the rotation of the
+/// principal axes), plus the regularising stiffness `k_min` [Pa] along n1 (perfect
+/// plasticity has none). Returns whether the cut-off is active.
+pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k_min: f64) -> bool {
+    let c = 0.5 * (sl[0] + sl[1]);
+    let r = (0.25 * (sl[0] - sl[1]).powi(2) + sl[2] * sl[2]).sqrt();
+    let (s1, s2) = (c + r, c - r);
+    if s1 <= f {
+        return false;
+    }
+    let psi = 0.5 * (2.0 * sl[2]).atan2(sl[0] - sl[1]);
+    let t = strain_transform(psi);
+    let (sn, cs) = psi.sin_cos();
+    let q = [
+        [cs * cs, sn * sn, 2.0 * cs * sn],
+        [sn * sn, cs * cs, -2.0 * cs * sn],
+        [-cs * sn, cs * sn, cs * cs - sn * sn],
+    ];
+    let (s2c, a) = if s2 > f {
+        (f, [0.0, 0.0, 0.0])
+    } else {
+        (s2, [0.0, 1.0, (f - s2) / (s1 - s2)])
+    };
+    // A Q dl, with the regularising k_min along n1 (dσ_11 = k_min dε_11, ε_11 = T[0]·ε').
+    let mut aqd = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            aqd[i][j] = a[i] * (0..3).map(|k| q[i][k] * dl[k][j]).sum::<f64>();
+        }
+    }
+    for j in 0..3 {
+        aqd[0][j] += k_min * t[0][j];
+    }
+    let mut d = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            d[i][j] = (0..3).map(|k| t[k][i] * aqd[k][j]).sum();
+        }
+    }
+    let sp = [f, s2c, 0.0];
+    *sl = std::array::from_fn(|i| (0..3).map(|k| t[k][i] * sp[k]).sum());
+    *dl = d;
+    true
+}
+
 /// Strain transformation ε' = T ε to axes rotated by `phi` (engineering shear).
 pub fn strain_transform(phi: f64) -> [[f64; 3]; 3] {
     let (s, c) = phi.sin_cos();
@@ -382,6 +447,9 @@ pub fn update_cracked(
                 dl[2][2] = p.shear.beta_min * g;
                 dl[2][imax] = if consistent { sgn * dv } else { 0.0 };
             }
+        }
+        if p.principal_stress_limit == PrincipalStressLimit::TensileStrength {
+            cap_principal_stress(p.ftm, &mut sl, &mut dl, p.shear.beta_min * g);
         }
     }
     let (s, d) = to_global(&t, &sl, &dl);

@@ -232,6 +232,10 @@ pub struct ConcreteParams {
     /// Upper limit of the shear stress a fixed crack transfers (default none, the seed's).
     #[serde(default)]
     pub crack_shear_limit: cracking::CrackShearLimit,
+    /// Limit on the largest principal stress of fixed-cracked points (default none, the
+    /// seed's; a stress-locking remedy).
+    #[serde(default)]
+    pub principal_stress_limit: cracking::PrincipalStressLimit,
     /// MC90 creep and shrinkage in series with cracking and plasticity (None: the
     /// time-independent concrete, the default; see [`creep`]).
     #[serde(skip)]
@@ -277,6 +281,7 @@ impl ConcreteParams {
             compression_reduction: CompressionReduction::None,
             shear_retention: ShearRetentionLaw::Seed,
             crack_shear_limit: cracking::CrackShearLimit::None,
+            principal_stress_limit: cracking::PrincipalStressLimit::None,
             creep: None,
         }
     }

@@ -63,6 +63,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
             "fixed, seed β, VC86 limit, VC93",
             "crack_shear_limit = \"vecchio_collins_1986\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),
+        (
+            "fixed, seed β, Rankine cut-off",
+            "principal_stress_limit = \"tensile_strength\"\n",
+        ),
         ("rotating", "crack_model = \"rotating\"\n"),
         (
             "rotating, VC93",

@@ -445,3 +445,75 @@ fn crack_shear_limit_caps_the_retained_shear() {
         big.2[2][0]
     );
 }
+
+/// Pure shear after cracking, the rotation of principal axes that locks fixed cracks: a
+/// crack opened in x (ε_x = 3e-4 held), then γ_xy raised to 4e-3. The retained shear
+/// β G γ turns the principal axes away from the crack, and without a limit the principal
+/// stress grows well past f_tm (stress locking, asserted > 1.5 f_tm so that the case
+/// exercises the cut-off). With `principal_stress_limit = TensileStrength` the closed form
+/// of the Rankine return holds at every step: σ1 = min(σ1_free, f_tm), σ2 and the
+/// principal direction those of the stress without the limit (round-off 1e-9).
+#[test]
+fn principal_stress_limit_holds_in_pure_shear_after_cracking() {
+    let mut p = params();
+    let st = upd(&p, &ConcreteState::new(), [3e-4, 0.0, 0.0]).0;
+    assert_eq!(st.n_cracks(), 1);
+    let mut worst: f64 = 0.0;
+    let mut free = Vec::new();
+    for k in 0..=40 {
+        let e = [3e-4, 0.0, 4e-3 * k as f64 / 40.0];
+        let s = upd(&p, &st, e).1;
+        worst = worst.max(principal_max(&s).0);
+        free.push((e, s));
+    }
+    assert!(worst > 1.5 * p.ftm, "no locking to remove: {worst:.3e}");
+    p.principal_stress_limit = cracking::PrincipalStressLimit::TensileStrength;
+    let eig = |s: &[f64; 3]| {
+        let c = 0.5 * (s[0] + s[1]);
+        let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+        (c + r, c - r)
+    };
+    for (e, s0) in &free {
+        let s = upd(&p, &st, *e).1;
+        let (a0, b0) = eig(s0);
+        let (a, b) = eig(&s);
+        let tol = 1e-9 * p.ftm;
+        assert!((a - a0.min(p.ftm)).abs() < tol, "σ1 {a:.6e} vs {a0:.6e}");
+        assert!((b - b0).abs() < tol, "σ2 {b:.6e} vs {b0:.6e}");
+        if a0 - b0 > 1e-3 * p.ftm && a - b > 1e-3 * p.ftm {
+            let (t0, t) = (principal_max(s0).1, principal_max(&s).1);
+            assert!((t - t0).abs() < 1e-9, "direction {t} vs {t0}");
+        }
+    }
+}
+
+/// Tangent of the Rankine cut-off against central differences (same setting and
+/// tolerance as the other fixed-crack checks: 1e-5 E) at states where the cut-off is
+/// active: crack opened in x at ε_n, then slip γ and strain along the crack ε_t.
+#[test]
+fn principal_stress_limit_tangent_matches_finite_differences() {
+    let mut p = fd_params();
+    p.principal_stress_limit = cracking::PrincipalStressLimit::TensileStrength;
+    p.shear.beta_min = 0.0;
+    let st = upd(&p, &ConcreteState::new(), [3e-4, 0.0, 0.0]).0;
+    assert_eq!(st.n_cracks(), 1);
+    let mut checked = 0;
+    for (en, et, g) in [
+        (3.5e-4, 0.0, 2e-3),
+        (2.5e-4, -2e-4, 3e-3),
+        (4e-4, 5e-5, -1.5e-3),
+        (2e-4, -1e-3, 4e-3),
+    ] {
+        let e = [en, et, g];
+        let s = upd(&p, &st, e).1;
+        assert!(
+            principal_max(&s).0 > 0.999 * p.ftm,
+            "cut-off inactive at {e:?}"
+        );
+        if let Some(err) = fd_error(&p, &st, e) {
+            assert!(err < 1e-5 * p.ec, "err {err} at {e:?}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "{checked} states checked");
+}
