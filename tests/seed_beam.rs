@@ -144,9 +144,8 @@ fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
 /// at the opened joint, d_p − a/2 ≈ 0.49 m, whose only mesh-dependent part is the depth of
 /// the compression block at the joint (a ≈ 24 mm in statics; one element row of the
 /// coarse mesh is 0.1 m, so its resolution moves the lever arm by at most ≈ 1–2 %).
-/// Release only (≈ 22 s in release on 2 idle cores; minutes unoptimised). Refined 3× the
-/// top concrete crushes at 99 % of the tendon's yield (peak −0.6 %), refined 4× the run
-/// stops at 157 kN, an open defect: docs/performance.md ("The seed beam to failure").
+/// Release only (≈ 22 s in release on 2 idle cores; minutes unoptimised). Refined 4×:
+/// `seed_beam_with_concrete_refined_4x_reaches_tendon_yield` below.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release test: the 2× mesh to failure")]
 fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
@@ -184,6 +183,67 @@ fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
     assert!(
         (fine.q_max - q_u).abs() < 0.10 * q_u,
         "{} vs {q_u}",
+        fine.q_max
+    );
+}
+
+/// The same MC90-concrete beam refined 4× (24 rows through the depth, 25,547 equations; the
+/// loads on their 0.2 m plates, IMPL-EX cracks linear in the increment, issue 25) runs to
+/// L/60 with its tendon yielded. Its peak is compared with the coarse run within 4 %: the
+/// coarse mesh's top row (0.1 m, Gauss points 21 mm from its faces) is four times the
+/// statics compression block at the opened joint (a ≈ 21 mm), so the coarse lever arm
+/// d_p − a/2 ≈ 0.49 m is resolved only to ≈ 0.02 m (4 %); the 4× rows (25 mm) resolve it.
+/// And with statics of the opened joint within 5 % (the rectangular block against the MC90
+/// curve, 1 %; the tendon hardening past 0.9 f_ptk on the way to L/60, ≤ 3 %).
+/// Heavy release test: ≈ 4 min on 2 idle cores (10 min at a load average of 8).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release test: the 4× mesh to failure")]
+fn seed_beam_with_concrete_refined_4x_reaches_tendon_yield() {
+    let coarse = bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
+    let fine = bench::seed_failure_case(4, true).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!(
+        "coarse: Q_max {:.1} kN; 4x: Q_max {:.1} kN, tendon {:.0} MPa, {} increments, {} iterations, {:.1} s wall, {:.1} s CPU ({}; {})",
+        coarse.q_max,
+        fine.q_max,
+        fine.tendon_stress / 1e6,
+        fine.increments,
+        fine.iterations,
+        fine.total_s,
+        fine.cpu_s,
+        fine.end,
+        fine.mode
+    );
+    assert_eq!(fine.equations, 25547, "not the 4× mesh");
+    // The run finished (it stopped at 157 kN before issue 25) with its tendon yielded. The
+    // first event the run reports is a local one (a known deviation, docs/validation.md):
+    // two points of the web just under the flange beside the opened joints J2 and J5,
+    // cracked twice, crush at ≈ 165 kN and the load goes on rising to tendon yield. Crushing
+    // of the compression zone would take whole rows of points: fewer than 9 (one Q8
+    // element's points) crushed at the end.
+    assert_eq!(fine.end, "deflection L/60 reached");
+    assert!(
+        fine.mode == "tendon yield" || fine.mode == "concrete crushing",
+        "{}",
+        fine.mode
+    );
+    assert!(fine.crushed < 9, "{} crushed points", fine.crushed);
+    assert!(
+        fine.tendon_stress >= 0.999 * 0.9 * 1900e6,
+        "tendon {:.0} MPa",
+        fine.tendon_stress / 1e6
+    );
+    // Mesh objectivity of the peak (reason above): 4 %.
+    assert!(
+        (fine.q_max - coarse.q_max).abs() < 0.04 * coarse.q_max,
+        "Q_max {:.1} kN (4×) vs {:.1} kN (coarse)",
+        fine.q_max,
+        coarse.q_max
+    );
+    // Statics of the opened joint (reason above): 5 %.
+    let q_u = statics_ultimate_load() / 1e3;
+    assert!(
+        (fine.q_max - q_u).abs() < 0.05 * q_u,
+        "Q_max {:.1} kN vs statics {q_u:.1} kN",
         fine.q_max
     );
 }
@@ -378,9 +438,12 @@ fn mc90_text() -> String {
 const ELASTIC_MM: [f64; 7] = [1.749, 2.349, 5.574, 12.126, 21.835, 33.032, 44.337];
 
 /// MC90 concrete (the bench variant): as the elastic run to 84 kN, softer from 98 kN on
-/// (cracking of the web beside the opened joints, docs/validation.md): −19, +3, +19, +35 %
-/// against the seed at 98 … 140 kN.
-const MC90_MM: [f64; 7] = [1.744, 2.374, 5.955, 15.626, 29.763, 42.812, 56.334];
+/// (cracking of the web beside the opened joints, docs/validation.md): −24, +1, +18, +35 %
+/// against the seed at 98 … 140 kN. Issue 25 (IMPL-EX cracks linear in the increment)
+/// moved 98 kN from 15.626 mm (−5.4 %: the web cracks spread in those increments, faster
+/// than extrapolated, and now carry the secant's stress until the next extrapolation) and
+/// the other loads by < 2 %.
+const MC90_MM: [f64; 7] = [1.744, 2.374, 5.952, 14.782, 29.219, 42.488, 56.467];
 
 /// Each deflection against its known-deviation value, so that a regression and an
 /// unexplained improvement both fail. Tolerance `tol` relative, stated by the caller.
@@ -390,6 +453,9 @@ fn check_band(what: &str, got: &[f64], known: &[f64], tol: f64) {
             "{what}, Q = {q} kN: {d:.3} mm (known {k:.3} mm, seed {seed:.2} mm, {:+.0} %)",
             100.0 * (d / seed - 1.0)
         );
+    }
+    // All loads printed first, so that a failure shows the whole curve.
+    for ((&(q, seed), &d), &k) in seed_reference().iter().zip(got).zip(known) {
         assert!(
             (d / k - 1.0).abs() < tol,
             "{what}, Q = {q} kN: {d:.3} mm outside the known-deviation band {k:.3} mm ± {:.0} % (seed {seed} mm)",
