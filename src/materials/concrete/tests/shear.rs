@@ -277,7 +277,13 @@ fn rot_fd_params() -> ConcreteParams {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    // Fixed seed: the same cases on every machine and run (ChaCha).
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e6f_e025),
+        .. ProptestConfig::default()
+    })]
 
     /// Rotating model: tangent (with the coaxiality shear term and the compression-
     /// softening cross terms) against central differences, from a cracked or compressed
