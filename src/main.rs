@@ -185,6 +185,8 @@ enum Command {
         /// Benchmark: "linear" (banded beams of --dofs), "seed" (the seed beam through joint
         /// opening, refined by each factor of --refine), "long_term" (the seed beam with
         /// MC90 creep, shrinkage and relaxation over 1e4 days in 50 substeps, same --refine),
+        /// "long_term_concrete" (examples/creep-beam.toml with the cracking, creeping
+        /// concrete: 1e4 days in 50 substeps, then the service load; same --refine),
         /// "seed-failure" (the seed beam on to failure by arc length, each --refine) or
         /// "seed-failure-concrete" (the same with the MC90/Ottosen concrete), "rc" (the RC
         /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations),
@@ -340,6 +342,7 @@ fn main() -> ExitCode {
             "linear" => bench(dofs, element),
             "seed" => bench_seed(refine, cli::bench::seed_case),
             "long_term" => bench_seed(refine, cli::bench::seed_long_term_case),
+            "long_term_concrete" => bench_seed(refine, cli::bench::creep_beam_concrete_case),
             "seed-failure" => bench_seed_failure(refine, false),
             "rc" => bench_rc(refine),
             "viaduct" => bench_seed(refine, cli::bench::viaduct_case),
@@ -348,7 +351,7 @@ fn main() -> ExitCode {
             "panels" => bench_panels(model.as_deref()),
             "beams" => bench_beams(model.as_deref()),
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, seed-failure, seed-failure-concrete, rc, viaduct, material-point, panels or beams)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, long_term_concrete, seed-failure, seed-failure-concrete, rc, viaduct, material-point, panels or beams)");
                 ExitCode::from(2)
             }
         },

@@ -389,6 +389,44 @@ pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
     let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(NonlinearRow {
         case: format!("viaduct, {} rows", 6 * r),
+/// `examples/creep-beam.toml` (the seed beam's seven segments cast 30–90 days before
+/// erection, prestress and self weight on day 0, 50 log-spaced substeps to 10⁴ d, then the
+/// service load Q = 56 kN in 4 increments) with its `elastic_creep` concrete replaced by the
+/// cracking, creeping concrete (`kind = "concrete"`, `creep = "mc90"`, same MC90 keys), mesh
+/// refined `refine` times as in [`seed_case`] (issue 19 item 7). Reports the final midspan
+/// deflection [m].
+pub fn creep_beam_concrete_case(refine: usize) -> Result<NonlinearRow, String> {
+    let r = refine.max(1);
+    let example = include_str!("../../examples/creep-beam.toml");
+    let text = example
+        .replace(
+            "kind = \"elastic_creep\"",
+            "kind = \"concrete\"\ncreep = \"mc90\"",
+        )
+        .replace(
+            "nx_per_segment = 6 ",
+            &format!("nx_per_segment = {} ", 6 * r),
+        )
+        .replace(
+            "depth = 0.10, rows = 1 ",
+            &format!("depth = 0.10, rows = {r} "),
+        )
+        .replace(
+            "depth = 0.40, rows = 4 ",
+            &format!("depth = 0.40, rows = {} ", 4 * r),
+        );
+    if !text.contains("creep = \"mc90\"") || (r > 1 && text.contains("rows = 4 ")) {
+        return Err("creep-beam.toml changed: cannot build the cracking-concrete case".into());
+    }
+    let t0 = Instant::now();
+    let model = segfem::input::parse(&text, "creep-beam-concrete.toml")
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = Nothing(0.0);
+    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(NonlinearRow {
+        case: format!("creep concrete, {} rows", 6 * r),
         equations,
         increments: t.increments,
         iterations: t.iterations,
