@@ -389,6 +389,17 @@ pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
     let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
     Ok(NonlinearRow {
         case: format!("viaduct, {} rows", 6 * r),
+        equations,
+        increments: t.increments,
+        iterations: t.iterations,
+        factorisations: t.solver.factorisations,
+        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
+        assembly_s: t.assembly_s,
+        total_s: t0.elapsed().as_secs_f64(),
+        result: obs.0,
+    })
+}
+
 /// `examples/creep-beam.toml` (the seed beam's seven segments cast 30–90 days before
 /// erection, prestress and self weight on day 0, 50 log-spaced substeps to 10⁴ d, then the
 /// service load Q = 56 kN in 4 increments) with its `elastic_creep` concrete replaced by the
