@@ -68,6 +68,17 @@ impl System<'_> {
         }
     }
 
+    /// The committed state, owned (for a time-substep pair that may be rejected and
+    /// restored with [`System::restore`]).
+    pub(crate) fn snapshot(&self) -> SystemState {
+        SystemState {
+            u: self.u.clone(),
+            u_prev: self.u_prev.clone(),
+            time: self.time,
+            families: self.families.clone(),
+        }
+    }
+
     /// Replace the committed (and trial) states by a saved state of the same model. Errors
     /// name what does not match (the model changed since the state was saved).
     pub fn restore(&mut self, s: SystemState) -> Result<(), String> {

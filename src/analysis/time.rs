@@ -294,15 +294,3 @@ pub fn pair_error(probe: &[f64], start: &[f64], u: &[f64]) -> (f64, f64) {
         .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
     (err, change)
 }
-
-impl System<'_> {
-    /// The committed state, owned (for a substep pair that may be rejected).
-    pub(crate) fn snapshot(&self) -> SystemState {
-        SystemState {
-            u: self.u.clone(),
-            u_prev: self.u_prev.clone(),
-            time: self.time,
-            families: self.families.clone(),
-        }
-    }
-}

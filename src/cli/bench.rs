@@ -222,20 +222,65 @@ pub struct NonlinearRow {
     pub result: f64,
 }
 
-struct Nothing(f64);
+/// Follows the vertical displacement [m] of the soffit node at x = `.0` [m] (the check
+/// value of a bench row).
+struct DeflectionAt(f64, f64);
 
-impl Observer for Nothing {
+impl Observer for DeflectionAt {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         let m = snap.system.model;
         if let Some(n) = m
             .nodes
             .iter()
-            .position(|p| (p[0] - 3.6).abs() < 1e-9 && p[1].abs() < 1e-9)
+            .position(|p| (p[0] - self.0).abs() < 1e-6 && p[1].abs() < 1e-9)
         {
-            self.0 = snap.system.u[2 * n + 1];
+            self.1 = snap.system.u[2 * n + 1];
         }
         Ok(())
     }
+}
+
+/// Parses model text `text` (named `file` in errors), runs all its steps and times them,
+/// following the soffit deflection at x = `x` [m]: the row `case` of a nonlinear bench.
+fn timed_row(text: &str, file: &str, case: String, x: f64) -> Result<NonlinearRow, String> {
+    let t0 = Instant::now();
+    let model = segfem::input::parse(text, file)
+        .map_err(|e| e.to_string())?
+        .model;
+    let mut obs = DeflectionAt(x, 0.0);
+    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
+    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
+    Ok(NonlinearRow {
+        case,
+        equations,
+        increments: t.increments,
+        iterations: t.iterations,
+        factorisations: t.solver.factorisations,
+        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
+        assembly_s: t.assembly_s,
+        total_s: t0.elapsed().as_secs_f64(),
+        result: obs.1,
+    })
+}
+
+/// Midspan of the seed beam and of the examples built on its mesh [m].
+const SEED_MIDSPAN: f64 = 3.6;
+
+/// `text` (the seed beam's mesh keys: 6 columns a segment, rows of 0.10 m and 0.40 m) with
+/// its mesh refined `r` times in both directions.
+fn refine_seed_mesh(text: &str, r: usize) -> String {
+    text.replace(
+        "nx_per_segment = 6 ",
+        &format!("nx_per_segment = {} ", 6 * r),
+    )
+    .replace(
+        "depth = 0.10, rows = 1 ",
+        &format!("depth = 0.10, rows = {r} "),
+    )
+    .replace(
+        "depth = 0.40, rows = 4 ",
+        &format!("depth = 0.40, rows = {} ", 4 * r),
+    )
 }
 
 /// The seed beam's model file (bundled example) with its mesh refined `refine` times in both
@@ -251,20 +296,7 @@ fn seed_text(refine: usize) -> String {
 
 /// The bundled seed beam, refined as in [`seed_text`], with its last step on to failure.
 fn seed_text_to_failure(refine: usize) -> String {
-    let r = refine.max(1);
-    include_str!("../../examples/seed-beam.toml")
-        .replace(
-            "nx_per_segment = 6 ",
-            &format!("nx_per_segment = {} ", 6 * r),
-        )
-        .replace(
-            "depth = 0.10, rows = 1 ",
-            &format!("depth = 0.10, rows = {r} "),
-        )
-        .replace(
-            "depth = 0.40, rows = 4 ",
-            &format!("depth = 0.40, rows = {} ", 4 * r),
-        )
+    refine_seed_mesh(include_str!("../../examples/seed-beam.toml"), refine.max(1))
 }
 
 /// The seed beam (bundled example) with its mesh refined `refine` times in both directions
@@ -273,24 +305,12 @@ fn seed_text_to_failure(refine: usize) -> String {
 pub fn seed_case(refine: usize) -> Result<NonlinearRow, String> {
     let r = refine.max(1);
     let text = seed_text(r);
-    let t0 = Instant::now();
-    let model = segfem::input::parse(&text, "seed-beam.toml")
-        .map_err(|e| e.to_string())?
-        .model;
-    let mut obs = Nothing(0.0);
-    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
-    Ok(NonlinearRow {
-        case: format!("seed beam, {} rows", 6 * r),
-        equations,
-        increments: t.increments,
-        iterations: t.iterations,
-        factorisations: t.solver.factorisations,
-        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
-        assembly_s: t.assembly_s,
-        total_s: t0.elapsed().as_secs_f64(),
-        result: obs.0,
-    })
+    timed_row(
+        &text,
+        "seed-beam.toml",
+        format!("seed beam, {} rows", 6 * r),
+        SEED_MIDSPAN,
+    )
 }
 
 /// The seed beam (bundled example, mesh refined `refine` times as in [`seed_case`]) held
@@ -319,43 +339,16 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
     let text = format!(
         "{text}\n[[steps]]\nname = \"prestress\"\nkind = \"load\"\nloads = {{ self_weight = 1.0 }}\n\n[[steps]]\nname = \"long_term\"\nkind = \"time\"\nfrom = 28.0\nduration = 1e4\nsubsteps = 50\n"
     );
-    let t0 = Instant::now();
-    let model = segfem::input::parse(&text, "seed-beam-long-term.toml")
-        .map_err(|e| e.to_string())?
-        .model;
-    let mut obs = Nothing(0.0);
-    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
-    Ok(NonlinearRow {
-        case: format!("seed 1e4 d, {} rows", 6 * r),
-        equations,
-        increments: t.increments,
-        iterations: t.iterations,
-        factorisations: t.solver.factorisations,
-        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
-        assembly_s: t.assembly_s,
-        total_s: t0.elapsed().as_secs_f64(),
-        result: obs.0,
-    })
+    timed_row(
+        &text,
+        "seed-beam-long-term.toml",
+        format!("seed 1e4 d, {} rows", 6 * r),
+        SEED_MIDSPAN,
+    )
 }
 
-/// Follows the deflection [m] at x = 15.375 m on the soffit of the viaduct example (under
-/// the tandem of its traffic pattern).
-struct TandemDeflection(f64);
-
-impl Observer for TandemDeflection {
-    fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
-        let m = snap.system.model;
-        if let Some(n) = m
-            .nodes
-            .iter()
-            .position(|p| (p[0] - 15.375).abs() < 1e-6 && p[1].abs() < 1e-9)
-        {
-            self.0 = snap.system.u[2 * n + 1];
-        }
-        Ok(())
-    }
-}
+/// Soffit point under the tandem of the viaduct example's traffic pattern [m].
+const VIADUCT_TANDEM_X: f64 = 15.375;
 
 /// The bundled three-span viaduct (examples/viaduct.toml, issue #20 item 8) with its mesh
 /// refined `refine` times in both directions (1: the example's 2 columns a segment and 6
@@ -380,24 +373,12 @@ pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
     if r > 1 && !text.contains(&format!("depth = 1.90, rows = {} }}", 4 * r)) {
         return Err("viaduct.toml changed: cannot refine its mesh".into());
     }
-    let t0 = Instant::now();
-    let model = segfem::input::parse(&text, "viaduct.toml")
-        .map_err(|e| e.to_string())?
-        .model;
-    let mut obs = TandemDeflection(0.0);
-    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
-    Ok(NonlinearRow {
-        case: format!("viaduct, {} rows", 6 * r),
-        equations,
-        increments: t.increments,
-        iterations: t.iterations,
-        factorisations: t.solver.factorisations,
-        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
-        assembly_s: t.assembly_s,
-        total_s: t0.elapsed().as_secs_f64(),
-        result: obs.0,
-    })
+    timed_row(
+        &text,
+        "viaduct.toml",
+        format!("viaduct, {} rows", 6 * r),
+        VIADUCT_TANDEM_X,
+    )
 }
 
 /// `examples/creep-beam.toml` (the seed beam's seven segments cast 30–90 days before
@@ -409,44 +390,19 @@ pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
 pub fn creep_beam_concrete_case(refine: usize) -> Result<NonlinearRow, String> {
     let r = refine.max(1);
     let example = include_str!("../../examples/creep-beam.toml");
-    let text = example
-        .replace(
-            "kind = \"elastic_creep\"",
-            "kind = \"concrete\"\ncreep = \"mc90\"",
-        )
-        .replace(
-            "nx_per_segment = 6 ",
-            &format!("nx_per_segment = {} ", 6 * r),
-        )
-        .replace(
-            "depth = 0.10, rows = 1 ",
-            &format!("depth = 0.10, rows = {r} "),
-        )
-        .replace(
-            "depth = 0.40, rows = 4 ",
-            &format!("depth = 0.40, rows = {} ", 4 * r),
-        );
+    let text = refine_seed_mesh(example, r).replace(
+        "kind = \"elastic_creep\"",
+        "kind = \"concrete\"\ncreep = \"mc90\"",
+    );
     if !text.contains("creep = \"mc90\"") || (r > 1 && text.contains("rows = 4 ")) {
         return Err("creep-beam.toml changed: cannot build the cracking-concrete case".into());
     }
-    let t0 = Instant::now();
-    let model = segfem::input::parse(&text, "creep-beam-concrete.toml")
-        .map_err(|e| e.to_string())?
-        .model;
-    let mut obs = Nothing(0.0);
-    let t = steps::run(&model, &mut obs).map_err(|e| e.to_string())?;
-    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
-    Ok(NonlinearRow {
-        case: format!("creep concrete, {} rows", 6 * r),
-        equations,
-        increments: t.increments,
-        iterations: t.iterations,
-        factorisations: t.solver.factorisations,
-        factor_mean_s: t.solver.numeric_s / t.solver.factorisations.max(1) as f64,
-        assembly_s: t.assembly_s,
-        total_s: t0.elapsed().as_secs_f64(),
-        result: obs.0,
-    })
+    timed_row(
+        &text,
+        "creep-beam-concrete.toml",
+        format!("creep concrete, {} rows", 6 * r),
+        SEED_MIDSPAN,
+    )
 }
 
 /// CPU time of this process so far, user + system, all threads [s] (Linux /proc/self/stat,
