@@ -100,8 +100,13 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "viaduct",
-        "three-span 3 x 40 m segmental viaduct built span by span on falsework: stages, 30 years, gradient, traffic to failure",
+        "three-span 3 x 40 m segmental viaduct built span by span on falsework ([viaduct] generator): stages, 30 years, gradient, traffic to failure",
         include_str!("../examples/viaduct.toml"),
+    ),
+    (
+        "viaduct-explicit",
+        "the same viaduct written out table by table: the regions, mesh, supports, tendons and steps its [viaduct] section generates",
+        include_str!("../examples/viaduct-explicit.toml"),
     ),
     (
         "gmsh-tapered",

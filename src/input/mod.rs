@@ -3,6 +3,7 @@
 pub mod bar_layers;
 pub mod build;
 pub mod error;
+pub mod generators;
 pub mod limits;
 pub mod locate;
 pub mod schema;
@@ -80,6 +81,7 @@ pub fn parse(text: &str, label: &str) -> Result<Built, InputError> {
             message: plain_types(&e.message().trim().replace('\n', " ")),
         }
     })?;
-    build::build(file, &ctx)
+    let (file, generated) = generators::expand(file, &ctx)?;
+    build::build(file, &ctx).map_err(|e| generated.remap(e))
 }
 pub mod gmsh_mesh;

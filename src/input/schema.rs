@@ -33,6 +33,8 @@ pub struct File {
     #[serde(default)]
     pub bar_layers: Vec<BarLayerIn>,
     pub analysis: Option<AnalysisIn>,
+    /// Generator of a span-by-span segmental viaduct (expanded before validation).
+    pub viaduct: Option<super::generators::viaduct::ViaductIn>,
 }
 
 // The material table lives with its kinds and builders (one file per material law's input).
