@@ -140,6 +140,7 @@ fn every_documented_error_and_warning_is_given() {
         "creep-beam",
         "gmsh-tapered",
         "cantilever",
+        "viaduct",
     ] {
         let p = root().join(format!("examples/{ex}.toml"));
         bases.insert(ex.to_string(), std::fs::read_to_string(p).unwrap());

@@ -16,8 +16,12 @@ use super::schema::File;
 pub struct Generated {
     /// Section that generated them (`"viaduct"`), empty when nothing was generated.
     section: &'static str,
-    /// Per list (`"supports"`, `"steps"`, …): the names of the generated entries.
+    /// Per list (`"supports"`, `"steps"`, …): the names of the generated entries, in
+    /// front of the user's.
     lists: Vec<(&'static str, Vec<String>)>,
+    /// Lists only the generator writes (`"regions"`: the bands, split per segment when
+    /// the mesh is built, so their final number is not known here).
+    owned: Vec<&'static str>,
     /// The generator wrote `[mesh]`.
     mesh: bool,
 }
@@ -42,6 +46,16 @@ impl Generated {
             e.message = format!("in the generated [mesh] ({}): {}", e.key, e.message);
             e.key = self.section.to_string();
             return e;
+        }
+        for list in &self.owned {
+            let Some(rest) = e.key.strip_prefix(list) else {
+                continue;
+            };
+            if rest.is_empty() || rest.starts_with('[') || rest.starts_with('.') {
+                e.message = format!("in the generated {list} ({}): {}", e.key, e.message);
+                e.key = self.section.to_string();
+                return e;
+            }
         }
         for (list, names) in &self.lists {
             let Some(rest) = e.key.strip_prefix(list) else {

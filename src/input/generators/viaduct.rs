@@ -224,6 +224,7 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     let mut generated = Generated {
         section: "viaduct",
         lists: Vec::new(),
+        owned: vec!["regions"],
         mesh: true,
     };
     let regions: Vec<RegionIn> = v
@@ -246,6 +247,18 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     for (g, group) in layout.groups.iter().enumerate() {
         for (j, &s) in group.iter().enumerate() {
             cast_days[s] = v.cast_start[g] + j as f64 * v.cast_interval;
+        }
+        let last = cast_days[group[group.len() - 1]];
+        let placed = start + g as f64 * v.span_interval;
+        if last > placed {
+            return Err(ctx.err(
+                k(&format!("cast_start[{g}]")),
+                format!(
+                    "span {}'s segments are cast from day {} to day {last}, after the span is erected on day {placed}: cast them earlier",
+                    g + 1,
+                    v.cast_start[g]
+                ),
+            ));
         }
     }
     file.mesh = Some(MeshIn {
@@ -788,7 +801,7 @@ fn tendons(v: &ViaductIn, layout: &Layout, depth: f64, file: &File, ctx: &Ctx) -
                 return Err(ctx.err(
                     k("reach"),
                     format!(
-                        "the tendon over pier P{i} would run from x = {a} to {z} m, beyond the girder ({} … {} m)",
+                        "the tendon over pier P{i} would run from x = {a:.3} to {z:.3} m, beyond the girder ({:.3} … {:.3} m)",
                         layout.x0,
                         layout.end()
                     ),
