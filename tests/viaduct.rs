@@ -336,6 +336,12 @@ fn generated_two_span_girder_follows_the_statics_of_its_stage_sequence() {
     // reaction: Newton leaves a residual of 1e-6 of the forces (docs/input.md, [solver]).
     let r_a1 = w * 17.5 * (16.0 - 8.25) / 16.0;
     let r = &rec[step(&m, "strike falsework 1")];
+    eprintln!(
+        "after striking falsework 1 [N]: FE A1 {:.3}, P1 {:.3}; statics {r_a1:.3}, {:.3}",
+        r.reactions[a1],
+        r.reactions[p1],
+        w * 17.5 - r_a1
+    );
     for (s, want) in [(a1, r_a1), (p1, w * 17.5 - r_a1)] {
         assert!(
             (r.reactions[s] - want).abs() < 1e-4 * want,
@@ -352,6 +358,10 @@ fn generated_two_span_girder_follows_the_statics_of_its_stage_sequence() {
     let [ra, rp, rb] = two_span_reactions(16.0, 16.0, 17.0, 0.5);
     let want = [r_a1 + w * ra, w * 17.5 - r_a1 + w * rp, w * rb];
     let r = &rec[step(&m, "strike falsework 2")];
+    eprintln!(
+        "after striking falsework 2 [N]: FE {:.1?}, beam theory {want:.1?}",
+        [r.reactions[a1], r.reactions[p1], r.reactions[a2]]
+    );
     for (i, s) in [a1, p1, a2].into_iter().enumerate() {
         assert!(
             (r.reactions[s] - want[i]).abs() < 0.01 * want[1],
