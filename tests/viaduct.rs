@@ -375,3 +375,104 @@ fn generated_two_span_girder_follows_the_statics_of_its_stage_sequence() {
     // continuous spans: 1.25·w·16 = 20 w against 17.8 w here), many times the tolerance.
     assert!((want[1] - 1.25 * w * 16.0).abs() > 5.0 * 0.01 * want[1]);
 }
+
+#[test]
+fn generated_layout_of_unequal_spans() {
+    // Spans 30 + 39 + 30 m with 3 m segments: 9, 12 and 9 typical segments between the 2 m
+    // end segments (0.5 m overhang) and the 3 m pier segments; Q4, 4 columns a segment.
+    let text = r#"
+[[materials]]
+name = "c"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+density = 2500.0
+
+[[materials]]
+name = "y1860"
+kind = "prestressing_steel"
+Ep = 195e9
+fptk = 1860e6
+
+[[joint_materials]]
+name = "dry"
+kind = "keyed"
+
+[viaduct]
+sequence = "span_by_span"
+spans = [30.0, 39.0, 30.0]
+segment_length = 3.0
+pier_segment = 3.0
+end_segment = 2.0
+overhang = 0.5
+concrete = "c"
+joint_material = "dry"
+strand = "y1860"
+element = "Q4"
+nx_per_segment = 4
+section = [
+  { name = "slab", width = 5.0, depth = 0.3, rows = 1 },
+  { name = "webs", width = 0.8, depth = 1.5, rows = 3 },
+  { name = "deck", width = 10.0, depth = 0.2, rows = 1 },
+]
+cast_start = [-60.0, -40.0, -20.0]
+cast_interval = 1.0
+span_interval = 10.0
+
+[viaduct.span_tendons]
+area = 0.02
+end_anchor_height = 0.8
+pier_anchor_height = 1.3
+deviators = [{ segment = 3, height = 0.3 }, { segment = 7, height = 0.3 }]
+jacking_stress = 1300e6
+
+[viaduct.continuity_tendons]
+area = 0.005
+height = 1.8
+reach = 6.0
+jacking_stress = 1300e6
+"#;
+    let built = segfem::input::parse(text, "unequal.toml").unwrap_or_else(|e| panic!("{e}"));
+    let m = built.model;
+    // Every point the generator wrote is a node (a bearing or a tendon point between node
+    // columns would be moved with a warning); the one warning says the elastic concrete
+    // does not use the casting days.
+    assert_eq!(built.warnings.len(), 1, "{:?}", built.warnings);
+    assert!(built.warnings[0].contains("not time dependent"));
+    assert_eq!(
+        m.joints.len(),
+        1 + 9 + 1 + 12 + 1 + 9,
+        "34 segments, 33 joints"
+    );
+    let at = |n: usize| m.nodes[n];
+    // Bearings at the soffit, at 0, 30, 69 and 99 m.
+    for (name, x) in [("A1", 0.0), ("P1", 30.0), ("P2", 69.0), ("A2", 99.0)] {
+        let s = &m.supports[support(&m, name)];
+        assert!(
+            s.dofs.iter().all(|(n, _, _)| at(*n) == [x, 0.0]),
+            "{name}: {:?}",
+            s.dofs
+        );
+    }
+    // T2: pier axis P1, centres of span 2's 3rd and 7th typical segments (the first starts
+    // at 30 + 1.5 m), pier axis P2; C1 straight over P1, 6 m either side.
+    let tendon = |name: &str| {
+        let t = m.tendons.iter().find(|t| t.name == name).unwrap();
+        t.nodes.iter().map(|&n| at(n)).collect::<Vec<_>>()
+    };
+    assert_eq!(
+        tendon("T2"),
+        [
+            [30.0, 1.3],
+            [31.5 + 7.5, 0.3],
+            [31.5 + 19.5, 0.3],
+            [69.0, 1.3]
+        ]
+    );
+    assert_eq!(tendon("T1")[0], [-0.5, 0.8]);
+    assert_eq!(tendon("T3")[3], [99.5, 0.8]);
+    assert_eq!(tendon("C1"), [[24.0, 1.8], [36.0, 1.8]]);
+    // Nine steps, the last creep step ending on day 30.
+    assert_eq!(m.steps.len(), 9);
+    assert_eq!(m.steps[8].name, "span 3 creeps");
+}

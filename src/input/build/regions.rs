@@ -104,6 +104,7 @@ pub(super) fn assign_cast_days(
     warnings: &mut Vec<String>,
 ) -> R<()> {
     let mut seen = std::collections::HashSet::new();
+    let mut warned = std::collections::HashSet::new();
     let mut copies: HashMap<(usize, u64), usize> = HashMap::new();
     for (i, (r, region)) in input.iter().zip(regions.iter_mut()).enumerate() {
         let m = region.material;
@@ -116,7 +117,8 @@ pub(super) fn assign_cast_days(
             ));
         }
         if !creep {
-            if r.is_some() {
+            // Once per material: a segmental mesh gives every segment's regions a day.
+            if r.is_some() && warned.insert(m) {
                 warnings.push(format!(
                     "{}: regions[{i}].cast_day: ignored, material '{}' is not time dependent",
                     ctx.file, materials[m].name

@@ -181,6 +181,15 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
         }
     }
     let n = v.spans.len();
+    let finite = |key: &str, x: f64| -> R<f64> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(ctx.err(k(key), format!("must be a finite number (got {x})")))
+        }
+    };
+    // Casting days also name the segments (their regions are split per segment), which
+    // the erection steps place: required even for a concrete that does not age.
     if v.cast_start.len() != n {
         return Err(ctx.err(
             k("cast_start"),
@@ -190,13 +199,6 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
             ),
         ));
     }
-    let finite = |key: &str, x: f64| -> R<f64> {
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(ctx.err(k(key), format!("must be a finite number (got {x})")))
-        }
-    };
     for (i, d) in v.cast_start.iter().enumerate() {
         finite(&format!("cast_start[{i}]"), *d)?;
     }
@@ -243,24 +245,7 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
         .push(("regions", names(&regions, |r| &r.name)));
     file.regions = regions;
 
-    let mut cast_days = vec![0.0; layout.lengths.len()];
-    for (g, group) in layout.groups.iter().enumerate() {
-        for (j, &s) in group.iter().enumerate() {
-            cast_days[s] = v.cast_start[g] + j as f64 * v.cast_interval;
-        }
-        let last = cast_days[group[group.len() - 1]];
-        let placed = start + g as f64 * v.span_interval;
-        if last > placed {
-            return Err(ctx.err(
-                k(&format!("cast_start[{g}]")),
-                format!(
-                    "span {}'s segments are cast from day {} to day {last}, after the span is erected on day {placed}: cast them earlier",
-                    g + 1,
-                    v.cast_start[g]
-                ),
-            ));
-        }
-    }
+    let cast_days = cast_days(ctx, &layout, &v.cast_start, v.cast_interval, start, v)?;
     file.mesh = Some(MeshIn {
         kind: "segmental".into(),
         length: None,
@@ -326,6 +311,37 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
         &s.name
     })?;
     Ok(generated)
+}
+
+/// The casting day of every segment: span by span from its first segment's, `interval`
+/// apart; each cast by its span's erection day.
+fn cast_days(
+    ctx: &Ctx,
+    layout: &Layout,
+    first: &[f64],
+    interval: f64,
+    start: f64,
+    v: &ViaductIn,
+) -> R<Vec<f64>> {
+    let mut days = vec![0.0; layout.lengths.len()];
+    for (g, group) in layout.groups.iter().enumerate() {
+        for (j, &s) in group.iter().enumerate() {
+            days[s] = first[g] + j as f64 * interval;
+        }
+        let last = days[group[group.len() - 1]];
+        let placed = start + g as f64 * v.span_interval;
+        if last > placed {
+            return Err(ctx.err(
+                format!("viaduct.cast_start[{g}]"),
+                format!(
+                    "span {}'s segments are cast from day {} to day {last}, after the span is erected on day {placed}: cast them earlier",
+                    g + 1,
+                    first[g]
+                ),
+            ));
+        }
+    }
+    Ok(days)
 }
 
 /// The names of `items`.
