@@ -292,6 +292,8 @@ struct Progress<'a, 'm> {
     signal: Option<Arc<AtomicUsize>>,
     /// Timings when a step stopped early (the analysis returns none with its error).
     timings: Option<Timings>,
+    /// The last checkpoint, still being written (waited for before the next and at the end).
+    checkpoint: Option<checkpoint::Pending>,
 }
 
 impl Observer for Progress<'_, '_> {
@@ -305,14 +307,17 @@ impl Observer for Progress<'_, '_> {
     }
 
     fn step_end(&mut self, end: &StepEnd) -> std::io::Result<()> {
-        checkpoint::write(
+        if let Some(p) = self.checkpoint.take() {
+            p.wait()?;
+        }
+        self.checkpoint = Some(checkpoint::start(
             &self.dir,
             &self.origin,
             end.driver,
             &self.failures,
             &self.rec.state(),
             end.system.state(),
-        )?;
+        )?);
         if self.stop_after_step == Some(end.driver.next_step) {
             self.stop_now = true;
         }
@@ -462,6 +467,7 @@ pub fn run_file_opts(
         stop_now: false,
         signal: opts.signal.clone(),
         timings: None,
+        checkpoint: None,
     };
     let result = steps::run_with(
         &model,
@@ -471,6 +477,11 @@ pub fn run_file_opts(
             resume,
         },
     );
+    // The last checkpoint's write fails the run as it did when written in place.
+    let result = match (obs.checkpoint.take().map(checkpoint::Pending::wait), result) {
+        (Some(Err(e)), Ok(_)) => Err(AnalysisError::Output(e)),
+        (_, r) => r,
+    };
     let mut rec = obs.rec;
     let watch = obs.watch;
     let plausibility = obs.plausible.findings();

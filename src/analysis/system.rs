@@ -258,10 +258,17 @@ impl<'m> System<'m> {
         });
         let ordering_s = t_order.elapsed().as_secs_f64();
         let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
-        let mut committed = Vec::new();
+        // Sized at once: grown point by point, the states were copied ~twice over.
+        let mut committed = Vec::with_capacity(
+            model
+                .elements
+                .iter()
+                .map(|e| continuum::rule_points(e.kind, e.integration).len())
+                .sum(),
+        );
         gp_offset.push(0);
         for e in &model.elements {
-            let ngp = continuum::rule(e.kind, e.integration).len();
+            let ngp = continuum::rule_points(e.kind, e.integration).len();
             let mat = &model.materials[model.regions[e.region].material].law;
             for _ in 0..ngp {
                 committed.push(mat.initial_state());

@@ -196,44 +196,65 @@ mod geometry_tests {
 /// interface between them: two parts of the mesh touching there are not connected, which is
 /// what a joint missing from the model (a joint face with no opposite face) looks like.
 /// `tied[n]` is true for nodes of an interface element. Returns the number of such pairs and
-/// the first one (0-based nodes). Hashing on a grid of the tolerance keeps it O(n).
+/// the first one (0-based nodes: the pair of the lowest second node, and of its partners
+/// the first in cell order). The nodes are sorted by their cell on a grid of the
+/// tolerance: a node's partners lie in its own and the adjacent cells, which one walk over
+/// the sorted list reaches (a hash map of cells took 0.3 s at 2.5e5 nodes).
 pub fn loose_coincident(
     nodes: &[[f64; 2]],
     used: &[bool],
     tied: &[bool],
     size: f64,
 ) -> (usize, Option<(usize, usize)>) {
-    use std::collections::HashMap;
     let tol = 1e-9 * size;
     if !(tol > 0.0 && tol.is_finite()) {
         return (0, None);
     }
     let cell = |p: [f64; 2]| ((p[0] / tol).floor() as i64, (p[1] / tol).floor() as i64);
-    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
-    let (mut count, mut first) = (0, None);
-    for (n, p) in nodes.iter().enumerate() {
-        if !used[n] {
-            continue;
-        }
-        let (cx, cy) = cell(*p);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for &m in grid
-                    .get(&(cx + dx, cy + dy))
-                    .map(Vec::as_slice)
-                    .unwrap_or(&[])
-                {
-                    let q = nodes[m];
-                    if (p[0] - q[0]).hypot(p[1] - q[1]) <= tol && !(tied[n] && tied[m]) {
-                        count += 1;
-                        first.get_or_insert((m, n));
-                    }
-                }
+    // (cell, node), sorted: cells by column then row, nodes ascending within a cell.
+    let mut sorted: Vec<((i64, i64), usize)> = nodes
+        .iter()
+        .enumerate()
+        .filter(|&(n, _)| used[n])
+        .map(|(n, p)| (cell(*p), n))
+        .collect();
+    sorted.sort_unstable();
+    let (mut count, mut first): (usize, Option<(usize, usize, usize)>) = (0, None);
+    let mut pair = |i: usize, j: usize| {
+        // i, j: positions in `sorted`; (m, n) the pair's nodes, m < n.
+        let (a, b) = (sorted[i].1, sorted[j].1);
+        let (im, m, n) = if a < b { (i, a, b) } else { (j, b, a) };
+        let (p, q) = (nodes[n], nodes[m]);
+        if (p[0] - q[0]).hypot(p[1] - q[1]) <= tol && !(tied[n] && tied[m]) {
+            count += 1;
+            // The node scan of the definition meets n's partners in cell order.
+            if first.is_none_or(|(_, f_im, f_n)| (n, im) < (f_n, f_im)) {
+                first = Some((m, im, n));
             }
         }
-        grid.entry((cx, cy)).or_default().push(n);
+    };
+    // Each unordered pair of neighbouring cells once: from (cx, cy) forward in its column
+    // (same cell, cy + 1) and to the next column (cx + 1, cy − 1 ..= cy + 1).
+    let mut next_col = 0;
+    for i in 0..sorted.len() {
+        let (cx, cy) = sorted[i].0;
+        for j in i + 1..sorted.len() {
+            if sorted[j].0 .0 != cx || sorted[j].0 .1 > cy + 1 {
+                break;
+            }
+            pair(i, j);
+        }
+        while next_col < sorted.len() && sorted[next_col].0 < (cx + 1, cy - 1) {
+            next_col += 1;
+        }
+        for j in next_col..sorted.len() {
+            if sorted[j].0 > (cx + 1, cy + 1) {
+                break;
+            }
+            pair(i, j);
+        }
     }
-    (count, first)
+    (count, first.map(|(m, _, n)| (m, n)))
 }
 
 #[cfg(test)]
@@ -265,5 +286,70 @@ mod coincident_tests {
         }
         assert_eq!(loose_coincident(&nodes, &used, &tied, 2.2), (0, None));
         assert_eq!(loose_coincident(&nodes[..4], &used, &tied, 2.2), (0, None));
+    }
+
+    /// The definition scanned directly: nodes in order, each against the earlier nodes of
+    /// its own and the eight adjacent cells (column, then row, then node order).
+    fn by_scan(
+        nodes: &[[f64; 2]],
+        used: &[bool],
+        tied: &[bool],
+        size: f64,
+    ) -> (usize, Option<(usize, usize)>) {
+        let tol = 1e-9 * size;
+        let cell = |p: [f64; 2]| ((p[0] / tol).floor() as i64, (p[1] / tol).floor() as i64);
+        let (mut count, mut first) = (0, None);
+        for n in 0..nodes.len() {
+            let (cx, cy) = cell(nodes[n]);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for m in (0..n).filter(|&m| cell(nodes[m]) == (cx + dx, cy + dy)) {
+                        let (p, q) = (nodes[n], nodes[m]);
+                        if used[n]
+                            && used[m]
+                            && (p[0] - q[0]).hypot(p[1] - q[1]) <= tol
+                            && !(tied[n] && tied[m])
+                        {
+                            count += 1;
+                            first.get_or_insert((m, n));
+                        }
+                    }
+                }
+            }
+        }
+        (count, first)
+    }
+
+    /// The sorted walk finds the pairs of the direct scan, and the same first pair. Points
+    /// on a coarse lattice (many exact coincidences), some moved by less and by more than
+    /// the tolerance (1e-9 of the size 10 m = 1e-8 m) and across cell borders; some unused
+    /// or tied.
+    #[test]
+    fn same_pairs_as_the_direct_scan() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as usize
+        };
+        for round in 0..20 {
+            let mut nodes = Vec::new();
+            for _ in 0..300 {
+                let (i, j) = (next() % 8, next() % 8);
+                let shift = [0.0, 0.0, 4e-9, -7e-9, 3e-8, 9.9e-9][next() % 6];
+                let sign = if next() % 2 == 0 { 1.0 } else { -1.0 };
+                nodes.push([i as f64 * 0.5 + shift, j as f64 * 0.5 + sign * shift]);
+            }
+            let used: Vec<bool> = (0..nodes.len()).map(|_| next() % 7 != 0).collect();
+            let tied: Vec<bool> = (0..nodes.len()).map(|_| next() % 5 == 0).collect();
+            let expected = by_scan(&nodes, &used, &tied, 10.0);
+            assert!(expected.0 > 100, "round {round}: too few pairs to test");
+            assert_eq!(
+                loose_coincident(&nodes, &used, &tied, 10.0),
+                expected,
+                "round {round}"
+            );
+        }
     }
 }

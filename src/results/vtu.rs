@@ -35,64 +35,105 @@ pub struct Grid<'a> {
     pub types: &'a [u8],
 }
 
-fn b64_block(bytes: &[u8]) -> String {
-    // VTK's binary inline format: a UInt32 byte count, then the data, base64 as one block.
-    let mut buf = Vec::with_capacity(bytes.len() + 4);
-    buf.extend_from_slice(&(bytes.len() as u32).to_le_bytes());
-    buf.extend_from_slice(bytes);
-    // Large arrays are encoded in parallel pieces: base64 of a concatenation is the
-    // concatenation of the pieces' base64 when each piece but the last is a multiple of
-    // 3 bytes long.
+/// Append VTK's binary inline block of `bytes` to `out`: a UInt32 byte count, then the
+/// data, base64 as one block. Large arrays are encoded in parallel pieces straight into
+/// `out`: base64 of a concatenation is the concatenation of the pieces' base64 when each
+/// piece but the last is a multiple of 3 bytes long.
+fn b64_block(out: &mut Vec<u8>, bytes: &[u8]) {
+    use base64::engine::general_purpose::STANDARD;
     const PIECE: usize = 3 << 18;
-    if buf.len() <= PIECE {
-        return base64::engine::general_purpose::STANDARD.encode(buf);
-    }
-    let pieces: Vec<String> = buf
-        .par_chunks(PIECE)
-        .map(|c| base64::engine::general_purpose::STANDARD.encode(c))
-        .collect();
-    pieces.concat()
+    const PIECE_OUT: usize = PIECE / 3 * 4;
+    // The first piece: the count and the first PIECE − 4 data bytes.
+    let k = bytes.len().min(PIECE - 4);
+    let mut head = Vec::with_capacity(4 + k);
+    head.extend_from_slice(&(bytes.len() as u32).to_le_bytes());
+    head.extend_from_slice(&bytes[..k]);
+    let start = out.len();
+    let len = (4 + bytes.len()).div_ceil(3) * 4;
+    out.resize(start + len, 0);
+    let (first, rest) = out[start..].split_at_mut(PIECE_OUT.min(len));
+    let n = STANDARD
+        .encode_slice(&head, first)
+        .expect("output sized for the first piece");
+    debug_assert_eq!(n, first.len());
+    rest.par_chunks_mut(PIECE_OUT)
+        .zip(bytes[k..].par_chunks(PIECE))
+        .for_each(|(o, i)| {
+            let n = STANDARD
+                .encode_slice(i, o)
+                .expect("output sized for the piece");
+            debug_assert_eq!(n, o.len());
+        });
+}
+
+/// An element of the document, UTF-8.
+fn text(out: &mut Vec<u8>, args: std::fmt::Arguments) {
+    use std::io::Write as _;
+    let _ = out.write_fmt(args);
 }
 
 fn f64_bytes(v: &[f64]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
-fn write_array(out: &mut String, a: &Array) {
+fn write_array(out: &mut Vec<u8>, a: &Array) {
     match a {
         Array::F64 {
             name,
             components,
             values,
         } => {
-            let _ = writeln!(
+            text(
                 out,
-                r#"<DataArray type="Float64" Name="{name}" NumberOfComponents="{components}" format="binary">{}</DataArray>"#,
-                b64_block(&f64_bytes(values))
+                format_args!(
+                    r#"<DataArray type="Float64" Name="{name}" NumberOfComponents="{components}" format="binary">"#
+                ),
             );
+            b64_block(out, &f64_bytes(values));
         }
         Array::I32 { name, values } => {
             let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-            let _ = writeln!(
+            text(
                 out,
-                r#"<DataArray type="Int32" Name="{name}" NumberOfComponents="1" format="binary">{}</DataArray>"#,
-                b64_block(&bytes)
+                format_args!(
+                    r#"<DataArray type="Int32" Name="{name}" NumberOfComponents="1" format="binary">"#
+                ),
             );
+            b64_block(out, &bytes);
         }
     }
+    out.extend_from_slice(b"</DataArray>\n");
+}
+
+/// Bytes of the base64 blocks of `point_data` and `cell_data` and the grid, for reserving
+/// the document at once (an estimate: the tags are not counted).
+fn estimated_len(grid: &Grid, arrays: &[&Array]) -> usize {
+    let b64 = |bytes: usize| (4 + bytes).div_ceil(3) * 4 + 200;
+    let cells: usize = grid.cells.iter().map(Vec::len).sum();
+    let data: usize = arrays
+        .iter()
+        .map(|a| match a {
+            Array::F64 { values, .. } => b64(8 * values.len()),
+            Array::I32 { values, .. } => b64(4 * values.len()),
+        })
+        .sum();
+    data + b64(24 * grid.points.len()) + b64(8 * cells) + b64(9 * grid.cells.len()) + 1000
 }
 
 /// Render a .vtu document.
 pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String {
-    let mut s = String::new();
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<UnstructuredGrid>\n");
-    let _ = writeln!(
-        s,
-        r#"<Piece NumberOfPoints="{}" NumberOfCells="{}">"#,
-        grid.points.len(),
-        grid.cells.len()
+    let all: Vec<&Array> = point_data.iter().chain(cell_data).collect();
+    let mut s = Vec::with_capacity(estimated_len(grid, &all));
+    s.extend_from_slice("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<UnstructuredGrid>\n".as_bytes());
+    text(
+        &mut s,
+        format_args!(
+            "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
+            grid.points.len(),
+            grid.cells.len()
+        ),
     );
-    s.push_str("<Points>\n");
+    s.extend_from_slice(b"<Points>\n");
     let xyz: Vec<f64> = grid.points.iter().flat_map(|p| [p[0], p[1], 0.0]).collect();
     write_array(
         &mut s,
@@ -102,7 +143,7 @@ pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String 
             values: &xyz,
         },
     );
-    s.push_str("</Points>\n<Cells>\n");
+    s.extend_from_slice(b"</Points>\n<Cells>\n");
     let conn: Vec<u8> = grid
         .cells
         .iter()
@@ -118,31 +159,34 @@ pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String 
             off.to_le_bytes()
         })
         .collect();
-    let _ = writeln!(
-        s,
-        r#"<DataArray type="Int64" Name="connectivity" format="binary">{}</DataArray>"#,
-        b64_block(&conn)
-    );
-    let _ = writeln!(
-        s,
-        r#"<DataArray type="Int64" Name="offsets" format="binary">{}</DataArray>"#,
-        b64_block(&offsets)
-    );
-    let _ = writeln!(
-        s,
-        r#"<DataArray type="UInt8" Name="types" format="binary">{}</DataArray>"#,
-        b64_block(grid.types)
-    );
-    s.push_str("</Cells>\n<PointData>\n");
+    for (head, bytes) in [
+        (
+            &br#"<DataArray type="Int64" Name="connectivity" format="binary">"#[..],
+            &conn[..],
+        ),
+        (
+            br#"<DataArray type="Int64" Name="offsets" format="binary">"#,
+            &offsets,
+        ),
+        (
+            br#"<DataArray type="UInt8" Name="types" format="binary">"#,
+            grid.types,
+        ),
+    ] {
+        s.extend_from_slice(head);
+        b64_block(&mut s, bytes);
+        s.extend_from_slice(b"</DataArray>\n");
+    }
+    s.extend_from_slice(b"</Cells>\n<PointData>\n");
     for a in point_data {
         write_array(&mut s, a);
     }
-    s.push_str("</PointData>\n<CellData>\n");
+    s.extend_from_slice(b"</PointData>\n<CellData>\n");
     for a in cell_data {
         write_array(&mut s, a);
     }
-    s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    s
+    s.extend_from_slice(b"</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    String::from_utf8(s).expect("tags and base64 are ASCII")
 }
 
 /// Render a .pvd collection of (time, part, file name) entries; part 0 is the continuum,
@@ -163,23 +207,48 @@ pub fn render_pvd(entries: &[(f64, usize, String)]) -> String {
 mod tests {
     use super::*;
 
-    /// A block encoded in parallel pieces equals the one-piece encoding.
+    /// The block of `bytes` alone, as text.
+    fn block(bytes: &[u8]) -> String {
+        let mut out = Vec::new();
+        b64_block(&mut out, bytes);
+        String::from_utf8(out).unwrap()
+    }
+
+    /// A block encoded in parallel pieces equals the one-piece encoding, for lengths at
+    /// and around the piece boundaries, appended after earlier text.
     #[test]
     fn large_block_encodes_as_one_piece() {
+        let piece = 3 << 18;
         let v: Vec<f64> = (0..300_001).map(|i| (i as f64).sin()).collect();
-        let bytes = f64_bytes(&v);
-        let mut buf = (bytes.len() as u32).to_le_bytes().to_vec();
-        buf.extend_from_slice(&bytes);
-        assert_eq!(
-            b64_block(&bytes),
-            base64::engine::general_purpose::STANDARD.encode(buf)
-        );
+        let all = f64_bytes(&v);
+        for len in [
+            0,
+            1,
+            2,
+            piece - 5,
+            piece - 4,
+            piece - 3,
+            piece,
+            2 * piece + 1,
+            all.len(),
+        ] {
+            let bytes = &all[..len];
+            let mut buf = (bytes.len() as u32).to_le_bytes().to_vec();
+            buf.extend_from_slice(bytes);
+            let mut out = b"<x>".to_vec();
+            b64_block(&mut out, bytes);
+            let expected = format!(
+                "<x>{}",
+                base64::engine::general_purpose::STANDARD.encode(buf)
+            );
+            assert_eq!(String::from_utf8(out).unwrap(), expected, "{len} bytes");
+        }
     }
 
     /// The binary block decodes to a little-endian byte count followed by the data.
     #[test]
     fn binary_block_round_trip() {
-        let enc = b64_block(&f64_bytes(&[1.5, -2.0]));
+        let enc = block(&f64_bytes(&[1.5, -2.0]));
         let dec = base64::engine::general_purpose::STANDARD
             .decode(enc)
             .unwrap();
