@@ -9,6 +9,7 @@ use segfem::materials::concrete::{reduction, CompressionReduction, ConcreteParam
 fn panel(rho: [f64; 2], fcm: f64) -> Panel {
     Panel {
         id: "closed form".into(),
+        lab: String::new(),
         thickness: 0.07,
         size: 1.0,
         fcm,
@@ -180,6 +181,11 @@ fn panel_series_recommended_option_a_known_deviation() {
         .filter(|p| p.v_test.is_finite())
         .collect();
     assert!(panels.len() >= 15, "{} panels", panels.len());
+    // Every row names its laboratory (the `series` column), for the per-lab statistics.
+    assert!(
+        panels.iter().all(|p| !p.lab.is_empty()),
+        "a panel without its series"
+    );
     let opts = options();
     let key = |name: &str| opts.iter().find(|o| o.0 == name).unwrap().1;
     let ratios = |keys: &str| -> Vec<f64> {
