@@ -11,6 +11,8 @@ use crate::analysis::steps::{self, Observer, Snapshot};
 pub struct Panel {
     /// Test name.
     pub id: String,
+    /// Test series (laboratory), for the per-laboratory statistics ("" if not known).
+    pub lab: String,
     /// Thickness [m].
     pub thickness: f64,
     /// Side of the (square) panel [m].
@@ -299,8 +301,9 @@ pub(crate) fn csv_fields(line: &str) -> Vec<String> {
 
 /// Read the panel series from a CSV file with the columns (by header name) `id`,
 /// `thickness_mm`, `size_mm` (`AxB`), `fc_MPa`, `rho_x`, `fy_x_MPa`, `Es_x_MPa`, `rho_y`,
-/// `fy_y_MPa`, `Es_y_MPa`, `sx_over_v`, `sy_over_v`, `v_u_MPa`, `agg_mm`. Rows without
-/// v_u are kept (v_test = NaN); a missing E_s is 200 GPa, a missing aggregate size 16 mm.
+/// `fy_y_MPa`, `Es_y_MPa`, `sx_over_v`, `sy_over_v`, `v_u_MPa`, `agg_mm`, and optionally
+/// `series` (the laboratory). Rows without v_u are kept (v_test = NaN); a missing E_s is
+/// 200 GPa, a missing aggregate size 16 mm.
 pub fn read_panels(path: &std::path::Path) -> Result<Vec<Panel>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
@@ -330,6 +333,7 @@ pub fn read_panels(path: &std::path::Path) -> Result<Vec<Panel>, String> {
     .iter()
     .map(|c| col(c))
     .collect::<Result<_, _>>()?;
+    let lab_col = header.iter().position(|h| h == "series");
     let mut out = Vec::new();
     for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let f = csv_fields(line);
@@ -363,6 +367,10 @@ pub fn read_panels(path: &std::path::Path) -> Result<Vec<Panel>, String> {
             ))?;
         out.push(Panel {
             id: get(0).to_string(),
+            lab: lab_col
+                .and_then(|i| f.get(i))
+                .map(|s| s.trim().to_string())
+                .unwrap_or_default(),
             thickness: 1e-3 * num(1, None)?,
             size: 1e-3 * size,
             fcm: 1e6 * num(3, None)?,
@@ -386,8 +394,8 @@ pub fn mean_cov(x: &[f64]) -> (f64, f64) {
 }
 
 /// Run every panel with a measured strength under every option; returns a Markdown
-/// report (one table of test/predicted ratios, mean and COV per option) and the total
-/// time [s].
+/// report (one table of test/predicted ratios, mean and COV per option, then mean and COV
+/// per laboratory) and the total time [s].
 pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
     let start = std::time::Instant::now();
     let panels: Vec<Panel> = read_panels(path)?
@@ -396,6 +404,8 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
         .collect();
     let opts = options();
     let mut ratios = vec![Vec::new(); opts.len()];
+    // Per laboratory: (lab, ratios per option), in the order the labs first appear.
+    let mut by_lab: Vec<(String, Vec<Vec<f64>>)> = Vec::new();
     let mut s = String::from("| panel | v_test [MPa] |");
     for (name, _) in &opts {
         s.push_str(&format!(" {name} |"));
@@ -405,12 +415,20 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
     s.push('\n');
     let mut modes = String::new();
     for p in &panels {
+        let lab = match by_lab.iter().position(|(l, _)| *l == p.lab) {
+            Some(i) => i,
+            None => {
+                by_lab.push((p.lab.clone(), vec![Vec::new(); opts.len()]));
+                by_lab.len() - 1
+            }
+        };
         s.push_str(&format!("| {} | {:.2} |", p.id, p.v_test / 1e6));
         for (k, (name, keys)) in opts.iter().enumerate() {
             match run_panel(p, keys, 1) {
                 Ok(r) => {
                     let ratio = p.v_test / r.v_peak;
                     ratios[k].push(ratio);
+                    by_lab[lab].1[k].push(ratio);
                     s.push_str(&format!(" {ratio:.2} |"));
                     modes.push_str(&format!(
                         "{} / {name}: v = {:.2} MPa, {} ({} increments)\n",
@@ -435,6 +453,20 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
     s.push_str("\n| **COV** | |");
     for r in &ratios {
         s.push_str(&format!(" **{:.1} %** |", 100.0 * mean_cov(r).1));
+    }
+    s.push_str("\n\nPer laboratory (mean / COV of test/predicted):\n\n| series | panels |");
+    for (name, _) in &opts {
+        s.push_str(&format!(" {name} |"));
+    }
+    s.push_str("\n|---|---|");
+    s.push_str(&"---|".repeat(opts.len()));
+    for (lab, r) in &by_lab {
+        let label = if lab.is_empty() { "(not given)" } else { lab };
+        s.push_str(&format!("\n| {label} | {} |", r[0].len()));
+        for x in r {
+            let (m, c) = mean_cov(x);
+            s.push_str(&format!(" {m:.3} / {:.1} % |", 100.0 * c));
+        }
     }
     s.push_str("\n\nPredicted peak and failure mode per run:\n\n```\n");
     s.push_str(&modes);
