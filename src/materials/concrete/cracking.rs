@@ -152,13 +152,6 @@ pub fn tension_envelope(p: &ConcreteParams, alpha: f64, eps: f64) -> (f64, f64) 
     }
 }
 
-/// Slope past the extrapolated largest crack strain of an IMPL-EX crack, as a fraction of
-/// its secant there [-]. 1: the secant goes on, so the law is linear in the increment as in
-/// Oliver, Huespe & Cante (2008) — no kink at ẽ_max for Newton to cycle on (a smaller slope
-/// made the MC90 seed beam refined 4× stall, docs/performance.md); the stress exceeds the
-/// envelope by the secant times the unforeseen opening, corrected by the next extrapolation.
-pub const IMPLEX_CAP_SLOPE: f64 = 1.0;
-
 /// Result of one direction law.
 #[derive(Debug, Clone, Copy)]
 struct DirResult {
@@ -170,8 +163,6 @@ struct DirResult {
     open: bool,
     loading_crack: bool,
     e_el: f64,
-    /// IMPL-EX side of the kink at ẽ_max: 1 past it, −1 below it, 0 otherwise.
-    side: i8,
     /// ∂σ/∂ε_lat [Pa]: compression softening by the other direction's tensile strain.
     d_lateral: f64,
     /// Compression reduction factor β_d applied [-] (1 without compression softening).
@@ -221,7 +212,6 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         open: false,
         loading_crack: false,
         e_el,
-        side: 0,
         d_lateral: 0.0,
         beta,
     };
@@ -230,31 +220,12 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
             r.sigma = p.ec * e_el;
             r.k = p.ec;
         } else if let Some(ex) = extrapolated {
-            // IMPL-EX: secant at the extrapolated e_max up to it, then the line of slope
-            // IMPLEX_CAP_SLOPE × secant through the envelope's stress there: a monotone law
-            // in the increment, on the envelope at ẽ_max. e_max itself
-            // is updated implicitly for the next extrapolation.
-            let ex = ex.max(p.eps0());
-            let s_ex = tension_envelope(p, alpha, ex).0;
-            let k_cap = IMPLEX_CAP_SLOPE * s_ex / ex;
-            let cap = s_ex + k_cap * (e_el - ex);
-            r.side = if e_el > ex { 1 } else { -1 };
-            if frozen < 0 || (frozen == 0 && e_el <= ex) {
-                // The secant (held on it by a frozen branch even a little past ẽ_max).
-                r.sigma = s_ex / ex * e_el;
-                r.k = s_ex / ex;
-            } else if frozen > 0 && p.ec * e_el < cap {
-                // Held past ẽ_max but nearly closed: elastic, so that the stress still
-                // vanishes with the strain.
-                r.sigma = p.ec * e_el;
-                r.k = p.ec;
-            } else {
-                // Past ẽ_max the stress rises on IMPLEX_CAP_SLOPE × the secant: with a ~0
-                // slope a band of cracks opening faster than extrapolated is a near-mechanism
-                // and Newton explodes. A frozen branch holds this line a little below ẽ_max.
-                r.k = k_cap;
-                r.sigma = cap;
-            }
+            // IMPL-EX: the secant at the extrapolated e_max up to it, then the smooth,
+            // monotone continuation of `implex::tension` (no kink, so no held branch); e_max
+            // itself is updated implicitly for the next extrapolation.
+            let (s, k) = super::implex::tension(p, alpha, ex, e_el);
+            r.sigma = s;
+            r.k = k;
             r.emax = e_el.max(emax);
             r.open = e_el > 0.0;
         } else if frozen > 0 || (frozen == 0 && e_el >= emax) || emax <= 0.0 {
@@ -372,7 +343,6 @@ pub fn update_cracked(
     st.n_cracks = n_cracks;
     st.crack_max = [r0.emax, if n_cracks >= 2 { r1.emax } else { 0.0 }];
     st.crack_strain = [r0.e_el, if n_cracks >= 2 { r1.e_el } else { 0.0 }];
-    st.implex_side = [r0.side, if n_cracks >= 2 { r1.side } else { 0 }];
     st.dir_ebar = [r0.ebar, r1.ebar];
     st.dir_plastic = [r0.plastic, r1.plastic];
     st.crack_max_old = committed.crack_max;

@@ -20,6 +20,7 @@ pub mod biaxial;
 pub mod compression;
 pub mod cracking;
 pub mod creep;
+pub mod implex;
 pub mod ottosen;
 pub mod panel_bench;
 pub mod reduction;

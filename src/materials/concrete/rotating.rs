@@ -24,7 +24,7 @@
 //! consistent tangent of the rotating law (its limit 0.25 (D11 − D12 − D21 + D22) for
 //! ε1 = ε2).
 
-use super::cracking::{strain_transform, tension_envelope, IMPLEX_CAP_SLOPE};
+use super::cracking::{strain_transform, tension_envelope};
 use super::{
     biaxial, compression, reduction, ConcreteParams, ConcreteState, MaterialError, UpdateResult,
 };
@@ -53,8 +53,6 @@ struct Dir {
     xmax: f64,
     /// The direction reached the crushing strain.
     crushed: bool,
-    /// IMPL-EX side of the kink at the extrapolated e_max: 1 past it, −1 below, 0 none.
-    side: i8,
 }
 
 /// Uniaxial law of one principal direction at equivalent strain `e` [-] with lateral
@@ -75,24 +73,10 @@ fn direction(
     };
     if e >= 0.0 {
         if let Some(ex) = ex {
-            // IMPL-EX (as the fixed cracks, cracking.rs): the secant at the extrapolated
-            // largest strain up to it, then a line of a tenth of that secant; e_max itself
-            // is updated implicitly for the next extrapolation.
-            let ex = ex.max(p.eps0());
-            let s_ex = tension_envelope(p, alpha, ex).0;
-            let k_cap = IMPLEX_CAP_SLOPE * s_ex / ex;
-            let cap = s_ex + k_cap * (e - ex);
-            r.side = if e > ex { 1 } else { -1 };
-            if frozen < 0 || (frozen == 0 && e <= ex) {
-                r.sigma = s_ex / ex * e;
-                r.k = s_ex / ex;
-            } else if frozen > 0 && p.ec * e < cap {
-                r.sigma = p.ec * e;
-                r.k = p.ec;
-            } else {
-                r.sigma = cap;
-                r.k = k_cap;
-            }
+            // IMPL-EX (as the fixed cracks): the secant at the extrapolated largest strain
+            // up to it, then its smooth continuation (`implex::tension`); e_max itself is
+            // updated implicitly for the next extrapolation.
+            (r.sigma, r.k) = super::implex::tension(p, alpha, ex, e);
             r.emax = e.max(emax);
         } else if frozen > 0 || (frozen == 0 && e >= emax) || emax <= 0.0 {
             let (s, k) = tension_envelope(p, alpha, e);
@@ -177,7 +161,6 @@ pub fn update(
         // Formation: the strain reached is e_max with zero rate (as the fixed cracks).
         st.crack_max_old = st.crack_max;
     }
-    st.implex_side = [d[0].side, d[1].side];
     st.crack_strain = et;
     st.dir_ebar = [d[0].xmax, d[1].xmax];
     if d[0].crushed || d[1].crushed {

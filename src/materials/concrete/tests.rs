@@ -763,11 +763,10 @@ fn implex_tension_follows_the_envelope_to_first_order() {
             assert!(d[0][0] > 0.0, "tangent {d:?} at ε = {e:.3e}");
             if c.n_cracks > 0 {
                 // Bounded by the envelope at the largest strain reached before this step,
-                // plus the cap's slope (a fraction of the secant there, which is at most
-                // the secant at that strain) over one increment.
+                // plus its secant there over one increment (the law is concave and follows
+                // a secant no steeper than that one).
                 let s_prev = tension_envelope(&p, alpha, prev.max(e0)).0;
-                let slack = super::cracking::IMPLEX_CAP_SLOPE * s_prev / prev.max(e0) * (e - prev)
-                    + 1e-9 * p.ftm;
+                let slack = s_prev / prev.max(e0) * (e - prev) + 1e-9 * p.ftm;
                 let bound = s_prev + slack;
                 assert!(s[0] <= bound, "σ {:.6e} > {bound:.6e} at ε = {e:.3e}", s[0]);
                 if e > 1.5 * e0 {
@@ -888,5 +887,7 @@ fn crush_band_dissipates_gc_per_unit_band_area() {
     assert!((2.0 * p.fcm / d - s * p.ec / (1.0 - s)).abs() < 1e-6 * p.ec);
 }
 
+/// The IMPL-EX tension law within an increment.
+mod implex;
 /// Compression softening, rotating cracks and aggregate-interlock shear retention.
 mod shear;
