@@ -145,7 +145,7 @@ fn seed_beam_with_concrete_fails_by_tendon_yield_at_the_statics_load() {
 /// the compression block at the joint (a ≈ 24 mm in statics; one element row of the
 /// coarse mesh is 0.1 m, so its resolution moves the lever arm by at most ≈ 1–2 %).
 /// Release only (≈ 22 s in release on 2 idle cores; minutes unoptimised). Refined 4×:
-/// `seed_beam_with_concrete_refined_4x_reaches_tendon_yield` below.
+/// `seed_beam_with_concrete_refined_4x_peaks_at_the_tendon_yield_load` below.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release test: the 2× mesh to failure")]
 fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
@@ -203,7 +203,7 @@ fn seed_beam_with_concrete_refined_reaches_tendon_yield_as_the_coarse_mesh() {
 /// Heavy release test: ≈ 4 min on 2 idle cores (10 min at a load average of 8).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release test: the 4× mesh to failure")]
-fn seed_beam_with_concrete_refined_4x_reaches_tendon_yield() {
+fn seed_beam_with_concrete_refined_4x_peaks_at_the_tendon_yield_load() {
     let coarse = bench::seed_failure_case(1, true).unwrap_or_else(|e| panic!("{e}"));
     let fine = bench::seed_failure_case(4, true).unwrap_or_else(|e| panic!("{e}"));
     eprintln!(
