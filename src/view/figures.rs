@@ -1142,6 +1142,122 @@ impl Figure for JointFigure {
     }
 }
 
+/// One construction stage in the stage-history figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StageBand {
+    /// Step number (1-based).
+    pub step: usize,
+    /// Step name.
+    pub name: String,
+    /// First and last history.csv data row of the stage (1-based).
+    pub rows: (usize, usize),
+    /// Largest joint opening during the stage [mm].
+    pub opening_mm: f64,
+}
+
+/// The stage history of a staged run: per stage, a bar over its history rows as high as
+/// the largest joint opening reached during it, the stage boundaries marked and labelled
+/// with the stage names.
+#[derive(Debug, Clone)]
+pub struct StageFigure {
+    /// Title.
+    pub title: String,
+    /// Stages that produced history rows, in order.
+    pub stages: Vec<StageBand>,
+}
+
+impl StageFigure {
+    /// The figure of `stages` (summary.json `stages`); None when no stage produced a
+    /// history row (nothing to draw).
+    pub fn new(stages: &[crate::results::stages::StageResult]) -> Option<Self> {
+        let bands: Vec<StageBand> = stages
+            .iter()
+            .filter_map(|s| {
+                s.history_rows.map(|rows| StageBand {
+                    step: s.step,
+                    name: s.name.clone(),
+                    rows,
+                    opening_mm: s.max_joint_opening * 1e3,
+                })
+            })
+            .collect();
+        (!bands.is_empty()).then(|| StageFigure {
+            title: "Construction stages: largest joint opening per stage".into(),
+            stages: bands,
+        })
+    }
+}
+
+impl Figure for StageFigure {
+    fn size(&self) -> (u32, u32) {
+        (1000, 560)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        // Each history row is a unit-wide slot centred on its number.
+        let x0 = self.stages.iter().map(|s| s.rows.0).min().unwrap_or(1) as f64 - 0.5;
+        let x1 = self.stages.iter().map(|s| s.rows.1).max().unwrap_or(1) as f64 + 0.5;
+        let top = self
+            .stages
+            .iter()
+            .map(|s| s.opening_mm)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        // Room above the tallest bar for the stage names; 1 mm when no joint opens.
+        let y1 = if top > 0.0 { top * 1.5 } else { 1.0 };
+        let (dx, dy) = (label_step(x1 - x0, X_LABELS), label_step(y1, Y_LABELS));
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, (FONT, 22))
+            .margin(18)
+            .x_label_area_size(55)
+            .y_label_area_size(95)
+            .build_cartesian_2d(x0..x1, 0.0..y1)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("history row")
+            .y_desc("largest joint opening [mm]")
+            .label_style((FONT, 15))
+            .axis_desc_style((FONT, 17))
+            .x_labels(X_LABELS)
+            .y_labels(Y_LABELS)
+            .x_label_formatter(&|v| tick_label(*v, dx))
+            .y_label_formatter(&|v| tick_label(*v, dy))
+            .disable_x_mesh()
+            .light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(205, 205, 205))
+            .draw()
+            .map_err(de)?;
+        let name_style = TextStyle::from((FONT, 12).into_font())
+            .transform(FontTransform::Rotate90)
+            .color(&RGBColor(60, 60, 60));
+        for (i, s) in self.stages.iter().enumerate() {
+            let (a, b) = (s.rows.0 as f64 - 0.5, s.rows.1 as f64 + 0.5);
+            let c = PALETTE[i % PALETTE.len()];
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(a, 0.0), (b, s.opening_mm.max(0.0))],
+                    c.mix(0.45).filled(),
+                )))
+                .map_err(de)?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(a, 0.0), (a, y1)],
+                    RGBColor(150, 150, 150).stroke_width(1),
+                )))
+                .map_err(de)?;
+            let (px, py) = chart.backend_coord(&(0.5 * (a + b), y1));
+            root.draw(&Text::new(
+                format!("{} {}", s.step, s.name),
+                (px + 6, py + 6),
+                name_style.clone(),
+            ))
+            .map_err(de)?;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

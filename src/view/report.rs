@@ -4,7 +4,7 @@
 
 use super::data::{Grid, Table};
 use super::figures::{
-    png_bytes, svg_string, CurveFigure, DeformedFigure, JointProfile, MeshFigure,
+    png_bytes, svg_string, CurveFigure, DeformedFigure, JointProfile, MeshFigure, StageFigure,
 };
 use super::{
     auto_scale, crack_figure, curve_figure, displacements, field_values, fmt_scale, joint_figure,
@@ -370,6 +370,24 @@ fn stages_section(dir: &Path) -> String {
     }
     if !any {
         s.push_str("<p id=\"stage-openings\">No joint opens during construction (the stages before the last).</p>\n");
+    }
+    if let Some(fig) = StageFigure::new(&stages) {
+        match svg_string(&fig) {
+            Ok(svg) => {
+                let _ = writeln!(
+                    s,
+                    "<figure id=\"stage-history\">{svg}<figcaption>{}: a bar per stage over its rows of history.csv, as high as the largest joint opening reached during it (the table above); grey lines mark the stage boundaries.</figcaption></figure>",
+                    esc(&fig.title)
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(
+                    s,
+                    "<p class=\"note\">stage history figure: skipped ({})</p>",
+                    esc(&e.to_string())
+                );
+            }
+        }
     }
     s
 }
