@@ -696,3 +696,96 @@ fn joint_diagrams_reach_the_extreme_contact_stress() {
     assert!(html.contains("<h2>Joints</h2>"), "joints section");
     assert!(html.contains("at the joints' integration points"));
 }
+
+/// The stage-history figure of the staged viaduct example: one bar per stage over the
+/// history rows of stages.csv, as high as its largest joint opening, which equals the
+/// largest value of the run's own `max_opening` monitor (history.csv) over those rows;
+/// every stage is labelled in the report's SVG. A run without stages (box-beam) has no
+/// such figure.
+#[test]
+fn staged_report_has_the_stage_history_figure() {
+    let out = tmp("viaduct");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/viaduct.toml");
+    segfem::run::run_file(&path, &out, &mut |_| {}).expect("viaduct runs");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let stages: Vec<segfem::results::stages::StageResult> =
+        serde_json::from_value(summary["stages"].clone()).unwrap();
+    let fig = view::figures::StageFigure::new(&stages).expect("a staged run has a figure");
+
+    // stages.csv parsed independently: step, name, first_row, last_row, opening [m].
+    let csv = std::fs::read_to_string(out.join("stages.csv")).unwrap();
+    let table: Vec<Vec<String>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    assert_eq!(fig.stages.len(), table.len(), "one bar per stage that ran");
+    let (header, rows) = history(&out);
+    let (step_col, open_col) = (col(&header, "step"), col(&header, "max_opening"));
+    for (band, t) in fig.stages.iter().zip(&table) {
+        assert_eq!(band.step.to_string(), t[0]);
+        assert_eq!(band.name, t[1]);
+        assert_eq!(
+            (band.rows.0.to_string(), band.rows.1.to_string()),
+            (t[4].clone(), t[5].clone())
+        );
+        let csv_mm = t[6].parse::<f64>().unwrap() * 1e3;
+        // Both are the same f64 printed in full and scaled by 1e3: equal to round-off.
+        assert!((band.opening_mm - csv_mm).abs() <= 1e-12 * csv_mm.abs().max(1e-9));
+        // The bar's rows are the stage's rows of history.csv (its step column).
+        let mine = &rows[band.rows.0 - 1..band.rows.1];
+        assert!(mine.iter().all(|r| r[step_col] as usize == band.step));
+        // The monitor takes every joint point, the bar only open points of acting joints:
+        // they differ by the contact round-off (1.4e-14 m in this run), far below 1e-9 m,
+        // while the smallest real opening of the run is 1.5e-6 m.
+        let monitor_mm = mine.iter().map(|r| r[open_col]).fold(0.0, f64::max) * 1e3;
+        assert!(
+            (band.opening_mm - monitor_mm).abs() < 1e-6,
+            "stage {} '{}': bar {} mm, monitor {} mm",
+            band.step,
+            band.name,
+            band.opening_mm,
+            monitor_mm
+        );
+    }
+    assert!(
+        fig.stages.iter().any(|b| b.opening_mm > 1.0),
+        "a joint opens by more than 1 mm in the failure stage"
+    );
+
+    report::report(&report::ReportOptions {
+        dir: out.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let at = html
+        .find("<figure id=\"stage-history\"><svg")
+        .expect("the report has the stage-history figure");
+    let svg = &html[at..at + html[at..].find("</svg>").unwrap()];
+    check_svg(&format!(
+        "{}</svg>",
+        &svg["<figure id=\"stage-history\">".len()..]
+    ));
+    for b in &fig.stages {
+        assert!(
+            svg.contains(&format!("{} {}", b.step, b.name)),
+            "stage {} labelled in the figure",
+            b.step
+        );
+    }
+
+    let plain = tmp("no-stages");
+    report::report(&report::ReportOptions {
+        dir: run_dir().to_path_buf(),
+        out: Some(plain.join("report.html")),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(plain.join("report.html")).unwrap();
+    assert!(
+        !html.contains("stage-history"),
+        "no stages, no stage figure"
+    );
+}
