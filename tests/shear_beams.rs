@@ -1,7 +1,17 @@
 //! Shear-critical beam OA1 of Vecchio & Shim (2004), no stirrups, through the engine
 //! (docs/validation.md, "Shear beams"; data and sources in validation/beams/).
 
-use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam};
+use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam, Beam};
+
+/// The beam `id` of validation/beams/beams.csv.
+fn beam(id: &str) -> Beam {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
+    read_beams(&path)
+        .unwrap()
+        .into_iter()
+        .find(|b| b.id == id)
+        .unwrap_or_else(|| panic!("{id} not in beams.csv"))
+}
 
 /// OA1 fails in diagonal tension at P_u = 332 kN (9.2 mm), the load falling suddenly. On
 /// the coarse mesh (10 rows through the depth; both runs about 18 s of CPU in release):
@@ -16,12 +26,7 @@ use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam};
 ///   the peak, as in the test).
 #[test]
 fn oa1_peaks_bracket_the_test_and_the_failure_is_brittle() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beams = read_beams(&path).unwrap();
-    let oa1 = beams
-        .iter()
-        .find(|b| b.id == "OA1")
-        .expect("OA1 in beams.csv");
+    let oa1 = &beam("OA1");
     let p_u = oa1.test.0;
     let opts = options();
     let key = |name: &str| opts.iter().find(|o| o.0 == name).unwrap().1;
@@ -71,12 +76,7 @@ fn oa1_peaks_bracket_the_test_and_the_failure_is_brittle() {
 /// --case beams`: minutes of CPU.
 #[test]
 fn b1_default_model_reaches_the_measured_peak_by_crushing() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beams = read_beams(&path).unwrap();
-    let b1 = beams
-        .iter()
-        .find(|b| b.id == "B1")
-        .expect("B1 in beams.csv");
+    let b1 = &beam("B1");
     let p_u = b1.test.0;
     let opts = options();
     let keys = opts.iter().find(|o| o.0 == "fixed, seed β").unwrap().1;
@@ -114,12 +114,7 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
 /// band lets a regression (locking back, ratio < 0.8) and an unexplained change fail.
 #[test]
 fn oa1_rankine_cut_off_removes_stress_locking() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beams = read_beams(&path).unwrap();
-    let oa1 = beams
-        .iter()
-        .find(|b| b.id == "OA1")
-        .expect("OA1 in beams.csv");
+    let oa1 = &beam("OA1");
     let opts = options();
     let keys = opts
         .iter()

@@ -510,10 +510,7 @@ pub fn freeze_cracks(base: &PointState, trial: &PointState) -> Option<PointState
                 f.crack_max[1] = 0.0;
             }
             for i in 0..f.n_cracks as usize {
-                // IMPL-EX cracks are held on the side of their kink at ẽ_max.
-                f.frozen[i] = if t.implex_side[i] != 0 {
-                    t.implex_side[i]
-                } else if t.crack_max[i] > f.crack_max[i] {
+                f.frozen[i] = if t.crack_max[i] > f.crack_max[i] {
                     1
                 } else if t.crack_strain[i] > 0.0 {
                     -1

@@ -22,8 +22,9 @@ pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &str = "segfem checkpoint";
 /// Format version; bumped whenever a saved structure changes (the test `layout_has_a_version`
 /// fails until it is). 2: trailing checksum; 3: state saved by element family; 4: creep state
-/// of creeping concrete points; 5: tendon spans keep the shared steel state `SteelState`.
-const VERSION: u32 = 5;
+/// of creeping concrete points; 5: tendon spans keep the shared steel state `SteelState`; 6: concrete points without the
+/// IMPL-EX kink side.
+const VERSION: u32 = 6;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -36,6 +37,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (3, 16_113_229_074_358_229_730),
     (4, 14_334_971_633_857_522_506),
     (5, 10_812_821_786_394_591_690),
+    (6, 17_771_896_231_766_552_362),
 ];
 
 #[derive(Serialize, Deserialize)]

@@ -493,11 +493,6 @@ pub struct ConcreteState {
     /// [`crate::materials::point::plastic_base`]); always false in committed states.
     #[serde(default)]
     pub(crate) hold_plastic: bool,
-    /// IMPL-EX: the side of the kink at the extrapolated largest crack strain each crack's
-    /// last update was on (1 past it, −1 below, 0 closed or not IMPL-EX); read by
-    /// [`crate::materials::point::freeze_cracks`] from trial states.
-    #[serde(default)]
-    pub(crate) implex_side: [i8; 2],
     /// Creep state (chain, total strain, shrinkage) of a creeping concrete point (None
     /// without the creep option or before its first update; see [`creep`]). With creep,
     /// `strain` above is the concrete law's input ε_m, not the total strain.
@@ -530,7 +525,6 @@ impl ConcreteState {
             frozen: [0; 2],
             crack_max_old: [0.0; 2],
             hold_plastic: false,
-            implex_side: [0; 2],
             creep: None,
         }
     }
