@@ -62,7 +62,7 @@ fn crushing_peak(p: &ConcreteParams, rho: f64, es: f64) -> f64 {
         let s = hardening_curve(p, x).0;
         let mut b = 1.0;
         for _ in 0..200 {
-            b = reduction::factor(p, b * s / (rho * es) + b * x).0;
+            b = reduction::factor(p, b * s / (rho * es) + b * x, 1.0).0;
         }
         best = best.max(0.5 * b * s);
     }
@@ -78,7 +78,10 @@ fn crushing_peak(p: &ConcreteParams, rho: f64, es: f64) -> f64 {
 fn over_reinforced_panel_fails_by_strut_crushing_with_compression_softening() {
     let p = panel([0.05, 0.05], 30e6);
     let mut cp = ConcreteParams::from_mc90(30e6, 0.2);
-    cp.compression_reduction = CompressionReduction::VecchioCollins1993 { beta_min: 0.4 };
+    cp.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.0,
+    };
     let want = crushing_peak(&cp, 0.05, 200e9);
     let keys = "crack_model = \"rotating\"\ntension_softening = \"crack_band\"\n";
     let soft = format!("{keys}compression_reduction = \"vecchio_collins_1993\"\n");

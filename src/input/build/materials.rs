@@ -71,6 +71,7 @@ pub struct MaterialIn {
     pub crack_model: Option<String>,
     pub compression_reduction: Option<String>,
     pub compression_reduction_min: Option<f64>,
+    pub compression_reduction_spacing: Option<f64>,
     pub shear_retention: Option<String>,
     pub aggregate_size: Option<f64>,
     pub crack_shear_limit: Option<String>,
@@ -181,6 +182,7 @@ impl MaterialKind {
                 "crack_model",
                 "compression_reduction",
                 "compression_reduction_min",
+                "compression_reduction_spacing",
                 "shear_retention",
                 "aggregate_size",
                 "crack_shear_limit",
@@ -449,11 +451,22 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
     };
     p.compression_reduction = match m.compression_reduction.as_deref() {
         None | Some("none") => {
-            if m.compression_reduction_min.is_some() {
-                return Err(ctx.err(
-                    k("compression_reduction_min"),
-                    "used by compression_reduction = \"vecchio_collins_1993\" only",
-                ));
+            for (key, set) in [
+                (
+                    "compression_reduction_min",
+                    m.compression_reduction_min.is_some(),
+                ),
+                (
+                    "compression_reduction_spacing",
+                    m.compression_reduction_spacing.is_some(),
+                ),
+            ] {
+                if set {
+                    return Err(ctx.err(
+                        k(key),
+                        "used by compression_reduction = \"vecchio_collins_1993\" only",
+                    ));
+                }
             }
             CompressionReduction::None
         }
@@ -465,6 +478,10 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
                 1e-3,
                 1.0,
             )?,
+            spacing: match m.compression_reduction_spacing {
+                Some(s) => positive(ctx, &k("compression_reduction_spacing"), s)?,
+                None => 0.0,
+            },
         },
         Some(o) => {
             return Err(ctx.err(

@@ -307,8 +307,8 @@ pub fn update_cracked(
     // Compression softening of each direction by the other one's tensile strain.
     let lateral = |j: usize| (el[j] + committed.dir_plastic[j]).max(0.0);
     let red = [
-        super::reduction::factor(p, lateral(1)),
-        super::reduction::factor(p, lateral(0)),
+        super::reduction::factor(p, lateral(1), char_length),
+        super::reduction::factor(p, lateral(0), char_length),
     ];
     let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
         let cracked = (i as u8) < n_cracks;

@@ -134,6 +134,9 @@ pub enum CompressionReduction {
     VecchioCollins1993 {
         /// Lower bound of β_d [-] (default 0.4).
         beta_min: f64,
+        /// Mean crack spacing s_rm [m] over which a crack's opening is smeared for β_d
+        /// (ε_lat = ε0 + (ε − ε0) h/s_rm where s_rm > h); 0: the crack band h (the seed).
+        spacing: f64,
     },
 }
 
@@ -327,9 +330,14 @@ impl ConcreteParams {
     /// Check the options of compression softening, shear retention and crack model.
     fn validate_shear_laws(&self) -> Result<(), MaterialError> {
         let bad = |m: &str| Err(MaterialError::InvalidParams(m.to_string()));
-        if let CompressionReduction::VecchioCollins1993 { beta_min } = self.compression_reduction {
+        if let CompressionReduction::VecchioCollins1993 { beta_min, spacing } =
+            self.compression_reduction
+        {
             if !(beta_min > 0.0 && beta_min <= 1.0) {
                 return bad("the compression reduction floor must lie in (0, 1]");
+            }
+            if !(spacing >= 0.0 && spacing.is_finite()) {
+                return bad("the compression reduction crack spacing must be >= 0");
             }
         }
         if self.creep.is_some() && self.viscoplastic.is_some() {

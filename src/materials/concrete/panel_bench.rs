@@ -483,7 +483,10 @@ pub fn shear_model_rates(rate: impl Fn(&dyn Fn(f64) -> f64) -> f64) -> Vec<(Stri
     use std::hint::black_box;
     let fixed = ConcreteParams::from_mc90(38e6, 0.2);
     let mut fixed_vc = fixed.clone();
-    fixed_vc.compression_reduction = CompressionReduction::VecchioCollins1993 { beta_min: 0.4 };
+    fixed_vc.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.0,
+    };
     let mut rot = fixed.clone();
     rot.crack_model = CrackModel::Rotating;
     let mut rot_vc = fixed_vc.clone();

@@ -14,12 +14,19 @@ use super::compression::{self, Hardening};
 use super::{CompressionReduction, ConcreteParams};
 
 /// Reduction factor β_d [-] and dβ_d/dε_lat [-] for the lateral tensile strain `lateral`
-/// [-] (β_d = 1 for no reduction or ε_lat ≤ 0.37 ε_c1).
-pub fn factor(p: &ConcreteParams, lateral: f64) -> (f64, f64) {
-    let CompressionReduction::VecchioCollins1993 { beta_min } = p.compression_reduction else {
+/// [-] of a point in an element of crack band width `char_length` [m] (β_d = 1 for no
+/// reduction or an effective lateral strain ≤ 0.37 ε_c1).
+///
+/// With a crack spacing s_rm > h (`spacing`) the crack opening w = (ε − ε0) h of the band
+/// is smeared over s_rm, as the MCFT's average strain is: ε_lat = ε0 + (ε − ε0) h/s_rm
+/// for ε > ε0 ([`lateral_strain`]).
+pub fn factor(p: &ConcreteParams, lateral: f64, char_length: f64) -> (f64, f64) {
+    let CompressionReduction::VecchioCollins1993 { beta_min, spacing } = p.compression_reduction
+    else {
         return (1.0, 0.0);
     };
-    let cd = 0.27 * (lateral / p.eps_c1 - 0.37);
+    let (lat, dlat) = lateral_strain(p.eps0(), lateral, char_length, spacing);
+    let cd = 0.27 * (lat / p.eps_c1 - 0.37);
     if cd <= 0.0 {
         return (1.0, 0.0);
     }
@@ -27,7 +34,21 @@ pub fn factor(p: &ConcreteParams, lateral: f64) -> (f64, f64) {
     if b <= beta_min {
         (beta_min, 0.0)
     } else {
-        (b, -b * b * 0.27 / p.eps_c1)
+        (b, -b * b * 0.27 / p.eps_c1 * dlat)
+    }
+}
+
+/// The lateral strain that drives the compression softening [-] and its derivative in the
+/// point's lateral strain `lateral` [-]: the point's strain itself in the crack band
+/// (`spacing` ≤ `h`, or 0), else its elastic part up to ε0 = f_tm/E `eps0` [-] plus the
+/// crack opening of the band, (ε − ε0) h, over the mean crack spacing s_rm = `spacing`
+/// [m] (docs/theory-concrete.md §5.3).
+pub fn lateral_strain(eps0: f64, lateral: f64, h: f64, spacing: f64) -> (f64, f64) {
+    if spacing > h && h > 0.0 && lateral > eps0 {
+        let r = h / spacing;
+        (eps0 + (lateral - eps0) * r, r)
+    } else {
+        (lateral, 1.0)
     }
 }
 

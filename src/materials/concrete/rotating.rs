@@ -58,10 +58,11 @@ struct Dir {
 /// Uniaxial law of one principal direction at equivalent strain `e` [-] with lateral
 /// strain `lat` [-] (the other direction's), histories `emax`, `xmax` and held branch
 /// `frozen` (1 envelope, −1 secant, 0 free; see [`super::ConcreteState`]), the biaxial
-/// gain `gain` [-] and, with IMPL-EX, the extrapolated largest tensile strain `ex` [-].
+/// gain `gain` [-] and, with IMPL-EX, the extrapolated largest tensile strain `ex` [-];
+/// `h` [m] is the crack band width (for the crack spacing of the compression softening).
 fn direction(
     p: &ConcreteParams,
-    alpha: f64,
+    (alpha, h): (f64, f64),
     (emax, xmax, frozen): (f64, f64, i8),
     e: f64,
     (lat, gain, ex): (f64, f64, Option<f64>),
@@ -93,7 +94,7 @@ fn direction(
     // Compression softening by a tensile lateral strain, or the biaxial gain K ≥ 1 when
     // both directions are compressed (never both: K > 1 needs a compressed lateral).
     let (beta, dbeta) = if lat > 0.0 {
-        reduction::factor(p, lat)
+        reduction::factor(p, lat, h)
     } else {
         (gain, 0.0)
     };
@@ -140,7 +141,7 @@ pub fn update(
     let alpha = p.softening_alpha(char_length);
     let (e1, e2, theta) = principal_strains(strain);
     let mut cracked = committed.n_cracks > 0;
-    let mut out = evaluate(p, committed, alpha, [e1, e2], cracked, ratio);
+    let mut out = evaluate(p, committed, (alpha, char_length), [e1, e2], cracked, ratio);
     // IMPL-EX decides cracking on the committed state (explicitly): in the increment the
     // point cracks its law stays the uncracked one, capped past f_tm.
     if p.implex && !cracked && out.0[0].max(out.0[1]) >= p.eps0() {
@@ -149,7 +150,7 @@ pub fn update(
         // The point cracks: the Poisson coupling goes (as in the fixed model) and the laws
         // are re-evaluated at the same strain.
         cracked = true;
-        out = evaluate(p, committed, alpha, [e1, e2], cracked, ratio);
+        out = evaluate(p, committed, (alpha, char_length), [e1, e2], cracked, ratio);
     }
     let (et, d, dp) = out;
     let mut st = committed.clone();
@@ -197,7 +198,7 @@ pub fn update(
 fn evaluate(
     p: &ConcreteParams,
     c: &ConcreteState,
-    alpha: f64,
+    alpha: (f64, f64),
     e: [f64; 2],
     cracked: bool,
     ratio: f64,

@@ -5,7 +5,10 @@ use super::*;
 use crate::materials::concrete::rotating::principal_strains;
 
 fn vc93(p: &mut ConcreteParams) {
-    p.compression_reduction = CompressionReduction::VecchioCollins1993 { beta_min: 0.4 };
+    p.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.0,
+    };
 }
 
 fn rotating() -> ConcreteParams {
@@ -21,21 +24,26 @@ fn rotating() -> ConcreteParams {
 #[test]
 fn vecchio_collins_factor_closed_form() {
     let mut p = params();
-    assert_eq!(reduction::factor(&p, 5e-3), (1.0, 0.0), "off by default");
+    assert_eq!(
+        reduction::factor(&p, 5e-3, 0.1),
+        (1.0, 0.0),
+        "off by default"
+    );
     vc93(&mut p);
-    assert_eq!(reduction::factor(&p, 0.37 * 0.0022 * 0.999).0, 1.0);
+    assert_eq!(reduction::factor(&p, 0.37 * 0.0022 * 0.999, 0.1).0, 1.0);
     for (e, want) in [(2.2e-3, 1.0 / 1.1701), (1.1e-2, 1.0 / 2.2501), (2e-2, 0.4)] {
-        let (b, db) = reduction::factor(&p, e);
+        let (b, db) = reduction::factor(&p, e, 0.1);
         assert!((b - want).abs() < 1e-12, "β({e}) = {b}, want {want}");
         let h = 1e-9;
-        let fd = (reduction::factor(&p, e + h).0 - reduction::factor(&p, e - h).0) / (2.0 * h);
+        let fd =
+            (reduction::factor(&p, e + h, 0.1).0 - reduction::factor(&p, e - h, 0.1).0) / (2.0 * h);
         assert!((fd - db).abs() < 1e-6 * db.abs().max(1.0), "{fd} vs {db}");
     }
 }
 
 /// Closed form of the softened uniaxial law: σ = −β σ_c(−ε/β) with β = β_d(ε_lat).
 fn softened(p: &ConcreteParams, e: f64, lat: f64) -> f64 {
-    let (b, _) = reduction::factor(p, lat);
+    let (b, _) = reduction::factor(p, lat, 0.1);
     -b * compression::hardening_curve(p, -e / b).0
 }
 
@@ -521,4 +529,125 @@ fn principal_stress_limit_tangent_matches_finite_differences() {
         }
     }
     assert!(checked >= 3, "{checked} states checked");
+}
+
+/// Compression softening driven by the crack opening smeared over the crack spacing
+/// (`spacing` s_rm, docs/theory-concrete.md §5.3): closed forms, round-off tolerance.
+///
+/// * ε_lat = ε0 + (ε − ε0) h/s_rm for s_rm > h and ε > ε0, the point's own strain
+///   otherwise (s_rm ≤ h, ε ≤ ε0, or no spacing), derivative h/s_rm;
+/// * β_d at h = 0.05 m, s_rm = 0.2 m and ε = ε0 + 4 (2.2e-3 − ε0) is the band law's
+///   β_d(2.2e-3) = 1/1.1701, its derivative a quarter of the band law's there;
+/// * the same crack opening w in bands of h = 0.05 and 0.025 m (ε = ε0 + w/h) gives the
+///   same β_d with s_rm = 0.2 m (what makes the softening mesh objective) and different
+///   ones without it (the crack band law localizes the lateral strain).
+#[test]
+fn compression_softening_over_the_crack_spacing_closed_form() {
+    let mut p = params();
+    let e0 = p.eps0();
+    assert_eq!(reduction::lateral_strain(e0, 3e-3, 0.05, 0.0), (3e-3, 1.0));
+    assert_eq!(reduction::lateral_strain(e0, 3e-3, 0.05, 0.04), (3e-3, 1.0));
+    assert_eq!(
+        reduction::lateral_strain(e0, 0.5 * e0, 0.05, 0.2),
+        (0.5 * e0, 1.0)
+    );
+    let (l, d) = reduction::lateral_strain(e0, 3e-3, 0.05, 0.2);
+    assert!((l - (e0 + (3e-3 - e0) * 0.25)).abs() < 1e-18 && d == 0.25);
+    p.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.2,
+    };
+    let e = e0 + 4.0 * (2.2e-3 - e0);
+    let (b, db) = reduction::factor(&p, e, 0.05);
+    assert!((b - 1.0 / 1.1701).abs() < 1e-12, "β = {b}");
+    let band = {
+        let mut q = p.clone();
+        vc93(&mut q);
+        reduction::factor(&q, 2.2e-3, 0.05)
+    };
+    assert!(
+        (db - 0.25 * band.1).abs() < 1e-12 * band.1.abs(),
+        "{db} vs {band:?}"
+    );
+    let fd =
+        (reduction::factor(&p, e + 1e-9, 0.05).0 - reduction::factor(&p, e - 1e-9, 0.05).0) / 2e-9;
+    assert!((fd - db).abs() < 1e-6 * db.abs(), "{fd} vs {db}");
+    let w = 1e-4;
+    let beta = |q: &ConcreteParams, h: f64| reduction::factor(q, e0 + w / h, h).0;
+    assert!((beta(&p, 0.05) - beta(&p, 0.025)).abs() < 1e-12);
+    let mut q = p.clone();
+    vc93(&mut q);
+    assert!(beta(&q, 0.025) < beta(&q, 0.05) - 0.1, "band law localizes");
+}
+
+/// Rotating cracks with the softening over the crack spacing: a point cracked in x to a
+/// crack opening w = 0.4 mm in a band h (ε_x = ε0 + w/h held) and compressed in y follows
+/// σ_y = −β σ_c(−ε_y/β) with β = β_d(ε0 + w/s_rm), s_rm = 0.2 m, on both h = 0.1 m and
+/// h = 0.05 m (closed form, 1e-9 f_cm): the strut's response no longer depends on the band.
+#[test]
+fn rotating_softening_over_the_crack_spacing_does_not_depend_on_the_band() {
+    let mut p = rotating();
+    p.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.2,
+    };
+    let e0 = p.eps0();
+    let w = 4e-4;
+    let beta = reduction::factor(&p, e0 + w / 0.2, 0.2).0;
+    assert!(beta < 0.95, "β = {beta}: the case must soften");
+    for h in [0.1, 0.05] {
+        let ex = e0 + w / h;
+        let mut st = update(&p, &ConcreteState::new(), &[ex, 0.0, 0.0], h)
+            .unwrap()
+            .0;
+        for k in 1..=40 {
+            let ey = -2.5e-3 * k as f64 / 40.0;
+            let (s, sig, _) = update(&p, &st, &[ex, ey, 0.0], h).unwrap();
+            let want = -beta * compression::hardening_curve(&p, -ey / beta).0;
+            assert!(
+                (sig[1] - want).abs() < 1e-9 * FCM,
+                "h {h}, ε_y {ey}: {sig:?} vs {want}"
+            );
+            st = s;
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e6f_e026),
+        .. ProptestConfig::default()
+    })]
+
+    /// Rotating and fixed cracks with the softening over a crack spacing larger than the
+    /// band (s_rm = 0.3 m, h = 0.1 m in `fd_error`): tangents against central differences,
+    /// the settings and tolerance (1e-5 E) of `rotating_tangent_fd` and
+    /// `fixed_compression_softening_tangent_fd`.
+    #[test]
+    fn softening_over_the_crack_spacing_tangent_fd(
+        phi in -1.5..1.5f64,
+        e1 in 1e-3..6e-3f64,
+        f in 0.5..1.5f64,
+        e2 in -3e-3..-1e-4f64,
+        g in -1e-3..1e-3f64,
+        fixed in proptest::bool::ANY,
+    ) {
+        let mut p = if fixed { fd_params() } else { rot_fd_params() };
+        p.residual_stiffness = 0.0;
+        p.compression_reduction = CompressionReduction::VecchioCollins1993 {
+            beta_min: 0.4,
+            spacing: 0.3,
+        };
+        let (s, c) = phi.sin_cos();
+        let glob = |a: f64, b: f64| [c * c * a + s * s * b, s * s * a + c * c * b, 2.0 * s * c * (a - b)];
+        let base = upd(&p, &ConcreteState::new(), glob(e1, 0.0)).0;
+        prop_assume!(!base.is_crushed() && base.n_cracks() >= 1);
+        let e = glob(e1 * f, e2);
+        let e = [e[0], e[1], e[2] + g];
+        if let Some(err) = fd_error(&p, &base, e) {
+            prop_assert!(err < 1e-5 * p.ec, "err {err} at {e:?}");
+        }
+    }
 }
