@@ -137,3 +137,18 @@ fn oa1_rankine_cut_off_removes_stress_locking() {
     let ratio = oa1.test.0 / r.p_peak;
     assert!((0.8..1.2).contains(&ratio), "test/predicted {ratio:.3}");
 }
+
+/// The mean inclined crack spacing of the beams by the CEB-FIP MC90 formula
+/// (`beam_bench::crack_spacing`) against a hand calculation from the data of beams.csv:
+/// OA1 (d = 461.3 mm, x = 160.9 mm, h_ef = (h − x)/3 = 130.4 mm, ρ_ef = 6.04 %,
+/// φ = 27.7 mm, s_x = 85.1 mm, no stirrups) s_45 = √2 s_x = 120.3 mm; B1 (x = 179.8 mm,
+/// ρ_ef = 8.45 %, s_x = 60.8 mm; D5 stirrups, φ = 6.40 mm, ρ_w = 0.148 %, s_y = 801 mm)
+/// s_45 = 79.9 mm. Tolerance 0.1 mm (the hand values' rounding).
+#[test]
+fn crack_spacing_of_the_beams_follows_mc90() {
+    use segfem::materials::concrete::beam_bench::crack_spacing;
+    for (id, want) in [("OA1", 0.1203), ("B1", 0.0796)] {
+        let s = crack_spacing(&beam(id));
+        assert!((s - want).abs() < 1e-4, "{id}: s_rm = {s} m, hand {want} m");
+    }
+}

@@ -152,7 +152,20 @@ pub fn update(
         cracked = true;
         out = evaluate(p, committed, (alpha, char_length), [e1, e2], cracked, ratio);
     }
-    let (et, d, dp) = out;
+    let (et, d, mut dp) = out;
+    if p.secant_crack_tangent && cracked {
+        // Secant tangent (symmetric, non-negative): σ_i/ε̃_i per direction, no cross terms,
+        // floored at the residual stiffness; the coaxial shear term below is a secant too.
+        for i in 0..2 {
+            let sec = if et[i].abs() > 1e-14 {
+                d[i].sigma / et[i]
+            } else {
+                d[i].k
+            };
+            dp[i] = [0.0, 0.0];
+            dp[i][i] = sec.max(p.residual_stiffness * p.ec);
+        }
+    }
     let mut st = committed.clone();
     st.strain = *strain;
     st.crack_angle = theta;

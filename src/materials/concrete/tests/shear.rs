@@ -651,3 +651,26 @@ proptest! {
         }
     }
 }
+
+/// Rotating cracks with `secant_crack_tangent`: after cracking the tangent in the principal
+/// axes is diag(σ1/ε1, σ2/ε2, (σ1 − σ2)/(2(ε1 − ε2))) (closed form, round-off), symmetric and
+/// positive; here at a point cracked along x (ε_x = 1e-3, on the softening branch) and
+/// compressed along y (ε_y = −1e-3).
+#[test]
+fn rotating_secant_tangent_is_the_secant() {
+    let mut p = rotating();
+    p.secant_crack_tangent = true;
+    let st = upd(&p, &ConcreteState::new(), [1e-3, 0.0, 0.0]).0;
+    assert!(st.n_cracks() >= 1);
+    let (_, s, d) = upd(&p, &st, [1e-3, -1e-3, 0.0]);
+    assert!(s[0] > 0.0 && s[1] < 0.0);
+    let want = [s[0] / 1e-3, s[1] / -1e-3, (s[0] - s[1]) / 4e-3];
+    for i in 0..3 {
+        assert!((d[i][i] - want[i]).abs() < 1e-9 * p.ec, "{d:?} vs {want:?}");
+        for j in 0..3 {
+            if i != j {
+                assert!(d[i][j].abs() < 1e-9 * p.ec, "{d:?}");
+            }
+        }
+    }
+}
