@@ -681,14 +681,19 @@ pub fn update_full(
     // with dilatancy does exactly that).
     let trial_cd = p.compression_dominated(&s_tr);
     // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
-    let ebar0 = compression::initial_yield(p).0;
+    let law = compression::HardeningLaw::new(p);
+    let ebar0 = law.initial_yield_strain();
     let ebar_n = committed.ebar.max(ebar0);
-    // σ̂_e alone (the value of `compression::sigma_hat`, without its gradient).
-    let yields = ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
-        > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
-    if trial_cd || yields || committed.hold_plastic {
-        let res = compression::update_rate(
+    // σ̂_e alone (the value of `compression::sigma_hat`, without its gradient), evaluated
+    // only when the route is not already plastic.
+    let yields = || {
+        ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
+            > law.at(ebar_n).sigma_c * (1.0 + 1e-13)
+    };
+    if trial_cd || committed.hold_plastic || yields() {
+        let res = compression::update_rate_with_law(
             p,
+            &law,
             dt,
             &committed.strain,
             &committed.plastic_strain,
@@ -713,10 +718,11 @@ pub fn update_full(
             st.strain = *strain;
             st.plastic_strain = u.plastic_strain;
             st.ebar = u.ebar;
-            st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
+            let h = law.at(u.ebar);
+            st.kappa = h.kappa.max(0.0);
             // σ_c = 0 means crushed only past the peak: with zero initial yield the curve
             // also starts at σ_c = 0, where a round-off strain must not crush the point.
-            let spent = u.ebar > p.eps_c1 && compression::hardening(p, u.ebar).sigma_c <= 0.0;
+            let spent = u.ebar > p.eps_c1 && h.sigma_c <= 0.0;
             if u.ebar >= p.eps_cu || spent {
                 st.crushed = true;
                 return Ok(crushed(p, &st, strain));
