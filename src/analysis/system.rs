@@ -73,6 +73,8 @@ pub struct System<'m> {
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
     elem_buf: (Vec<f64>, Vec<f64>),
+    /// The tangent blocks each continuum element forms (those the scatter adds).
+    blocks: Vec<crate::elements::continuum::NodeBlocks>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -343,6 +345,13 @@ impl<'m> System<'m> {
                 time: vec![None; n_bp],
             },
         };
+        let blocks = (0..model.elements.len())
+            .map(|e| {
+                let number = numbers.number(Family::Continuum, e);
+                let n = model.elements[e].nodes.len();
+                crate::elements::continuum::NodeBlocks(asm.node_blocks(number, n))
+            })
+            .collect();
         Self {
             model,
             dofs,
@@ -364,6 +373,7 @@ impl<'m> System<'m> {
             thermal,
             stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
+            blocks,
         }
     }
 
@@ -477,6 +487,7 @@ impl<'m> System<'m> {
                 tangent,
                 (start, end),
                 stages,
+                &self.blocks,
             );
             let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
                 if stages.is_some_and(|s| !s.element_acts(p.0)) {

@@ -14,7 +14,7 @@
 //! - f = ∫ B_Lᵀ S t dA₀; K = ∫ B_Lᵀ D B_L t dA₀ + ∫ (∇N_aᵀ Ŝ ∇N_b) I₂ t dA₀ (the
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
-use super::continuum::{GaussOutput, Integration};
+use super::continuum::{GaussOutput, Integration, NodeBlocks};
 use crate::fem::shape::{QuadKind, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
@@ -57,11 +57,48 @@ pub fn response_tl(
     committed: &[PointState],
     u: &[f64],
     f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+) -> Result<(), UpdateError> {
+    response_tl_blocks(
+        kind,
+        integration,
+        coords,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        time,
+        imposed,
+        NodeBlocks::ALL,
+    )
+}
+
+/// As [`response_tl`], forming only the node blocks `blocks` of the tangent (the others
+/// are zero; see [`NodeBlocks`]).
+#[allow(clippy::too_many_arguments)]
+pub fn response_tl_blocks(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
     mut k: Option<&mut [f64]>,
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
     imposed: &[f64],
+    blocks: NodeBlocks,
 ) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
@@ -71,6 +108,8 @@ pub fn response_tl(
     }
     // Characteristic length of the undeformed element (strains are referred to it).
     let (n_pts, geo, h_len) = super::continuum::gauss_geometry(kind, integration, coords);
+    // The 4 × 4 matrices C of the points (see below), for the stiffness after all updates.
+    let mut cs = [[[0.0; 4]; 4]; 9];
     for g in 0..n_pts {
         let (dn, wdet) = geo[g];
         let h = displacement_gradient(&dn, u, n);
@@ -96,9 +135,9 @@ pub fn response_tl(
                 f[2 * a + i] += w * (b[0][i] * s[0] + b[1][i] * s[1] + b[2][i] * s[2]);
             }
         }
-        let Some(k) = k.as_deref_mut() else {
+        if k.is_none() {
             continue;
-        };
+        }
         // With δE = S(F) δh, δh = (δH₁₁, δH₁₂, δH₂₁, δH₂₂) and δH_ik = N_a,k δu_a,i, both
         // terms of K are ∇N_aᵀ C_ij ∇N_b with the 4 × 4 C = w (Sᵀ D S + I₂ ⊗ Ŝ): about half
         // the operations of B_Lᵀ D B_L node pair by node pair. Column 2i + k of S is
@@ -115,7 +154,7 @@ pub fn response_tl(
             }
         }
         let shat = [[s[0], s[2]], [s[2], s[1]]];
-        let mut c = [[0.0; 4]; 4];
+        let c = &mut cs[g];
         for p in 0..4 {
             for q in 0..4 {
                 let mut v = sm[p][0] * ds[q][0] + sm[p][1] * ds[q][1] + sm[p][2] * ds[q][2];
@@ -125,6 +164,12 @@ pub fn response_tl(
                 c[p][q] = w * v;
             }
         }
+    }
+    let Some(k) = k else {
+        return Ok(());
+    };
+    for g in 0..n_pts {
+        let (dn, c) = (&geo[g].0, &cs[g]);
         let (mut dx, mut dy) = ([0.0; MAX_NODES], [0.0; MAX_NODES]);
         for a in 0..n {
             dx[a] = dn[a][0];
@@ -138,6 +183,9 @@ pub fn response_tl(
                 let (t00, t01, t10, t11) = (t(0), t(1), t(2), t(3));
                 let kr = &mut k[(2 * a + i) * nd..(2 * a + i + 1) * nd];
                 for bn in 0..n {
+                    if !blocks.has(a, bn) {
+                        continue;
+                    }
                     kr[2 * bn] += t00 * dx[bn] + t01 * dy[bn];
                     kr[2 * bn + 1] += t10 * dx[bn] + t11 * dy[bn];
                 }

@@ -191,6 +191,25 @@ impl Assembler {
         }
     }
 
+    /// The node blocks of element `e` (of `n` nodes, 2 dofs each) that `add_matrix` reads:
+    /// bit 9a + b is set when any entry of block (a, b) goes into the lower triangle
+    /// (see [`crate::elements::continuum::NodeBlocks`]).
+    pub fn node_blocks(&self, e: usize, n: usize) -> u128 {
+        let s = &self.scatter[self.scatter_ptr[e]..self.scatter_ptr[e + 1]];
+        let nd = 2 * n;
+        assert_eq!(s.len(), nd * nd, "element {e}: not of {n} nodes");
+        let mut mask = 0u128;
+        for a in 0..n {
+            for b in 0..n {
+                let used = (0..2).any(|i| (0..2).any(|j| s[(2 * a + i) * nd + 2 * b + j] != SKIP));
+                if used {
+                    mask |= 1u128 << (9 * a + b);
+                }
+            }
+        }
+        mask
+    }
+
     /// Add the dense row-major element matrix `k` of element `e` into `values`.
     #[inline]
     pub fn add_matrix(&self, e: usize, k: &[f64], values: &mut [f64]) {
