@@ -389,33 +389,41 @@ pub fn response_blocks(
     let Some(k) = k else {
         return Ok(());
     };
-    for g in 0..n_pts {
-        let (dn, w, d) = (&geo[g].0, weights[g], &tangents[g]);
-        for a in 0..n {
+    // Rows of B_aᵀ D (2×3) of every point and node; then K_ab = Σ_g w B_aᵀ D B_b block
+    // by block, summed over the points in their order in registers (the operations of
+    // adding point by point into K).
+    for a in 0..n {
+        let mut rs = [[0.0; 6]; 9];
+        for g in 0..n_pts {
+            let (dn, d) = (&geo[g].0, &tangents[g]);
             let (ax, ay) = (dn[a][0], dn[a][1]);
-            // Rows of B_aᵀ D (2×3).
-            let r0 = [
+            rs[g] = [
                 ax * d[0][0] + ay * d[2][0],
                 ax * d[0][1] + ay * d[2][1],
                 ax * d[0][2] + ay * d[2][2],
-            ];
-            let r1 = [
                 ay * d[1][0] + ax * d[2][0],
                 ay * d[1][1] + ax * d[2][1],
                 ay * d[1][2] + ax * d[2][2],
             ];
-            for b in 0..n {
-                if !blocks.has(a, b) {
-                    continue;
-                }
-                let (bx, by) = (dn[b][0], dn[b][1]);
-                let row0 = 2 * a * nd;
-                let row1 = (2 * a + 1) * nd;
-                k[row0 + 2 * b] += w * (r0[0] * bx + r0[2] * by);
-                k[row0 + 2 * b + 1] += w * (r0[1] * by + r0[2] * bx);
-                k[row1 + 2 * b] += w * (r1[0] * bx + r1[2] * by);
-                k[row1 + 2 * b + 1] += w * (r1[1] * by + r1[2] * bx);
+        }
+        for b in 0..n {
+            if !blocks.has(a, b) {
+                continue;
             }
+            let mut acc = [0.0; 4];
+            for g in 0..n_pts {
+                let (r, w) = (&rs[g], weights[g]);
+                let (bx, by) = (geo[g].0[b][0], geo[g].0[b][1]);
+                acc[0] += w * (r[0] * bx + r[2] * by);
+                acc[1] += w * (r[1] * by + r[2] * bx);
+                acc[2] += w * (r[3] * bx + r[5] * by);
+                acc[3] += w * (r[4] * by + r[5] * bx);
+            }
+            let (row0, row1) = (2 * a * nd, (2 * a + 1) * nd);
+            k[row0 + 2 * b] = acc[0];
+            k[row0 + 2 * b + 1] = acc[1];
+            k[row1 + 2 * b] = acc[2];
+            k[row1 + 2 * b + 1] = acc[3];
         }
     }
     Ok(())

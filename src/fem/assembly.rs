@@ -245,5 +245,9 @@ mod tests {
         asm.add_matrix(0, &k, &mut vals);
         // Element 0 touches only node 1's two eqs: entries (0,0), (1,0), (1,1).
         assert_eq!(vals.iter().sum::<f64>(), 3.0);
+        // Its node blocks read by the scatter: (1, 1) alone (node 0 is fixed).
+        assert_eq!(asm.node_blocks(0, 2), 1 << (9 + 1));
+        // Element 1: nodes 1, 2 numbered in order, so the lower blocks (0,0), (1,0), (1,1).
+        assert_eq!(asm.node_blocks(1, 2), 1 | 1 << 9 | 1 << 10);
     }
 }

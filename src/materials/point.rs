@@ -355,6 +355,21 @@ pub fn update_into(
     trial: &mut PointState,
 ) -> Result<([f64; 3], [[f64; 3]; 3]), UpdateError> {
     if let (Material::Concrete { params, .. }, PointState::Concrete(c)) = (mat, committed) {
+        // Without creep the new state is written into the slot's box in place.
+        if let (None, PointState::Concrete(slot)) = (&params.creep, &mut *trial) {
+            let (sig, mut d) = concrete::update_full_into(
+                params,
+                c,
+                strain,
+                char_length,
+                time.dt(),
+                time.extrapolation,
+                slot,
+            )
+            .map_err(UpdateError::from)?;
+            symmetrise3(&mut d);
+            return Ok((sig, d));
+        }
         let (st, sig, d) = concrete_update(params, c, strain, char_length, time)?;
         match trial {
             PointState::Concrete(slot) => **slot = st,
@@ -401,9 +416,14 @@ fn concrete_update(
         ),
     };
     let (st, sig, mut d) = res.map_err(UpdateError::from)?;
-    // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
-    // the symmetric solvers take its symmetric part (same converged answer, possibly
-    // more iterations).
+    symmetrise3(&mut d);
+    Ok((st, sig, d))
+}
+
+/// The symmetric part of a concrete tangent: the cracked tangent is unsymmetric (shear
+/// retention falls as the crack opens); the symmetric solvers take its symmetric part
+/// (same converged answer, possibly more iterations).
+fn symmetrise3(d: &mut [[f64; 3]; 3]) {
     for i in 0..3 {
         for j in 0..i {
             let m = 0.5 * (d[i][j] + d[j][i]);
@@ -411,7 +431,6 @@ fn concrete_update(
             d[j][i] = m;
         }
     }
-    Ok((st, sig, d))
 }
 
 /// The state an update should start from for the rest of an increment once a crack has
