@@ -357,6 +357,9 @@ pub fn response_blocks(
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
     let (n_pts, geo, h) = gauss_geometry(kind, integration, coords);
+    // Size-dependent material constants once per element (same values as per point).
+    let local = crate::materials::point::for_element(mat, h)?;
+    let mat = local.as_ref().unwrap_or(mat);
     // Tangents and weights of the points, for the stiffness after all updates.
     let mut tangents = [[[0.0; 3]; 3]; 9];
     let mut weights = [0.0; 9];

@@ -108,6 +108,9 @@ pub fn response_tl_blocks(
     }
     // Characteristic length of the undeformed element (strains are referred to it).
     let (n_pts, geo, h_len) = super::continuum::gauss_geometry(kind, integration, coords);
+    // Size-dependent material constants once per element (same values as per point).
+    let local = crate::materials::point::for_element(mat, h_len)?;
+    let mat = local.as_ref().unwrap_or(mat);
     // The 4 × 4 matrices C of the points (see below), for the stiffness after all updates.
     let mut cs = [[[0.0; 4]; 4]; 9];
     for g in 0..n_pts {

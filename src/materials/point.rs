@@ -224,6 +224,26 @@ impl TimeContext {
     }
 }
 
+/// The material of an element of characteristic length `h` [m] with what depends on the
+/// element size resolved once for all its points: a concrete with crush-band compression
+/// softening gets its ultimate strain ([`concrete::ConcreteParams::for_element`], which the
+/// point update otherwise does at every point, copying the parameters). None when nothing
+/// depends on the element (the material is used as it is).
+pub fn for_element(mat: &Material, h: f64) -> Result<Option<Material>, UpdateError> {
+    match mat {
+        Material::Concrete { params, density }
+            if params.crush_eu.is_none()
+                && params.compression_softening != concrete::CompressionSoftening::Mc90 =>
+        {
+            Ok(Some(Material::Concrete {
+                params: Box::new(params.for_element(h)?),
+                density: *density,
+            }))
+        }
+        _ => Ok(None),
+    }
+}
+
 /// Why a material update failed (the increment is then cut).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UpdateError {
