@@ -6,7 +6,7 @@ use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
 use crate::analysis::bonded_time::BarPointTime;
 use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
-use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput};
+use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput, NodeBlocks};
 use crate::elements::{ElementResponse, Response};
 use crate::materials::point::{PointState, TimeContext, UpdateError};
 use crate::materials::steel::SteelState;
@@ -42,6 +42,8 @@ pub(super) struct HostChunk<'a> {
     bar_imposed: &'a [f64],
     /// Construction stages (reference displacements of elements born late), if any.
     stages: Option<&'a StageState>,
+    /// Tangent blocks each element forms (all elements).
+    blocks: &'a [NodeBlocks],
 }
 
 /// One element's own trial slices: element index, point states, Gauss outputs, bar steel
@@ -68,6 +70,7 @@ pub(super) fn split_chunk<'a>(
     tangent: bool,
     (start, end): (usize, usize),
     stages: Option<&'a StageState>,
+    blocks: &'a [NodeBlocks],
 ) -> (HostChunk<'a>, Vec<HostPiece<'a>>) {
     let g0 = gp_offset[start];
     let g1 = gp_offset[end];
@@ -93,6 +96,7 @@ pub(super) fn split_chunk<'a>(
         imposed: thermal.points.get(g0..g1).unwrap_or(&[]),
         bar_imposed: thermal.bars.get(b0..b1).unwrap_or(&[]),
         stages,
+        blocks,
     };
     let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
     // Per-element slices.
@@ -147,6 +151,7 @@ impl HostChunk<'_> {
             imposed,
             bar_imposed,
             stages,
+            blocks,
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -192,6 +197,7 @@ impl HostChunk<'_> {
             material: mat,
             time,
             imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
+            blocks: blocks[e],
         };
         element.response(
             ue,

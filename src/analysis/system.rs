@@ -8,7 +8,7 @@ use crate::elements::tendon::{ExternalTendon, TendonLaw};
 use crate::elements::{ElementResponse, Response};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
-use crate::materials::point::{crack_base, plastic_base, TimeContext, UpdateError};
+use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext, UpdateError};
 use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
@@ -73,6 +73,8 @@ pub struct System<'m> {
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
     elem_buf: (Vec<f64>, Vec<f64>),
+    /// The tangent blocks each continuum element forms (those the scatter adds).
+    blocks: Vec<crate::elements::continuum::NodeBlocks>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -343,6 +345,13 @@ impl<'m> System<'m> {
                 time: vec![None; n_bp],
             },
         };
+        let blocks = (0..model.elements.len())
+            .map(|e| {
+                let number = numbers.number(Family::Continuum, e);
+                let n = model.elements[e].nodes.len();
+                crate::elements::continuum::NodeBlocks(asm.node_blocks(number, n))
+            })
+            .collect();
         Self {
             model,
             dofs,
@@ -364,6 +373,7 @@ impl<'m> System<'m> {
             thermal,
             stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
+            blocks,
         }
     }
 
@@ -372,25 +382,38 @@ impl<'m> System<'m> {
     pub fn latch_cracks(&mut self) -> usize {
         let model = self.model;
         let c = &mut self.families.continuum;
-        let mut new = Vec::new();
-        for (e, el) in model.elements.iter().enumerate() {
-            let mat = &model.materials[model.regions[el.region].material].law;
-            if mat.is_linear() {
-                continue;
-            }
-            for g in self.gp_offset[e]..self.gp_offset[e + 1] {
-                if c.holds.latched.binary_search_by_key(&g, |x| x.0).is_ok() {
-                    continue;
-                }
-                let (committed, trial) = (&c.points.committed[g], &c.points.trial[g]);
-                if let Some(b) = crack_base(mat, committed, trial) {
-                    new.push((g, b));
-                } else if let Some(b) = plastic_base(committed, trial) {
-                    c.holds.held_plastic = true;
-                    new.push((g, b));
-                }
-            }
+        let gp_offset = &self.gp_offset;
+        // The points checked in parallel (the main thread did this alone between
+        // assemblies); collected in point order, as the loop over them did. The flag says
+        // whether the base is a plastic hold.
+        let (latched, points) = (&c.holds.latched, &c.points);
+        let new: Vec<(usize, PointState, bool)> = (0..model.elements.len())
+            .into_par_iter()
+            .flat_map_iter(|e| {
+                let el = &model.elements[e];
+                let mat = &model.materials[model.regions[el.region].material].law;
+                let range = if mat.is_linear() {
+                    0..0
+                } else {
+                    gp_offset[e]..gp_offset[e + 1]
+                };
+                range.filter_map(move |g| {
+                    if latched.binary_search_by_key(&g, |x| x.0).is_ok() {
+                        return None;
+                    }
+                    let (committed, trial) = (&points.committed[g], &points.trial[g]);
+                    if let Some(b) = crack_base(mat, committed, trial) {
+                        Some((g, b, false))
+                    } else {
+                        plastic_base(committed, trial).map(|b| (g, b, true))
+                    }
+                })
+            })
+            .collect();
+        if new.iter().any(|x| x.2) {
+            c.holds.held_plastic = true;
         }
+        let new = new.into_iter().map(|(g, b, _)| (g, b));
         let n = new.len();
         if n > 0 {
             c.holds.latched.extend(new);
@@ -477,6 +500,7 @@ impl<'m> System<'m> {
                 tangent,
                 (start, end),
                 stages,
+                &self.blocks,
             );
             let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
                 if stages.is_some_and(|s| !s.element_acts(p.0)) {

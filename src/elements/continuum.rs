@@ -80,6 +80,7 @@ type ResponseFn = fn(
     &mut [GaussOutput],
     &TimeContext,
     &[f64],
+    NodeBlocks,
 ) -> Result<(), UpdateError>;
 
 /// A continuum element ready to answer: formulation, node coordinates [m], thickness [m],
@@ -98,6 +99,8 @@ pub struct ContinuumElement<'a> {
     /// Imposed (stress-free) normal strain θ [-] of each Gauss point, ε_th = θ (1, 1, 0)
     /// (thermal actions, [`super::thermal`]); empty: none.
     pub imposed: &'a [f64],
+    /// The node blocks of the tangent to form (the assembly wants one of (a, b), (b, a)).
+    pub blocks: NodeBlocks,
 }
 
 impl super::ElementResponse for ContinuumElement<'_> {
@@ -116,10 +119,12 @@ impl super::ElementResponse for ContinuumElement<'_> {
         let (f, k) = (into.f, into.k);
         // The small-strain and total Lagrangian responses take the same arguments.
         let (kind, integration, respond): (_, _, ResponseFn) = match self.formulation {
-            Formulation::SmallStrain { kind, integration } => (kind, integration, response_at),
-            Formulation::TotalLagrangian { kind, integration } => {
-                (kind, integration, super::total_lagrangian::response_tl)
-            }
+            Formulation::SmallStrain { kind, integration } => (kind, integration, response_blocks),
+            Formulation::TotalLagrangian { kind, integration } => (
+                kind,
+                integration,
+                super::total_lagrangian::response_tl_blocks,
+            ),
             Formulation::IncompatibleModes => {
                 super::incompatible::response_at(
                     c,
@@ -151,6 +156,7 @@ impl super::ElementResponse for ContinuumElement<'_> {
             out,
             self.time,
             self.imposed,
+            self.blocks,
         )?;
         Ok(true)
     }
@@ -295,11 +301,48 @@ pub fn response_at(
     committed: &[PointState],
     u: &[f64],
     f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+) -> Result<(), UpdateError> {
+    response_blocks(
+        kind,
+        integration,
+        coords,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        time,
+        imposed,
+        NodeBlocks::ALL,
+    )
+}
+
+/// As [`response_at`], forming only the node blocks `blocks` of the tangent (the others
+/// are zero).
+#[allow(clippy::too_many_arguments)]
+pub fn response_blocks(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
     mut k: Option<&mut [f64]>,
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
     imposed: &[f64],
+    blocks: NodeBlocks,
 ) -> Result<(), UpdateError> {
     if integration == Integration::Incompatible {
         debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
@@ -314,6 +357,12 @@ pub fn response_at(
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
     let (n_pts, geo, h) = gauss_geometry(kind, integration, coords);
+    // Size-dependent material constants once per element (same values as per point).
+    let local = crate::materials::point::for_element(mat, h)?;
+    let mat = local.as_ref().unwrap_or(mat);
+    // Tangents and weights of the points, for the stiffness after all updates.
+    let mut tangents = [[[0.0; 3]; 3]; 9];
+    let mut weights = [0.0; 9];
     for g in 0..n_pts {
         let (dn, wdet) = geo[g];
         let mut eps = [0.0; 3];
@@ -337,34 +386,69 @@ pub fn response_at(
             f[2 * a] += w * (ax * sig[0] + ay * sig[2]);
             f[2 * a + 1] += w * (ay * sig[1] + ax * sig[2]);
         }
-        let Some(k) = k.as_deref_mut() else {
-            continue;
-        };
-        for a in 0..n {
+        tangents[g] = d;
+        weights[g] = w;
+    }
+    let Some(k) = k else {
+        return Ok(());
+    };
+    // Rows of B_aᵀ D (2×3) of every point and node; then K_ab = Σ_g w B_aᵀ D B_b block
+    // by block, summed over the points in their order in registers (the operations of
+    // adding point by point into K).
+    for a in 0..n {
+        let mut rs = [[0.0; 6]; 9];
+        for g in 0..n_pts {
+            let (dn, d) = (&geo[g].0, &tangents[g]);
             let (ax, ay) = (dn[a][0], dn[a][1]);
-            // Rows of B_aᵀ D (2×3).
-            let r0 = [
+            rs[g] = [
                 ax * d[0][0] + ay * d[2][0],
                 ax * d[0][1] + ay * d[2][1],
                 ax * d[0][2] + ay * d[2][2],
-            ];
-            let r1 = [
                 ay * d[1][0] + ax * d[2][0],
                 ay * d[1][1] + ax * d[2][1],
                 ay * d[1][2] + ax * d[2][2],
             ];
-            for b in 0..n {
-                let (bx, by) = (dn[b][0], dn[b][1]);
-                let row0 = 2 * a * nd;
-                let row1 = (2 * a + 1) * nd;
-                k[row0 + 2 * b] += w * (r0[0] * bx + r0[2] * by);
-                k[row0 + 2 * b + 1] += w * (r0[1] * by + r0[2] * bx);
-                k[row1 + 2 * b] += w * (r1[0] * bx + r1[2] * by);
-                k[row1 + 2 * b + 1] += w * (r1[1] * by + r1[2] * bx);
+        }
+        for b in 0..n {
+            if !blocks.has(a, b) {
+                continue;
             }
+            let mut acc = [0.0; 4];
+            for g in 0..n_pts {
+                let (r, w) = (&rs[g], weights[g]);
+                let (bx, by) = (geo[g].0[b][0], geo[g].0[b][1]);
+                acc[0] += w * (r[0] * bx + r[2] * by);
+                acc[1] += w * (r[1] * by + r[2] * bx);
+                acc[2] += w * (r[3] * bx + r[5] * by);
+                acc[3] += w * (r[4] * by + r[5] * bx);
+            }
+            let (row0, row1) = (2 * a * nd, (2 * a + 1) * nd);
+            k[row0 + 2 * b] = acc[0];
+            k[row0 + 2 * b + 1] = acc[1];
+            k[row1 + 2 * b] = acc[2];
+            k[row1 + 2 * b + 1] = acc[3];
         }
     }
     Ok(())
+}
+
+/// The node blocks (a, b) of an element matrix that are wanted: bit 9a + b (a, b < 9). The
+/// assembly adds only the lower triangle of the global matrix, i.e. for a symmetric
+/// element matrix one of the blocks (a, b), (b, a) of each node pair; the element forms
+/// the blocks it is asked for (the others stay zero) with the operations of the full
+/// matrix, so the assembled values are the same bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NodeBlocks(pub u128);
+
+impl NodeBlocks {
+    /// Every block.
+    pub const ALL: NodeBlocks = NodeBlocks(u128::MAX);
+
+    /// Whether block (a, b) is wanted.
+    #[inline]
+    pub fn has(self, a: usize, b: usize) -> bool {
+        self.0 >> (9 * a + b) & 1 == 1
+    }
 }
 
 /// The strain the material law sees at Gauss point `g`: the total strain `eps` less the

@@ -14,8 +14,8 @@
 //! - f = ∫ B_Lᵀ S t dA₀; K = ∫ B_Lᵀ D B_L t dA₀ + ∫ (∇N_aᵀ Ŝ ∇N_b) I₂ t dA₀ (the
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
-use super::continuum::{GaussOutput, Integration};
-use crate::fem::shape::{QuadKind, MAX_NODES};
+use super::continuum::{GaussOutput, Integration, NodeBlocks};
+use crate::fem::shape::QuadKind;
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
@@ -57,11 +57,48 @@ pub fn response_tl(
     committed: &[PointState],
     u: &[f64],
     f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+) -> Result<(), UpdateError> {
+    response_tl_blocks(
+        kind,
+        integration,
+        coords,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        time,
+        imposed,
+        NodeBlocks::ALL,
+    )
+}
+
+/// As [`response_tl`], forming only the node blocks `blocks` of the tangent (the others
+/// are zero; see [`NodeBlocks`]).
+#[allow(clippy::too_many_arguments)]
+pub fn response_tl_blocks(
+    kind: QuadKind,
+    integration: Integration,
+    coords: &[[f64; 2]],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
     mut k: Option<&mut [f64]>,
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
     imposed: &[f64],
+    blocks: NodeBlocks,
 ) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
@@ -71,6 +108,11 @@ pub fn response_tl(
     }
     // Characteristic length of the undeformed element (strains are referred to it).
     let (n_pts, geo, h_len) = super::continuum::gauss_geometry(kind, integration, coords);
+    // Size-dependent material constants once per element (same values as per point).
+    let local = crate::materials::point::for_element(mat, h_len)?;
+    let mat = local.as_ref().unwrap_or(mat);
+    // The 4 × 4 matrices C of the points (see below), for the stiffness after all updates.
+    let mut cs = [[[0.0; 4]; 4]; 9];
     for g in 0..n_pts {
         let (dn, wdet) = geo[g];
         let h = displacement_gradient(&dn, u, n);
@@ -96,9 +138,9 @@ pub fn response_tl(
                 f[2 * a + i] += w * (b[0][i] * s[0] + b[1][i] * s[1] + b[2][i] * s[2]);
             }
         }
-        let Some(k) = k.as_deref_mut() else {
+        if k.is_none() {
             continue;
-        };
+        }
         // With δE = S(F) δh, δh = (δH₁₁, δH₁₂, δH₂₁, δH₂₂) and δH_ik = N_a,k δu_a,i, both
         // terms of K are ∇N_aᵀ C_ij ∇N_b with the 4 × 4 C = w (Sᵀ D S + I₂ ⊗ Ŝ): about half
         // the operations of B_Lᵀ D B_L node pair by node pair. Column 2i + k of S is
@@ -115,7 +157,7 @@ pub fn response_tl(
             }
         }
         let shat = [[s[0], s[2]], [s[2], s[1]]];
-        let mut c = [[0.0; 4]; 4];
+        let c = &mut cs[g];
         for p in 0..4 {
             for q in 0..4 {
                 let mut v = sm[p][0] * ds[q][0] + sm[p][1] * ds[q][1] + sm[p][2] * ds[q][2];
@@ -125,23 +167,42 @@ pub fn response_tl(
                 c[p][q] = w * v;
             }
         }
-        let (mut dx, mut dy) = ([0.0; MAX_NODES], [0.0; MAX_NODES]);
-        for a in 0..n {
-            dx[a] = dn[a][0];
-            dy[a] = dn[a][1];
-        }
-        for a in 0..n {
+    }
+    let Some(k) = k else {
+        return Ok(());
+    };
+    // t_jl = Σ_k N_a,k C[2i + k][2j + l] of every point, node and row i; then
+    // K[(a,i), (b,j)] = Σ_g Σ_l t_jl N_b,l block by block, summed over the points in
+    // their order in registers (the operations of adding point by point into K).
+    for a in 0..n {
+        let mut ts = [[0.0; 8]; 9];
+        for g in 0..n_pts {
+            let (dn, c) = (&geo[g].0, &cs[g]);
             for i in 0..2 {
-                // t_jl = Σ_k N_a,k C[2i + k][2j + l]; K[(a,i), (b,j)] += Σ_l t_jl N_b,l.
                 let (p0, p1) = (2 * i, 2 * i + 1);
-                let t = |q: usize| dx[a] * c[p0][q] + dy[a] * c[p1][q];
-                let (t00, t01, t10, t11) = (t(0), t(1), t(2), t(3));
-                let kr = &mut k[(2 * a + i) * nd..(2 * a + i + 1) * nd];
-                for bn in 0..n {
-                    kr[2 * bn] += t00 * dx[bn] + t01 * dy[bn];
-                    kr[2 * bn + 1] += t10 * dx[bn] + t11 * dy[bn];
+                for q in 0..4 {
+                    ts[g][4 * i + q] = dn[a][0] * c[p0][q] + dn[a][1] * c[p1][q];
                 }
             }
+        }
+        for bn in 0..n {
+            if !blocks.has(a, bn) {
+                continue;
+            }
+            let mut acc = [0.0; 4];
+            for g in 0..n_pts {
+                let t = &ts[g];
+                let (bx, by) = (geo[g].0[bn][0], geo[g].0[bn][1]);
+                acc[0] += t[0] * bx + t[1] * by;
+                acc[1] += t[2] * bx + t[3] * by;
+                acc[2] += t[4] * bx + t[5] * by;
+                acc[3] += t[6] * bx + t[7] * by;
+            }
+            let (r0, r1) = (2 * a * nd, (2 * a + 1) * nd);
+            k[r0 + 2 * bn] = acc[0];
+            k[r0 + 2 * bn + 1] = acc[1];
+            k[r1 + 2 * bn] = acc[2];
+            k[r1 + 2 * bn + 1] = acc[3];
         }
     }
     Ok(())
@@ -211,6 +272,76 @@ mod tests {
         )
         .unwrap();
         (f, k, out)
+    }
+
+    /// A tangent formed on some node blocks only (what the assembly asks for) equals the
+    /// full tangent bit for bit in those blocks and is zero elsewhere, for the total
+    /// Lagrangian and the small-strain element: the assembled matrix cannot change. Exact
+    /// equality is the claim (the same operations in the same order).
+    #[test]
+    fn tangent_blocks_are_those_of_the_full_tangent() {
+        let mut seed = 11u64;
+        for kind in KINDS {
+            let n = kind.n_nodes();
+            let nd = 2 * n;
+            let u: Vec<f64> = (0..nd).map(|_| 0.01 * rand(&mut seed)).collect();
+            // The lower node blocks and, of the upper ones, every third: an irregular mask.
+            let mut mask = 0u128;
+            for a in 0..n {
+                for b in 0..n {
+                    if b <= a || (a + 2 * b) % 3 == 0 {
+                        mask |= 1 << (9 * a + b);
+                    }
+                }
+            }
+            let blocks = NodeBlocks(mask);
+            let c = coords(kind);
+            let ngp = rule_points(kind, Integration::Full).len();
+            let committed = vec![PointState::Elastic; ngp];
+            for tl in [true, false] {
+                let run = |blocks: NodeBlocks| {
+                    let (mut trial, mut out) =
+                        (committed.clone(), vec![GaussOutput::default(); ngp]);
+                    let (mut f, mut k) = (vec![0.0; nd], vec![7.0; nd * nd]);
+                    let respond = if tl {
+                        response_tl_blocks
+                    } else {
+                        crate::elements::continuum::response_blocks
+                    };
+                    respond(
+                        kind,
+                        Integration::Full,
+                        &c,
+                        0.3,
+                        &elastic(),
+                        &committed,
+                        &u,
+                        &mut f,
+                        Some(&mut k),
+                        &mut trial,
+                        &mut out,
+                        &TimeContext::default(),
+                        &[],
+                        blocks,
+                    )
+                    .unwrap();
+                    (f, k)
+                };
+                let (f_all, k_all) = run(NodeBlocks::ALL);
+                let (f_some, k_some) = run(blocks);
+                assert_eq!(f_all, f_some);
+                for r in 0..nd {
+                    for s in 0..nd {
+                        let want = if blocks.has(r / 2, s / 2) {
+                            k_all[r * nd + s]
+                        } else {
+                            0.0
+                        };
+                        assert_eq!(k_some[r * nd + s].to_bits(), want.to_bits(), "{kind:?}");
+                    }
+                }
+            }
+        }
     }
 
     /// The TL tangent is the derivative of the TL internal force: central differences at

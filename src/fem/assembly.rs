@@ -191,6 +191,25 @@ impl Assembler {
         }
     }
 
+    /// The node blocks of element `e` (of `n` nodes, 2 dofs each) that `add_matrix` reads:
+    /// bit 9a + b is set when any entry of block (a, b) goes into the lower triangle
+    /// (see [`crate::elements::continuum::NodeBlocks`]).
+    pub fn node_blocks(&self, e: usize, n: usize) -> u128 {
+        let s = &self.scatter[self.scatter_ptr[e]..self.scatter_ptr[e + 1]];
+        let nd = 2 * n;
+        assert_eq!(s.len(), nd * nd, "element {e}: not of {n} nodes");
+        let mut mask = 0u128;
+        for a in 0..n {
+            for b in 0..n {
+                let used = (0..2).any(|i| (0..2).any(|j| s[(2 * a + i) * nd + 2 * b + j] != SKIP));
+                if used {
+                    mask |= 1u128 << (9 * a + b);
+                }
+            }
+        }
+        mask
+    }
+
     /// Add the dense row-major element matrix `k` of element `e` into `values`.
     #[inline]
     pub fn add_matrix(&self, e: usize, k: &[f64], values: &mut [f64]) {
@@ -226,5 +245,9 @@ mod tests {
         asm.add_matrix(0, &k, &mut vals);
         // Element 0 touches only node 1's two eqs: entries (0,0), (1,0), (1,1).
         assert_eq!(vals.iter().sum::<f64>(), 3.0);
+        // Its node blocks read by the scatter: (1, 1) alone (node 0 is fixed).
+        assert_eq!(asm.node_blocks(0, 2), 1 << (9 + 1));
+        // Element 1: nodes 1, 2 numbered in order, so the lower blocks (0,0), (1,0), (1,1).
+        assert_eq!(asm.node_blocks(1, 2), 1 | 1 << 9 | 1 << 10);
     }
 }

@@ -224,6 +224,26 @@ impl TimeContext {
     }
 }
 
+/// The material of an element of characteristic length `h` [m] with what depends on the
+/// element size resolved once for all its points: a concrete with crush-band compression
+/// softening gets its ultimate strain ([`concrete::ConcreteParams::for_element`], which the
+/// point update otherwise does at every point, copying the parameters). None when nothing
+/// depends on the element (the material is used as it is).
+pub fn for_element(mat: &Material, h: f64) -> Result<Option<Material>, UpdateError> {
+    match mat {
+        Material::Concrete { params, density }
+            if params.crush_eu.is_none()
+                && params.compression_softening != concrete::CompressionSoftening::Mc90 =>
+        {
+            Ok(Some(Material::Concrete {
+                params: Box::new(params.for_element(h)?),
+                density: *density,
+            }))
+        }
+        _ => Ok(None),
+    }
+}
+
 /// Why a material update failed (the increment is then cut).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UpdateError {
@@ -355,6 +375,21 @@ pub fn update_into(
     trial: &mut PointState,
 ) -> Result<([f64; 3], [[f64; 3]; 3]), UpdateError> {
     if let (Material::Concrete { params, .. }, PointState::Concrete(c)) = (mat, committed) {
+        // Without creep the new state is written into the slot's box in place.
+        if let (None, PointState::Concrete(slot)) = (&params.creep, &mut *trial) {
+            let (sig, mut d) = concrete::update_full_into(
+                params,
+                c,
+                strain,
+                char_length,
+                time.dt(),
+                time.extrapolation,
+                slot,
+            )
+            .map_err(UpdateError::from)?;
+            symmetrise3(&mut d);
+            return Ok((sig, d));
+        }
         let (st, sig, d) = concrete_update(params, c, strain, char_length, time)?;
         match trial {
             PointState::Concrete(slot) => **slot = st,
@@ -401,9 +436,14 @@ fn concrete_update(
         ),
     };
     let (st, sig, mut d) = res.map_err(UpdateError::from)?;
-    // The cracked tangent is unsymmetric (shear retention falls as the crack opens);
-    // the symmetric solvers take its symmetric part (same converged answer, possibly
-    // more iterations).
+    symmetrise3(&mut d);
+    Ok((st, sig, d))
+}
+
+/// The symmetric part of a concrete tangent: the cracked tangent is unsymmetric (shear
+/// retention falls as the crack opens); the symmetric solvers take its symmetric part
+/// (same converged answer, possibly more iterations).
+fn symmetrise3(d: &mut [[f64; 3]; 3]) {
     for i in 0..3 {
         for j in 0..i {
             let m = 0.5 * (d[i][j] + d[j][i]);
@@ -411,7 +451,6 @@ fn concrete_update(
             d[j][i] = m;
         }
     }
-    Ok((st, sig, d))
 }
 
 /// The state an update should start from for the rest of an increment once a crack has

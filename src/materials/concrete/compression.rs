@@ -51,6 +51,12 @@ pub struct Hardening {
 /// Curve strain ε̄0 [-] at initial yield (σ_c = r0 f_cm on the ascending branch) and the
 /// offset κ0 = ε̄0 − r0 f_cm/E [-].
 pub fn initial_yield(p: &ConcreteParams) -> (f64, f64) {
+    let law = HardeningLaw::new(p);
+    (law.e0, law.k0)
+}
+
+/// [`initial_yield`] evaluated (the memoised [`HardeningLaw`] keeps its values).
+fn initial_yield_of(p: &ConcreteParams) -> (f64, f64) {
     let r = p.initial_yield_ratio.clamp(0.0, 1.0);
     if r == 0.0 {
         return (0.0, 0.0);
@@ -130,15 +136,54 @@ pub struct HardeningLaw {
     crush_eu: Option<f64>,
     /// Linear post-peak branch: start ε̄* [-], stress there [Pa], slope E_t [Pa].
     linear: Option<(f64, f64, f64)>,
-    /// Offset κ0 [-] (see [`initial_yield`]).
+    /// Curve strain ε̄0 at initial yield [-] and offset κ0 [-] (see [`initial_yield`]).
+    e0: f64,
     k0: f64,
     /// Modulus E [Pa].
     ec: f64,
 }
 
+/// The parameters a [`HardeningLaw`] depends on, as bits: f_cm, E, ε_c1, the softening
+/// limit, the initial yield ratio, whether a crush-band ε_u is set and its value.
+type LawKey = [u64; 7];
+
+fn law_key(p: &ConcreteParams) -> LawKey {
+    [
+        p.fcm.to_bits(),
+        p.ec.to_bits(),
+        p.eps_c1.to_bits(),
+        p.softening_limit.to_bits(),
+        p.initial_yield_ratio.to_bits(),
+        u64::from(p.crush_eu.is_some()),
+        p.crush_eu.map_or(0, f64::to_bits),
+    ]
+}
+
 impl HardeningLaw {
-    /// The law of `p`.
+    /// The law of `p`. Memoised per thread for the last parameter set (bit-identical
+    /// inputs give the same law): every update of an uncracked point evaluates it, and its
+    /// constants (the MC90 curve, the start of the linear post-peak branch, the initial
+    /// yield) cost a tenth of a plastic point update.
     pub fn new(p: &ConcreteParams) -> Self {
+        thread_local! {
+            static LAST: std::cell::RefCell<Option<(LawKey, HardeningLaw)>> =
+                const { std::cell::RefCell::new(None) };
+        }
+        let key = law_key(p);
+        LAST.with(|last| {
+            if let Some((k, law)) = &*last.borrow() {
+                if *k == key {
+                    return *law;
+                }
+            }
+            let law = Self::evaluate(p);
+            *last.borrow_mut() = Some((key, law));
+            law
+        })
+    }
+
+    /// The law of `p`, its constants evaluated.
+    fn evaluate(p: &ConcreteParams) -> Self {
         let curve = p.curve();
         let linear = if p.crush_eu.is_some() {
             None
@@ -149,15 +194,22 @@ impl HardeningLaw {
                 (es, s0, et)
             })
         };
+        let (e0, k0) = initial_yield_of(p);
         Self {
             curve,
             fcm: p.fcm,
             eps_c1: p.eps_c1,
             crush_eu: p.crush_eu,
             linear,
-            k0: initial_yield(p).1,
+            e0,
+            k0,
             ec: p.ec,
         }
+    }
+
+    /// Curve strain ε̄0 at initial yield [-] (see [`initial_yield`]).
+    pub fn initial_yield_strain(&self) -> f64 {
+        self.e0
     }
 
     /// σ_c(ε̄) [Pa] and dσ_c/dε̄ [Pa] (see [`hardening_curve`]).
@@ -226,7 +278,18 @@ pub fn update(
     ebar_n: f64,
     eps: &[f64; 3],
 ) -> Result<PlasticUpdate, MaterialError> {
-    let law = HardeningLaw::new(p);
+    update_with_law(p, &HardeningLaw::new(p), eps_n, ep_n, ebar_n, eps)
+}
+
+/// [`update`] with the hardening law of `p` given.
+fn update_with_law(
+    p: &ConcreteParams,
+    law: &HardeningLaw,
+    eps_n: &[f64; 3],
+    ep_n: &[f64; 3],
+    ebar_n: f64,
+    eps: &[f64; 3],
+) -> Result<PlasticUpdate, MaterialError> {
     let mut m = 1;
     let mut last_err = None;
     while m <= MAX_SUBSTEPS {
@@ -237,7 +300,7 @@ pub fn update(
         for k in 1..=m {
             let t = k as f64 / m as f64;
             let e: [f64; 3] = std::array::from_fn(|i| eps_n[i] + t * (eps[i] - eps_n[i]));
-            match step(p, &law, &ep, eb, &e) {
+            match step(p, law, &ep, eb, &e) {
                 Ok(u) => {
                     ep = u.plastic_strain;
                     eb = u.ebar;
@@ -349,7 +412,9 @@ fn step(
     let s_tr: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| d[i][j] * ee[j]).sum());
     let h_n = law.at(ebar_n);
     let q = p.q_norm();
-    let se_tr = ottosen::equivalent_stress(&p.ottosen, &s_tr) / q;
+    // σ_e of the trial with its invariants and arccos kept for the first iterate.
+    let (se_tr, kept_tr) = ottosen::equivalent_stress_kept(&p.ottosen, &s_tr);
+    let se_tr = se_tr / q;
     if se_tr <= h_n.sigma_c * (1.0 + 1e-13) {
         return Ok(PlasticUpdate {
             stress: s_tr,
@@ -371,10 +436,13 @@ fn step(
     let cs = [f, f, f, p.eps_c1];
     // Residual and what the Jacobian needs at one iterate, from one evaluation of σ_e and
     // its derivatives (the Hessian is formed with the gradient: same arccos).
-    let eval = |s: &[f64; 3], eb: f64| -> Iterate {
+    let eval = |s: &[f64; 3], eb: f64, kept: Option<&ottosen::Kept>| -> Iterate {
         let h = law.at(eb);
         let dl = h.kappa - h_n.kappa;
-        let (se, g, hs) = ottosen::equivalent_stress_derivatives(&p.ottosen, s);
+        let (se, g, hs) = match kept {
+            Some(k) => ottosen::derivatives_kept(&p.ottosen, s, k),
+            None => ottosen::equivalent_stress_derivatives(&p.ottosen, s),
+        };
         let (se, n) = (se / q, g.map(|v| v / q));
         let mut r = [0.0; 4];
         for i in 0..3 {
@@ -410,7 +478,7 @@ fn step(
 
     let mut s = s_tr;
     let mut eb = ebar_n;
-    let mut cur = eval(&s, eb);
+    let mut cur = eval(&s, eb, Some(&kept_tr));
     let mut it = 0;
     'newton: while cur.norm > TOL {
         it += 1;
@@ -425,7 +493,7 @@ fn step(
         loop {
             let s_new: [f64; 3] = std::array::from_fn(|i| s[i] + t * dy[i] * cs[i]);
             let eb_new = (eb + t * dy[3] * cs[3]).max(ebar_n);
-            let trial = eval(&s_new, eb_new);
+            let trial = eval(&s_new, eb_new, None);
             let n_new = trial.norm;
             if n_new.is_finite() && (n_new <= (1.0 - 1e-4 * t) * norm || t < 1e-3) {
                 if n_new >= norm && norm < STAGNATION_TOL {
@@ -528,8 +596,21 @@ pub fn update_rate(
     ebar_n: f64,
     eps: &[f64; 3],
 ) -> Result<PlasticUpdate, MaterialError> {
+    update_rate_with_law(p, &HardeningLaw::new(p), dt, eps_n, ep_n, ebar_n, eps)
+}
+
+/// [`update_rate`] with the hardening law of `p` given (the point update has it already).
+pub fn update_rate_with_law(
+    p: &ConcreteParams,
+    law: &HardeningLaw,
+    dt: f64,
+    eps_n: &[f64; 3],
+    ep_n: &[f64; 3],
+    ebar_n: f64,
+    eps: &[f64; 3],
+) -> Result<PlasticUpdate, MaterialError> {
     match &p.viscoplastic {
-        None => update(p, eps_n, ep_n, ebar_n, eps),
+        None => update_with_law(p, law, eps_n, ep_n, ebar_n, eps),
         Some(vp) => viscoplastic_update(p, vp, dt, ep_n, ebar_n, eps),
     }
 }

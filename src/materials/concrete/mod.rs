@@ -658,6 +658,30 @@ pub fn update_full(
     dt: f64,
     ratio: f64,
 ) -> UpdateResult {
+    let mut st = committed.clone();
+    let (s, d) = update_full_into(p, committed, strain, char_length, dt, ratio, &mut st)?;
+    Ok((st, s, d))
+}
+
+/// Stress (σx, σy, τxy) [Pa] and tangent [Pa] of [`update_full`], its new state written
+/// into `out` (the trial slot of the point: no state is built and moved per update). On an
+/// error `out` holds no meaningful state.
+pub fn update_full_into(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    dt: f64,
+    ratio: f64,
+    out: &mut ConcreteState,
+) -> Result<([f64; 3], [[f64; 3]; 3]), MaterialError> {
+    // The other routes build their state; it is moved into `out`.
+    let moved = |out: &mut ConcreteState, r: UpdateResult| {
+        r.map(|(st, s, d)| {
+            *out = st;
+            (s, d)
+        })
+    };
     if !strain.iter().all(|v| v.is_finite()) {
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
@@ -670,13 +694,19 @@ pub fn update_full(
         p
     };
     if committed.crushed {
-        return Ok(crushed(p, committed, strain));
+        return moved(out, Ok(crushed(p, committed, strain)));
     }
     if p.crack_model == CrackModel::Rotating {
-        return rotating::update(p, committed, strain, char_length, ratio);
+        return moved(
+            out,
+            rotating::update(p, committed, strain, char_length, ratio),
+        );
     }
     if committed.n_cracks > 0 {
-        return cracking::update_cracked(p, committed, strain, char_length, ratio);
+        return moved(
+            out,
+            cracking::update_cracked(p, committed, strain, char_length, ratio),
+        );
     }
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
@@ -689,14 +719,19 @@ pub fn update_full(
     // with dilatancy does exactly that).
     let trial_cd = p.compression_dominated(&s_tr);
     // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
-    let ebar0 = compression::initial_yield(p).0;
+    let law = compression::HardeningLaw::new(p);
+    let ebar0 = law.initial_yield_strain();
     let ebar_n = committed.ebar.max(ebar0);
-    // σ̂_e alone (the value of `compression::sigma_hat`, without its gradient).
-    let yields = ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
-        > compression::hardening(p, ebar_n).sigma_c * (1.0 + 1e-13);
-    if trial_cd || yields || committed.hold_plastic {
-        let res = compression::update_rate(
+    // σ̂_e alone (the value of `compression::sigma_hat`, without its gradient), evaluated
+    // only when the route is not already plastic.
+    let yields = || {
+        ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
+            > law.at(ebar_n).sigma_c * (1.0 + 1e-13)
+    };
+    if trial_cd || committed.hold_plastic || yields() {
+        let res = compression::update_rate_with_law(
             p,
+            &law,
             dt,
             &committed.strain,
             &committed.plastic_strain,
@@ -717,25 +752,28 @@ pub fn update_full(
         };
         if accept {
             let u = res?;
-            let mut st = committed.clone();
-            st.strain = *strain;
-            st.plastic_strain = u.plastic_strain;
-            st.ebar = u.ebar;
-            st.kappa = compression::hardening(p, u.ebar).kappa.max(0.0);
+            assign(out, committed);
+            out.strain = *strain;
+            out.plastic_strain = u.plastic_strain;
+            out.ebar = u.ebar;
+            let h = law.at(u.ebar);
+            out.kappa = h.kappa.max(0.0);
             // σ_c = 0 means crushed only past the peak: with zero initial yield the curve
             // also starts at σ_c = 0, where a round-off strain must not crush the point.
-            let spent = u.ebar > p.eps_c1 && compression::hardening(p, u.ebar).sigma_c <= 0.0;
+            let spent = u.ebar > p.eps_c1 && h.sigma_c <= 0.0;
             if u.ebar >= p.eps_cu || spent {
-                st.crushed = true;
-                return Ok(crushed(p, &st, strain));
+                out.crushed = true;
+                let r = crushed(p, out, strain);
+                return moved(out, Ok(r));
             }
-            st.stress = u.stress;
-            return Ok((st, u.stress, u.tangent));
+            out.stress = u.stress;
+            return Ok((u.stress, u.tangent));
         }
     }
     // Tension-dominated: elastic until the Ottosen failure surface, then crack.
     if s1 >= p.crack_ratio * p.ftm && ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
-        let mut st = committed.clone();
+        assign(out, committed);
+        let st = &mut *out;
         st.n_cracks = 1;
         st.crack_angle = phi;
         st.crack_max = [0.0; 2];
@@ -751,14 +789,53 @@ pub fn update_full(
             st.crack_strain = [e_n, 0.0];
             st.strain = *strain;
             st.stress = s_tr;
-            return Ok((st, s_tr, d));
+            return Ok((s_tr, d));
         }
-        return cracking::update_cracked(p, &st, strain, char_length, ratio);
+        let r = cracking::update_cracked(p, out, strain, char_length, ratio);
+        return moved(out, r);
     }
-    let mut st = committed.clone();
-    st.strain = *strain;
-    st.stress = s_tr;
-    Ok((st, s_tr, d))
+    assign(out, committed);
+    out.strain = *strain;
+    out.stress = s_tr;
+    Ok((s_tr, d))
+}
+
+/// `*out = c.clone()` field by field (a creep box is reused; no whole-state temporary).
+fn assign(out: &mut ConcreteState, c: &ConcreteState) {
+    let ConcreteState {
+        strain,
+        stress,
+        plastic_strain,
+        ebar,
+        kappa,
+        n_cracks,
+        crack_angle,
+        crack_max,
+        crack_strain,
+        dir_ebar,
+        dir_plastic,
+        crushed,
+        frozen,
+        crack_max_old,
+        hold_plastic,
+        creep,
+    } = c;
+    out.strain = *strain;
+    out.stress = *stress;
+    out.plastic_strain = *plastic_strain;
+    out.ebar = *ebar;
+    out.kappa = *kappa;
+    out.n_cracks = *n_cracks;
+    out.crack_angle = *crack_angle;
+    out.crack_max = *crack_max;
+    out.crack_strain = *crack_strain;
+    out.dir_ebar = *dir_ebar;
+    out.dir_plastic = *dir_plastic;
+    out.crushed = *crushed;
+    out.frozen = *frozen;
+    out.crack_max_old = *crack_max_old;
+    out.hold_plastic = *hold_plastic;
+    out.creep.clone_from(creep);
 }
 
 /// Response of a crushed point: zero stress, residual tangent.

@@ -206,11 +206,11 @@ pub fn q_c(p: &OttosenParams) -> f64 {
 
 /// λ [-], dλ/dc [-] and d²λ/dc² [-] at c = cos3θ (see [`lambda`]): with x = c2 c,
 /// ψ = arccos x, d²λ/dx² = (c1/3)[x sin(ψ/3)/√(1 − x²) − cos(ψ/3)/3]/(1 − x²).
-fn lambda_d2(p: &OttosenParams, c: f64) -> (f64, f64, f64) {
+/// `psi3` is ψ/3 ([`Kept`]).
+fn lambda_d2(p: &OttosenParams, c: f64, psi3: f64) -> (f64, f64, f64) {
     // The operations of [`lambda`] (same bits) sharing its arccos and sine/cosine.
     let c2 = p.c2.min(C2_MAX);
     let x = (c2 * c).clamp(-1.0, 1.0);
-    let psi3 = x.acos() / 3.0;
     let (sin3, cos3) = psi3.sin_cos();
     let lam = p.c1 * cos3;
     let dlam = p.c1 * c2 * sin3 / (3.0 * (1.0 - x * x).sqrt());
@@ -244,15 +244,61 @@ pub fn equivalent_stress_derivatives(
     p: &OttosenParams,
     s: &[f64; 3],
 ) -> (f64, [f64; 3], [[f64; 3]; 3]) {
-    let inv = invariants(s);
+    derivatives_kept(p, s, &Kept::new(p, s))
+}
+
+/// The invariants of a stress and the angle ψ/3 = ⅓ arccos(c2 cos3θ) of λ(θ) (None at the
+/// apex, J2 = 0): what [`equivalent_stress_kept`] evaluates and [`derivatives_kept`]
+/// reuses, so that a return mapping checks its trial stress by σ_e and, if it yields,
+/// forms the derivatives there without a second arccos.
+#[derive(Debug, Clone, Copy)]
+pub struct Kept {
+    inv: Invariants,
+    psi3: Option<f64>,
+}
+
+impl Kept {
+    /// The invariants of `s` and ψ/3 (the operations of [`lambda`] and [`lambda_d2`]).
+    pub fn new(p: &OttosenParams, s: &[f64; 3]) -> Self {
+        let inv = invariants(s);
+        let psi3 = (inv.j2 > 0.0).then(|| {
+            let c2 = p.c2.min(C2_MAX);
+            let x = (c2 * inv.cos3theta).clamp(-1.0, 1.0);
+            x.acos() / 3.0
+        });
+        Self { inv, psi3 }
+    }
+}
+
+/// σ_e [Pa] of `s` (the bits of [`equivalent_stress`]) and what its derivatives at `s`
+/// need ([`derivatives_kept`]).
+pub fn equivalent_stress_kept(p: &OttosenParams, s: &[f64; 3]) -> (f64, Kept) {
+    let kept = Kept::new(p, s);
+    let inv = &kept.inv;
+    let Some(psi3) = kept.psi3 else {
+        return ((p.beta * inv.i1).max(0.0), kept);
+    };
+    let lam = p.c1 * psi3.cos();
+    let pp = lam * inv.j2.sqrt() + p.beta * inv.i1;
+    let root = (pp * pp + 4.0 * p.alpha * inv.j2).sqrt();
+    (0.5 * (pp + root), kept)
+}
+
+/// [`equivalent_stress_derivatives`] at `s` from its [`Kept`] values (same bits).
+pub fn derivatives_kept(
+    p: &OttosenParams,
+    s: &[f64; 3],
+    kept: &Kept,
+) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+    let inv = kept.inv;
     let (di1, dj2, dj3) = invariant_gradients(s, &inv);
-    if inv.j2 <= 0.0 {
+    let Some(psi3) = kept.psi3 else {
         let v = (p.beta * inv.i1).max(0.0);
         let g = if v > 0.0 { p.beta } else { 0.0 };
         return (v, [g, g, 0.0], [[0.0; 3]; 3]);
-    }
+    };
     let (j2, c) = (inv.j2, inv.cos3theta);
-    let (lam, dlam, d2lam) = lambda_d2(p, c);
+    let (lam, dlam, d2lam) = lambda_d2(p, c, psi3);
     let (se, grad) = value_and_gradient(p, &inv, (&di1, &dj2, &dj3), lam, dlam);
     let u = j2.sqrt();
     let k = 1.5 * 3f64.sqrt();
