@@ -277,6 +277,22 @@ pub struct SparseCholesky {
     pub stats: SolverStats,
 }
 
+impl Drop for SparseCholesky {
+    /// A large factor is released on a thread of its own: returning 0.5 GB of pages to the
+    /// kernel took ~0.1–0.2 s at 5e5 equations, which the caller (writing results) need not
+    /// wait for.
+    fn drop(&mut self) {
+        if self.l_values.len() >= TOUCH_AHEAD_VALUES {
+            let l_values = std::mem::take(&mut self.l_values);
+            let mem = std::mem::replace(
+                &mut self.mem,
+                MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+            );
+            std::thread::spawn(move || drop((l_values, mem)));
+        }
+    }
+}
+
 impl SparseCholesky {
     /// Ordering (AMD) and symbolic analysis of `pattern`; done once per pattern.
     pub fn new(pattern: &LowerPattern) -> Result<Self, SolverError> {

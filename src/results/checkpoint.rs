@@ -10,7 +10,7 @@
 //! with the 8-byte FNV-1a digest of everything before it: a damaged file (a flipped bit, a
 //! truncated copy) is refused instead of restarting from a silently different state.
 
-use super::atomic::write_atomic;
+use super::atomic::write_atomic_after;
 use super::recorder::{FieldWrite, RecorderState};
 use crate::analysis::failure::FailureReport;
 use crate::analysis::state::{DriverState, SystemState, SystemStateRef};
@@ -156,10 +156,8 @@ pub fn start(
     Ok(Pending(std::thread::spawn(move || {
         let sum = digest(&bytes);
         bytes.extend(sum.to_le_bytes());
-        if let Some(fields) = after {
-            fields.wait()?;
-        }
-        write_atomic(&path, &bytes)
+        // Written beside the field files, renamed into place after them.
+        write_atomic_after(&path, &bytes, || after.map_or(Ok(()), FieldWrite::wait))
     })))
 }
 
