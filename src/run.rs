@@ -320,7 +320,7 @@ impl Observer for Progress<'_, '_> {
             &self.failures,
             &self.rec.state(),
             (!initial).then(|| end.system.state()),
-            self.rec.take_writing(),
+            self.rec.writing(),
         )?);
         if self.stop_after_step == Some(end.driver.next_step) {
             self.stop_now = true;

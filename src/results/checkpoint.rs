@@ -157,7 +157,7 @@ pub fn start(
         let sum = digest(&bytes);
         bytes.extend(sum.to_le_bytes());
         // Written beside the field files, renamed into place after them.
-        write_atomic_after(&path, &bytes, || after.map_or(Ok(()), FieldWrite::wait))
+        write_atomic_after(&path, &bytes, || after.map_or(Ok(()), |w| w.wait()))
     })))
 }
 

@@ -13,6 +13,7 @@ use crate::analysis::system::System;
 use crate::model::{Model, MonitorKind};
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 
 /// One row of the history: step, increment, iterations, load factors, monitor values.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -76,24 +77,43 @@ pub struct Recorder<'m> {
 /// it never lists a file not yet in place): the analysis goes on meanwhile (at 5e5 dofs the
 /// 95 MB .vtu took 0.2–0.45 s to write, now overlapping the checkpoint's encoding and the
 /// release of the factor). Waited for before the next field files, before the checkpoint
-/// that lists them is put in place, and before the run ends.
-pub struct FieldWrite(std::thread::JoinHandle<std::io::Result<()>>);
+/// that lists them is put in place, and before the run ends. Clones share the one write:
+/// whichever waits first joins it, the others see its outcome.
+#[derive(Clone)]
+pub struct FieldWrite(Arc<Mutex<WriteState>>);
+
+/// The thread until joined, then its outcome (an error kept as kind and text).
+struct WriteState {
+    thread: Option<std::thread::JoinHandle<std::io::Result<()>>>,
+    outcome: Result<(), (std::io::ErrorKind, String)>,
+}
 
 impl FieldWrite {
     /// Write `files` (path, contents) in order on another thread.
     fn start(files: Vec<(PathBuf, Vec<u8>)>) -> Self {
-        Self(std::thread::spawn(move || {
+        let thread = std::thread::spawn(move || {
             files
                 .iter()
                 .try_for_each(|(path, bytes)| write_atomic(path, bytes))
-        }))
+        });
+        Self(Arc::new(Mutex::new(WriteState {
+            thread: Some(thread),
+            outcome: Ok(()),
+        })))
     }
 
     /// Wait until every file is in place; the first write's error, if any.
-    pub fn wait(self) -> std::io::Result<()> {
-        self.0
-            .join()
-            .unwrap_or_else(|_| Err(std::io::Error::other("the field writer panicked")))
+    pub fn wait(&self) -> std::io::Result<()> {
+        let mut st = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(t) = st.thread.take() {
+            st.outcome = t
+                .join()
+                .unwrap_or_else(|_| Err(std::io::Error::other("the field writer panicked")))
+                .map_err(|e| (e.kind(), e.to_string()));
+        }
+        st.outcome
+            .clone()
+            .map_err(|(kind, text)| std::io::Error::new(kind, text))
     }
 }
 
@@ -133,13 +153,13 @@ impl<'m> Recorder<'m> {
 
     /// The field files under way, if any: to wait for before anything that lists them
     /// (a checkpoint) is put in place.
-    pub fn take_writing(&mut self) -> Option<FieldWrite> {
-        self.writing.take()
+    pub fn writing(&self) -> Option<FieldWrite> {
+        self.writing.clone()
     }
 
     /// Wait until the field files under way, if any, are written.
     pub fn wait_fields(&mut self) -> std::io::Result<()> {
-        self.writing.take().map_or(Ok(()), FieldWrite::wait)
+        self.writing.take().map_or(Ok(()), |w| w.wait())
     }
 
     /// What a restart needs to continue the history and the .pvd collection.
