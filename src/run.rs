@@ -310,13 +310,17 @@ impl Observer for Progress<'_, '_> {
         if let Some(p) = self.checkpoint.take() {
             p.wait()?;
         }
+        // Before the first step the state is the model's initial one, which a restart
+        // rebuilds from the model: not saved.
+        let initial = end.driver.next_step == 0;
         self.checkpoint = Some(checkpoint::start(
             &self.dir,
             &self.origin,
             end.driver,
             &self.failures,
             &self.rec.state(),
-            end.system.state(),
+            (!initial).then(|| end.system.state()),
+            self.rec.writing(),
         )?);
         if self.stop_after_step == Some(end.driver.next_step) {
             self.stop_now = true;
@@ -424,7 +428,7 @@ pub fn run_file_opts(
             out.display()
         ))
     })?;
-    let (resume, failures) = match saved {
+    let (resume, failures, restarted_from_step) = match saved {
         Some((_, cp)) => {
             // The history goes on with the same columns, or not at all.
             if let Some(r) = cp.recorder.rows.first() {
@@ -442,11 +446,13 @@ pub fn run_file_opts(
                 }
             }
             rec.restore(cp.recorder);
-            (Some((cp.driver, cp.system)), cp.failures)
+            let from = cp.driver.next_step + 1;
+            // Without a saved state (the checkpoint before the first step) the run starts
+            // from the model's initial state, as a fresh run does.
+            (cp.system.map(|s| (cp.driver, s)), cp.failures, Some(from))
         }
-        None => (None, Vec::new()),
+        None => (None, Vec::new(), None),
     };
-    let restarted_from_step = resume.as_ref().map(|(d, _)| d.next_step + 1);
     let model_file = std::fs::canonicalize(path)
         .unwrap_or_else(|_| path.to_path_buf())
         .display()
@@ -477,9 +483,14 @@ pub fn run_file_opts(
             resume,
         },
     );
-    // The last checkpoint's write fails the run as it did when written in place.
+    // The last checkpoint's write, and the last field files', fail the run as they did
+    // when written in place.
     let result = match (obs.checkpoint.take().map(checkpoint::Pending::wait), result) {
         (Some(Err(e)), Ok(_)) => Err(AnalysisError::Output(e)),
+        (_, r) => r,
+    };
+    let result = match (obs.rec.wait_fields(), result) {
+        (Err(e), Ok(_)) => Err(AnalysisError::Output(e)),
         (_, r) => r,
     };
     let mut rec = obs.rec;

@@ -223,6 +223,44 @@ fn interruption_keeps_results_and_restarts() {
     same_outputs(&tmp.join("straight"), &out);
 }
 
+/// Interrupted in its first step, a run leaves the checkpoint written before that step,
+/// which holds no analysis state (the model's initial one, checkpoint format 7): the restart
+/// runs the model from its start and ends with the uninterrupted results, bit for bit.
+#[test]
+fn restart_from_the_initial_checkpoint_reruns_from_the_start() {
+    let tmp = TempDir::new("restart-initial");
+    let model = tmp.join("m.toml");
+    std::fs::write(&model, rc_beam_steps(-0.0003, 2, "")).unwrap();
+    run(
+        tmp.path(),
+        Some(&model),
+        "straight",
+        &RunOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    // Raised before the run: it stops after the first increment of step 1 (of 2).
+    let opts = RunOptions {
+        signal: Some(Arc::new(AtomicUsize::new(2))),
+        ..Default::default()
+    };
+    let e = run(tmp.path(), Some(&model), "cut", &opts, &mut |_| {}).unwrap_err();
+    assert_eq!(e.exit_code(), 130, "{e}");
+    let out = tmp.join("cut");
+    assert_eq!(summary(&out)["resume_step"], 1);
+    let (_, cp) = segfem::results::checkpoint::read(&out).unwrap();
+    assert_eq!(cp.driver.next_step, 0);
+    assert!(cp.system.is_none(), "the initial checkpoint holds no state");
+    let again = RunOptions {
+        restart: true,
+        ..Default::default()
+    };
+    let s = run(tmp.path(), Some(&model), "cut", &again, &mut |_| {}).unwrap();
+    assert_eq!(s.status, "completed");
+    assert_eq!(s.restarted_from_step, Some(1));
+    same_outputs(&tmp.join("straight"), &out);
+}
+
 /// The real thing: SIGINT sent to the `segfem` binary, at a deterministic point. The model
 /// file is a named pipe: the binary installs its signal handlers before it reads the
 /// model, so once its read end is open (our write end's open returns) the signal is

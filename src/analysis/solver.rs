@@ -177,6 +177,11 @@ impl Prepermuted {
     }
 }
 
+/// Systems from this many equations on are analysed on a thread of their own
+/// ([`SparseCholesky::in_background`]): below, the analysis takes a few milliseconds and
+/// the thread and the pattern's copy would cost as much.
+pub const BACKGROUND_MIN_EQUATIONS: usize = 50_000;
+
 /// Factor values from this many on (≈ 1e5 equations of a plane mesh) are allocated and their
 /// pages touched on a thread of their own while the caller assembles the matrix.
 const TOUCH_AHEAD_VALUES: usize = 4_000_000;
@@ -262,11 +267,30 @@ pub struct SparseCholesky {
     /// Factor values and scratch being allocated and touched on another thread (large
     /// factors, see [`Storage`]); taken into `l_values` and `mem` before they are used.
     pending: Option<std::thread::JoinHandle<Result<Storage, SolverError>>>,
+    /// The whole analysis running on another thread ([`SparseCholesky::in_background`]):
+    /// until it is joined, `symbolic` is a stand-in of order 1 and `stats` are empty.
+    analysis: Option<std::thread::JoinHandle<Result<SparseCholesky, SolverError>>>,
     factor: Factor,
     /// Negative pivots of the last successful factorisation (0 after LLᵀ).
     pub negative_pivots: usize,
     /// Accumulated timings.
     pub stats: SolverStats,
+}
+
+impl Drop for SparseCholesky {
+    /// A large factor is released on a thread of its own: returning 0.5 GB of pages to the
+    /// kernel took ~0.1–0.2 s at 5e5 equations, which the caller (writing results) need not
+    /// wait for.
+    fn drop(&mut self) {
+        if self.l_values.len() >= TOUCH_AHEAD_VALUES {
+            let l_values = std::mem::take(&mut self.l_values);
+            let mem = std::mem::replace(
+                &mut self.mem,
+                MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+            );
+            std::thread::spawn(move || drop((l_values, mem)));
+        }
+    }
 }
 
 impl SparseCholesky {
@@ -283,6 +307,48 @@ impl SparseCholesky {
         order: Option<&[usize]>,
     ) -> Result<Self, SolverError> {
         Self::build(pattern, FACTOR_KIND, order)
+    }
+
+    /// As [`SparseCholesky::with_ordering`], the analysis of a large system (from
+    /// [`BACKGROUND_MIN_EQUATIONS`]) done on a thread of its own, while the caller goes on
+    /// (sets up the states, assembles the matrix); the first factorisation waits for it. At
+    /// 5e5 equations faer's symbolic analysis takes 0.3–0.4 s on one core. Errors of the
+    /// analysis come with that factorisation. Smaller systems are analysed at once.
+    pub fn in_background(
+        pattern: &LowerPattern,
+        order: Option<&[usize]>,
+    ) -> Result<Self, SolverError> {
+        if pattern.n < BACKGROUND_MIN_EQUATIONS {
+            return Self::with_ordering(pattern, order);
+        }
+        let (pattern, order) = (pattern.clone(), order.map(<[usize]>::to_vec));
+        let handle =
+            std::thread::spawn(move || Self::build(&pattern, FACTOR_KIND, order.as_deref()));
+        let stand_in = LowerPattern {
+            n: 1,
+            col_ptr: vec![0, 1],
+            row_idx: vec![0],
+        };
+        let mut s = Self::build(&stand_in, FACTOR_KIND, None)?;
+        s.stats = SolverStats::default();
+        s.analysis = Some(handle);
+        Ok(s)
+    }
+
+    /// Wait for an analysis running on another thread, if any, and take it in.
+    fn take_analysis(&mut self) -> Result<(), SolverError> {
+        if let Some(h) = self.analysis.take() {
+            let a = h
+                .join()
+                .map_err(|_| SolverError::Internal("symbolic analysis thread panicked".into()))??;
+            // What the caller set or added meanwhile (the ordering's time, the negative
+            // pivots of a restored run) is kept.
+            let (before, negative_pivots) = (std::mem::take(&mut self.stats), self.negative_pivots);
+            *self = a;
+            self.stats.symbolic_s += before.symbolic_s;
+            self.negative_pivots = negative_pivots;
+        }
+        Ok(())
     }
 
     /// As [`SparseCholesky::new`], choosing simplicial or supernodal factorisation by
@@ -349,6 +415,7 @@ impl SparseCholesky {
             l_values,
             mem,
             pending,
+            analysis: None,
             factor: Factor::None,
             negative_pivots: 0,
             stats,
@@ -406,6 +473,7 @@ impl SparseCholesky {
 
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
+        self.take_analysis()?;
         if self.prepermute_due && self.stats.factorisations > 0 {
             self.prepermute(pattern)?;
         }

@@ -35,7 +35,7 @@ pub fn run_with(
         .iter()
         .map(|c| load_vector(model, c))
         .collect();
-    let mut solver = SparseCholesky::with_ordering(&sys.asm.pattern, sys.ordering.as_deref())
+    let mut solver = SparseCholesky::in_background(&sys.asm.pattern, sys.ordering.as_deref())
         .map_err(|e| mechanism(&sys, e))?;
     // The ordering is part of the symbolic analysis, wherever it is computed.
     solver.stats.symbolic_s += sys.ordering_s;

@@ -5,6 +5,16 @@ use std::path::Path;
 
 /// Write `bytes` to `path` atomically (a reader sees the old file or the new one, never a part).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic_after(path, bytes, || Ok(()))
+}
+
+/// As [`write_atomic`], the file put in place only once `ready` has returned (e.g. other
+/// files it refers to are written); an error of `ready` leaves the old file.
+pub fn write_atomic_after(
+    path: &Path,
+    bytes: &[u8],
+    ready: impl FnOnce() -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let name = path
         .file_name()
@@ -18,7 +28,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
     }
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+    ready()
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
 }

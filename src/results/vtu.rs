@@ -3,6 +3,7 @@
 
 use base64::Engine;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::fmt::Write;
 
 /// A data array for a .vtu file.
@@ -25,12 +26,13 @@ pub enum Array<'a> {
     },
 }
 
-/// The geometry of a .vtu piece: points and cells (VTK node order and type ids).
-pub struct Grid<'a> {
+/// The geometry of a .vtu piece: points and cells (VTK node order and type ids). A cell is
+/// anything that lists its points (`Vec<usize>`, or `&[usize]` borrowed from the model).
+pub struct Grid<'a, C: AsRef<[usize]> = Vec<usize>> {
     /// Point coordinates (x, y); z is written as 0.
     pub points: &'a [[f64; 2]],
     /// Cell connectivity (0-based point indices).
-    pub cells: &'a [Vec<usize>],
+    pub cells: &'a [C],
     /// VTK cell type per cell.
     pub types: &'a [u8],
 }
@@ -72,6 +74,48 @@ fn text(out: &mut Vec<u8>, args: std::fmt::Arguments) {
     let _ = out.write_fmt(args);
 }
 
+/// The little-endian bytes of `v`: the values' own memory on a little-endian machine (no
+/// copy: at 5e5 dofs the .vtu arrays are 70 MB), a converted copy elsewhere.
+#[cfg(target_endian = "little")]
+fn le_bytes<T: LittleEndian>(v: &[T]) -> Cow<'_, [u8]> {
+    // SAFETY: `T` is a plain number type (f64, i32 or i64: no padding, every byte
+    // initialised), the slice covers exactly the values' memory, and u8 has alignment 1.
+    Cow::Borrowed(unsafe {
+        std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v))
+    })
+}
+
+#[cfg(not(target_endian = "little"))]
+fn le_bytes<T: LittleEndian>(v: &[T]) -> Cow<'_, [u8]> {
+    Cow::Owned(v.iter().flat_map(|x| x.le()).collect())
+}
+
+/// The number types written into .vtu arrays.
+trait LittleEndian: Copy {
+    /// Little-endian bytes of one value.
+    #[allow(dead_code)]
+    fn le(self) -> Vec<u8>;
+}
+
+impl LittleEndian for f64 {
+    fn le(self) -> Vec<u8> {
+        self.to_le_bytes().to_vec()
+    }
+}
+
+impl LittleEndian for i32 {
+    fn le(self) -> Vec<u8> {
+        self.to_le_bytes().to_vec()
+    }
+}
+
+impl LittleEndian for i64 {
+    fn le(self) -> Vec<u8> {
+        self.to_le_bytes().to_vec()
+    }
+}
+
+#[cfg(test)]
 fn f64_bytes(v: &[f64]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
@@ -89,17 +133,16 @@ fn write_array(out: &mut Vec<u8>, a: &Array) {
                     r#"<DataArray type="Float64" Name="{name}" NumberOfComponents="{components}" format="binary">"#
                 ),
             );
-            b64_block(out, &f64_bytes(values));
+            b64_block(out, &le_bytes(values));
         }
         Array::I32 { name, values } => {
-            let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
             text(
                 out,
                 format_args!(
                     r#"<DataArray type="Int32" Name="{name}" NumberOfComponents="1" format="binary">"#
                 ),
             );
-            b64_block(out, &bytes);
+            b64_block(out, &le_bytes(values));
         }
     }
     out.extend_from_slice(b"</DataArray>\n");
@@ -107,9 +150,9 @@ fn write_array(out: &mut Vec<u8>, a: &Array) {
 
 /// Bytes of the base64 blocks of `point_data` and `cell_data` and the grid, for reserving
 /// the document at once (an estimate: the tags are not counted).
-fn estimated_len(grid: &Grid, arrays: &[&Array]) -> usize {
+fn estimated_len<C: AsRef<[usize]>>(grid: &Grid<C>, arrays: &[&Array]) -> usize {
     let b64 = |bytes: usize| (4 + bytes).div_ceil(3) * 4 + 200;
-    let cells: usize = grid.cells.iter().map(Vec::len).sum();
+    let cells: usize = grid.cells.iter().map(|c| c.as_ref().len()).sum();
     let data: usize = arrays
         .iter()
         .map(|a| match a {
@@ -121,7 +164,11 @@ fn estimated_len(grid: &Grid, arrays: &[&Array]) -> usize {
 }
 
 /// Render a .vtu document.
-pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String {
+pub fn render<C: AsRef<[usize]>>(
+    grid: &Grid<C>,
+    point_data: &[Array],
+    cell_data: &[Array],
+) -> String {
     let all: Vec<&Array> = point_data.iter().chain(cell_data).collect();
     let mut s = Vec::with_capacity(estimated_len(grid, &all));
     s.extend_from_slice("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<UnstructuredGrid>\n".as_bytes());
@@ -144,21 +191,21 @@ pub fn render(grid: &Grid, point_data: &[Array], cell_data: &[Array]) -> String 
         },
     );
     s.extend_from_slice(b"</Points>\n<Cells>\n");
-    let conn: Vec<u8> = grid
+    let conn: Vec<i64> = grid
         .cells
         .iter()
-        .flatten()
-        .flat_map(|&n| (n as i64).to_le_bytes())
+        .flat_map(|c| c.as_ref().iter().map(|&n| n as i64))
         .collect();
     let mut off = 0i64;
-    let offsets: Vec<u8> = grid
+    let offsets: Vec<i64> = grid
         .cells
         .iter()
-        .flat_map(|c| {
-            off += c.len() as i64;
-            off.to_le_bytes()
+        .map(|c| {
+            off += c.as_ref().len() as i64;
+            off
         })
         .collect();
+    let (conn, offsets) = (le_bytes(&conn), le_bytes(&offsets));
     for (head, bytes) in [
         (
             &br#"<DataArray type="Int64" Name="connectivity" format="binary">"#[..],
@@ -243,6 +290,19 @@ mod tests {
             );
             assert_eq!(String::from_utf8(out).unwrap(), expected, "{len} bytes");
         }
+    }
+
+    /// The arrays' bytes are their values' little-endian bytes, for every type written.
+    #[test]
+    fn array_bytes_are_little_endian() {
+        let f = [1.5, -2.0, f64::MIN_POSITIVE];
+        assert_eq!(&*le_bytes(&f), &f64_bytes(&f)[..]);
+        let i = [1i32, -7, i32::MAX];
+        let ib: Vec<u8> = i.iter().flat_map(|x| x.to_le_bytes()).collect();
+        assert_eq!(&*le_bytes(&i), &ib[..]);
+        let l = [3i64, -1, i64::MIN];
+        let lb: Vec<u8> = l.iter().flat_map(|x| x.to_le_bytes()).collect();
+        assert_eq!(&*le_bytes(&l), &lb[..]);
     }
 
     /// The binary block decodes to a little-endian byte count followed by the data.
