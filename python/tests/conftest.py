@@ -2,12 +2,19 @@
 
 import os
 import shutil
+import signal
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
+
+# The Ctrl-C tests send SIGINT and expect Python's KeyboardInterrupt. Python installs that
+# handler only if SIGINT was not ignored when it started, and a shell without job control
+# starts background commands (`.ci/run &`, nohup) with SIGINT ignored: restore it here.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")
