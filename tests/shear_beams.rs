@@ -141,9 +141,9 @@ fn oa1_rankine_cut_off_removes_stress_locking() {
 /// The mean inclined crack spacing of the beams by the CEB-FIP MC90 formula
 /// (`beam_bench::crack_spacing`) against a hand calculation from the data of beams.csv:
 /// OA1 (d = 461.3 mm, x = 160.9 mm, h_ef = (h − x)/3 = 130.4 mm, ρ_ef = 6.04 %,
-/// φ = 27.7 mm, s_x = 85.1 mm, no stirrups) s_45 = √2 s_x = 120.3 mm; B1 (x = 179.8 mm,
-/// ρ_ef = 8.45 %, s_x = 60.8 mm; D5 stirrups, φ = 6.40 mm, ρ_w = 0.148 %, s_y = 801 mm)
-/// s_45 = 79.9 mm. Tolerance 0.1 mm (the hand values' rounding).
+/// φ = 27.7 mm, s_x = 85.1 mm, no stirrups) s_45 = √2 s_x = 120.3 mm; B1 (its M25 layer
+/// with E_s = 210 GPa: x = 181.2 mm, ρ_ef = 8.48 %, s_x = 60.6 mm; D5 stirrups, φ = 6.40 mm,
+/// ρ_w = 0.148 %, s_y = 801 mm) s_45 = 79.6 mm. Tolerance 0.1 mm (the hand values' rounding).
 #[test]
 fn crack_spacing_of_the_beams_follows_mc90() {
     use segfem::materials::concrete::beam_bench::crack_spacing;

@@ -119,12 +119,10 @@ impl super::ElementResponse for ContinuumElement<'_> {
         let (f, k) = (into.f, into.k);
         // The small-strain and total Lagrangian responses take the same arguments.
         let (kind, integration, respond): (_, _, ResponseFn) = match self.formulation {
-            Formulation::SmallStrain { kind, integration } => (kind, integration, response_blocks),
-            Formulation::TotalLagrangian { kind, integration } => (
-                kind,
-                integration,
-                super::total_lagrangian::response_tl_blocks,
-            ),
+            Formulation::SmallStrain { kind, integration } => (kind, integration, response_at),
+            Formulation::TotalLagrangian { kind, integration } => {
+                (kind, integration, super::total_lagrangian::response_tl)
+            }
             Formulation::IncompatibleModes => {
                 super::incompatible::response_at(
                     c,
@@ -265,6 +263,7 @@ pub fn response_with_time(
         out,
         time,
         &[],
+        NodeBlocks::ALL,
     )
 }
 
@@ -290,45 +289,10 @@ pub(crate) fn gauss_geometry(
 /// As [`response_with_time`]; the tangent is formed only when `k` is given (a residual
 /// check or a stress recovery needs forces and stresses alone). `imposed` holds the
 /// stress-free normal strain θ of each Gauss point (empty: none): the material sees
-/// ε − θ (1, 1, 0), the output keeps the total strain ε.
+/// ε − θ (1, 1, 0), the output keeps the total strain ε. Only the node blocks `blocks` of
+/// the tangent are formed (the others are zero; [`NodeBlocks::ALL`]: all).
 #[allow(clippy::too_many_arguments)]
 pub fn response_at(
-    kind: QuadKind,
-    integration: Integration,
-    coords: &[[f64; 2]],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-) -> Result<(), UpdateError> {
-    response_blocks(
-        kind,
-        integration,
-        coords,
-        thickness,
-        mat,
-        committed,
-        u,
-        f,
-        k,
-        trial,
-        out,
-        time,
-        imposed,
-        NodeBlocks::ALL,
-    )
-}
-
-/// As [`response_at`], forming only the node blocks `blocks` of the tangent (the others
-/// are zero).
-#[allow(clippy::too_many_arguments)]
-pub fn response_blocks(
     kind: QuadKind,
     integration: Integration,
     coords: &[[f64; 2]],

@@ -46,45 +46,10 @@ pub fn displacement_gradient(dn: &[[f64; 2]], u: &[f64], n: usize) -> [[f64; 2];
 
 /// As [`super::continuum::response_at`] with the total Lagrangian kinematics: internal force
 /// `f` [N] and (if `k` is given) tangent `k` [N/m] at the nodal displacements `u` [m]; the
-/// Gauss outputs hold E [-] and S [Pa].
+/// Gauss outputs hold E [-] and S [Pa]. Only the node blocks `blocks` of the tangent are
+/// formed (the others are zero; see [`NodeBlocks`]).
 #[allow(clippy::too_many_arguments)]
 pub fn response_tl(
-    kind: QuadKind,
-    integration: Integration,
-    coords: &[[f64; 2]],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-) -> Result<(), UpdateError> {
-    response_tl_blocks(
-        kind,
-        integration,
-        coords,
-        thickness,
-        mat,
-        committed,
-        u,
-        f,
-        k,
-        trial,
-        out,
-        time,
-        imposed,
-        NodeBlocks::ALL,
-    )
-}
-
-/// As [`response_tl`], forming only the node blocks `blocks` of the tangent (the others
-/// are zero; see [`NodeBlocks`]).
-#[allow(clippy::too_many_arguments)]
-pub fn response_tl_blocks(
     kind: QuadKind,
     integration: Integration,
     coords: &[[f64; 2]],
@@ -269,6 +234,7 @@ mod tests {
             &mut out,
             &TimeContext::default(),
             &[],
+            NodeBlocks::ALL,
         )
         .unwrap();
         (f, k, out)
@@ -304,9 +270,9 @@ mod tests {
                         (committed.clone(), vec![GaussOutput::default(); ngp]);
                     let (mut f, mut k) = (vec![0.0; nd], vec![7.0; nd * nd]);
                     let respond = if tl {
-                        response_tl_blocks
+                        response_tl
                     } else {
-                        crate::elements::continuum::response_blocks
+                        crate::elements::continuum::response_at
                     };
                     respond(
                         kind,
@@ -429,6 +395,7 @@ mod tests {
                 &mut out,
                 &TimeContext::default(),
                 &[],
+                NodeBlocks::ALL,
             )
             .unwrap();
             assert!((out[0].strain[0] - (c - 1.0)).abs() < 1e-12);
@@ -463,6 +430,7 @@ mod tests {
                 &mut out,
                 &TimeContext::default(),
                 &[],
+                NodeBlocks::ALL,
             )
             .unwrap();
             let fmax = fl.iter().fold(0.0f64, |m, v| m.max(v.abs()));
