@@ -698,6 +698,19 @@ fn box_beam_vtu_files_are_complete() {
         // Points, 3 cell arrays, 5 point arrays, and at least the 3 continuum cell-data
         // arrays (region, stress, strain; concrete state arrays may follow).
         assert!(n_arrays >= 12, "{f}: {n_arrays} arrays");
+        // The box beam is elastic: no point can crack or crush, so no concrete state arrays.
+        for name in [
+            "cracks",
+            "crack_angle",
+            "crack_normal",
+            "plastic_strain",
+            "crushed",
+        ] {
+            assert!(
+                !arrays.contains_key(&format!("CellData/{name}")),
+                "{f}: elastic model wrote CellData/{name}"
+            );
+        }
         let f64s = |key: &str| -> Vec<f64> {
             arrays[key]
                 .chunks(8)
@@ -717,11 +730,13 @@ fn box_beam_vtu_files_are_complete() {
             arrays["Cells/types"].iter().all(|&t| t == 23),
             "{f}: Q8 is VTK type 23"
         );
-        let offsets: Vec<i64> = arrays["Cells/offsets"]
-            .chunks(8)
-            .map(|b| i64::from_le_bytes(b.try_into().unwrap()))
+        // Int32 indices (the mesh is far below 2³¹ points).
+        let offsets: Vec<i32> = arrays["Cells/offsets"]
+            .chunks(4)
+            .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
             .collect();
-        assert_eq!(offsets.last(), Some(&(8 * n_cells as i64)));
+        assert_eq!(offsets.len(), n_cells);
+        assert_eq!(offsets.last(), Some(&(8 * n_cells as i32)));
         // The vertical reactions of all nodes balance the applied load of that increment:
         // W + 2 × 1 kN × Q. 1e-6 relative: equilibrium to the solver residual plus round-off.
         let q = h.column("factor:Q")[k];

@@ -425,7 +425,6 @@ impl<'m> Recorder<'m> {
         let cs = flat(&f.cell_stress);
         let ce = flat(&f.cell_strain);
         let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
-        let st = cell_states(snap);
         let mut reaction = vec![0.0; 3 * model.nodes.len()];
         for s in &model.supports {
             for &(n, d, _) in &s.dofs {
@@ -433,21 +432,75 @@ impl<'m> Recorder<'m> {
                 reaction[3 * n + d.index()] = snap.f_int[k] - snap.f_ext[k];
             }
         }
-        // Unit normal of the widest crack of each cell, as a vector for ParaView glyphs
-        // (zero for uncracked cells); crack_angle holds the same in degrees from x.
-        let crack_normal: Vec<f64> = st
-            .angle
-            .iter()
-            .zip(&st.cracks)
-            .flat_map(|(deg, n)| {
-                let t = deg.to_radians();
-                if *n > 0 {
-                    [t.cos(), t.sin(), 0.0]
-                } else {
-                    [0.0; 3]
-                }
-            })
-            .collect();
+        // The concrete state per cell only where a material can crack or crush: an elastic
+        // model's zeros would be a fifth of a large .vtu.
+        let concrete = (super::gauss_points::wanted(model)).then(|| {
+            let st = cell_states(snap);
+            // Unit normal of the widest crack of each cell, as a vector for ParaView glyphs
+            // (zero for uncracked cells); crack_angle holds the same in degrees from x.
+            let crack_normal: Vec<f64> = st
+                .angle
+                .iter()
+                .zip(&st.cracks)
+                .flat_map(|(deg, n)| {
+                    let t = deg.to_radians();
+                    if *n > 0 {
+                        [t.cos(), t.sin(), 0.0]
+                    } else {
+                        [0.0; 3]
+                    }
+                })
+                .collect();
+            (st, crack_normal)
+        });
+        let mut cell_data = vec![
+            Array::I32 {
+                name: "region",
+                values: &region,
+            },
+            Array::F64 {
+                name: "stress",
+                components: 3,
+                values: &cs,
+            },
+            Array::F64 {
+                name: "strain",
+                components: 3,
+                values: &ce,
+            },
+        ];
+        if let Some((st, crack_normal)) = &concrete {
+            cell_data.extend([
+                Array::I32 {
+                    name: "cracks",
+                    values: &st.cracks,
+                },
+                Array::F64 {
+                    name: "crack_angle",
+                    components: 1,
+                    values: &st.angle,
+                },
+                Array::F64 {
+                    name: "crack_strain",
+                    components: 1,
+                    values: &st.crack_strain,
+                },
+                Array::F64 {
+                    name: "crack_normal",
+                    components: 3,
+                    values: crack_normal,
+                },
+                Array::F64 {
+                    name: "plastic_strain",
+                    components: 1,
+                    values: &st.plastic,
+                },
+                Array::I32 {
+                    name: "crushed",
+                    values: &st.crushed,
+                },
+            ]);
+        }
         let doc = render(
             &Grid {
                 points: &model.nodes,
@@ -481,50 +534,7 @@ impl<'m> Recorder<'m> {
                     values: &ne,
                 },
             ],
-            &[
-                Array::I32 {
-                    name: "region",
-                    values: &region,
-                },
-                Array::F64 {
-                    name: "stress",
-                    components: 3,
-                    values: &cs,
-                },
-                Array::F64 {
-                    name: "strain",
-                    components: 3,
-                    values: &ce,
-                },
-                Array::I32 {
-                    name: "cracks",
-                    values: &st.cracks,
-                },
-                Array::F64 {
-                    name: "crack_angle",
-                    components: 1,
-                    values: &st.angle,
-                },
-                Array::F64 {
-                    name: "crack_strain",
-                    components: 1,
-                    values: &st.crack_strain,
-                },
-                Array::F64 {
-                    name: "crack_normal",
-                    components: 3,
-                    values: &crack_normal,
-                },
-                Array::F64 {
-                    name: "plastic_strain",
-                    components: 1,
-                    values: &st.plastic,
-                },
-                Array::I32 {
-                    name: "crushed",
-                    values: &st.crushed,
-                },
-            ],
+            &cell_data,
         );
         let tag = field_tag(model, snap.step);
         let name = format!("{tag}_inc{:04}.vtu", snap.increment);

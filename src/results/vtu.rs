@@ -191,30 +191,33 @@ pub fn render<C: AsRef<[usize]>>(
         },
     );
     s.extend_from_slice(b"</Points>\n<Cells>\n");
-    let conn: Vec<i64> = grid
-        .cells
-        .iter()
-        .flat_map(|c| c.as_ref().iter().map(|&n| n as i64))
-        .collect();
-    let mut off = 0i64;
-    let offsets: Vec<i64> = grid
-        .cells
-        .iter()
-        .map(|c| {
-            off += c.as_ref().len() as i64;
-            off
-        })
-        .collect();
-    let (conn, offsets) = (le_bytes(&conn), le_bytes(&offsets));
+    // Int32 indices whenever they fit (every mesh this program can hold in memory): half
+    // the bytes of Int64 for the largest arrays of a big mesh; ParaView reads both.
+    let n_conn: usize = grid.cells.iter().map(|c| c.as_ref().len()).sum();
+    let narrow = grid.points.len() <= i32::MAX as usize && n_conn <= i32::MAX as usize;
+    let conn = grid.cells.iter().flat_map(|c| c.as_ref().iter().copied());
+    let ends = grid.cells.iter().scan(0usize, |end, c| {
+        *end += c.as_ref().len();
+        Some(*end)
+    });
+    let (conn, offsets, ty): (Vec<u8>, Vec<u8>, _) = if narrow {
+        (
+            conn.flat_map(|n| (n as i32).to_le_bytes()).collect(),
+            ends.flat_map(|n| (n as i32).to_le_bytes()).collect(),
+            "Int32",
+        )
+    } else {
+        (
+            conn.flat_map(|n| (n as i64).to_le_bytes()).collect(),
+            ends.flat_map(|n| (n as i64).to_le_bytes()).collect(),
+            "Int64",
+        )
+    };
+    let conn_head = format!(r#"<DataArray type="{ty}" Name="connectivity" format="binary">"#);
+    let off_head = format!(r#"<DataArray type="{ty}" Name="offsets" format="binary">"#);
     for (head, bytes) in [
-        (
-            &br#"<DataArray type="Int64" Name="connectivity" format="binary">"#[..],
-            &conn[..],
-        ),
-        (
-            br#"<DataArray type="Int64" Name="offsets" format="binary">"#,
-            &offsets,
-        ),
+        (conn_head.as_bytes(), &conn[..]),
+        (off_head.as_bytes(), &offsets[..]),
         (
             br#"<DataArray type="UInt8" Name="types" format="binary">"#,
             grid.types,
