@@ -490,9 +490,9 @@ impl<'m> System<'m> {
         let model = self.model;
         let mut sc = Scatter {
             asm: &self.asm,
-            f_int: vec![0.0; u.len()],
-            f_abs: vec![0.0; u.len()],
-            k_values: tangent.then(|| vec![0.0; self.asm.pattern.nnz()]),
+            f_int: crate::fem::assembly::zeroed_values(u.len()),
+            f_abs: crate::fem::assembly::zeroed_values(u.len()),
+            k_values: tangent.then(|| crate::fem::assembly::zeroed_values(self.asm.pattern.nnz())),
             symmetrised: false,
         };
         let numbers = &self.numbers;
