@@ -10,7 +10,7 @@
 //! with the 8-byte FNV-1a digest of everything before it: a damaged file (a flipped bit, a
 //! truncated copy) is refused instead of restarting from a silently different state.
 
-use super::atomic::write_atomic_after;
+use super::atomic::write_atomic_with_tail;
 use super::recorder::{FieldWrite, RecorderState};
 use crate::analysis::failure::FailureReport;
 use crate::analysis::state::{DriverState, SystemState, SystemStateRef};
@@ -150,14 +150,22 @@ pub fn start(
         recorder,
         system,
     };
-    let mut bytes = postcard::to_extend(&body, bytes).map_err(std::io::Error::other)?;
+    let bytes = postcard::to_extend(&body, bytes).map_err(std::io::Error::other)?;
     LAST_LEN.store(bytes.len() + CHECKSUM_BYTES, Ordering::Relaxed);
     let path = dir.join(FILE);
     Ok(Pending(std::thread::spawn(move || {
-        let sum = digest(&bytes);
-        bytes.extend(sum.to_le_bytes());
-        // Written beside the field files, renamed into place after them.
-        write_atomic_after(&path, &bytes, || after.map_or(Ok(()), |w| w.wait()))
+        std::thread::scope(|s| {
+            // The checksum (byte-serial, ~80 ms at 57 MB) on a thread of its own while the
+            // bytes are written, appended after them.
+            let sum = s.spawn(|| digest(&bytes));
+            let tail = || {
+                sum.join()
+                    .map(|d| d.to_le_bytes().to_vec())
+                    .map_err(|_| std::io::Error::other("the checkpoint digest panicked"))
+            };
+            // Written beside the field files, renamed into place after them.
+            write_atomic_with_tail(&path, &bytes, tail, || after.map_or(Ok(()), |w| w.wait()))
+        })
     })))
 }
 
