@@ -420,6 +420,9 @@ pub struct SolverControls {
     pub max_iterations: usize,
     /// Maximum number of times an increment may be halved.
     pub max_cuts: usize,
+    /// Start of the Newton iterations of an increment of a displacement-controlled or
+    /// instantaneous load step.
+    pub predictor: Predictor,
     /// Print every Newton iteration's residual and energy norms to standard error
     /// (set by `segfem run --verbose`, not by the model file).
     pub verbose: bool,
@@ -432,9 +435,21 @@ impl Default for SolverControls {
             energy_tolerance: 1e-12,
             max_iterations: 25,
             max_cuts: 6,
+            predictor: Predictor::LastConverged,
             verbose: false,
         }
     }
+}
+
+/// Where the Newton iterations of an increment start (`[solver] predictor`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Predictor {
+    /// From the last converged displacements (the tangent predictor alone); the default.
+    LastConverged,
+    /// From the last converged displacements plus the last increment of the same step,
+    /// scaled to the length of this one (linear extrapolation of the path); an increment
+    /// retried after a failed attempt starts from the last converged state.
+    Extrapolated,
 }
 
 /// A named joint material (contact law parameters).

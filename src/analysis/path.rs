@@ -9,7 +9,7 @@ use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
-use crate::model::{ArcLengthControl, PathControl, Step, StepKind};
+use crate::model::{ArcLengthControl, PathControl, Predictor, Step, StepKind};
 use std::time::Instant;
 
 /// The analysis state a path-following step works on (owned by `steps::run`).
@@ -209,13 +209,22 @@ fn displacement_step(
     let last_move = (ctx.sys.u[c0] - ctx.sys.u_prev[c0]).abs();
     let full = (value - v0).abs();
     let mut prev_size: Option<f64> = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
+    // Whether the last attempt failed: its retry starts from the last converged state.
+    let mut retry = false;
     while level < 1.0 - 1e-12 {
         let target = (level + d_level).min(1.0);
         let shift = (value - v0) * target;
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
         ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
-        match newton_controlled(ctx, &f_ext, &ctl, shift) {
+        // Path extrapolation from the last increment of this step ([`Predictor`]).
+        let extrapolate = (ctx.sys.model.controls.predictor == Predictor::Extrapolated
+            && increment > 0
+            && !retry)
+            .then(|| prev_size.map(|p| (target - level) / p))
+            .flatten();
+        match newton_controlled(ctx, &f_ext, &ctl, shift, extrapolate) {
             Ok((f_int, iterations)) => {
+                retry = false;
                 let u = ctx.u.clone();
                 ctx.sys.commit(&u);
                 prev_size = Some(target - level);
@@ -241,6 +250,7 @@ fn displacement_step(
             Err(f) => {
                 ctx.u.copy_from_slice(&ctx.sys.u);
                 ctx.sys.unlatch();
+                retry = true;
                 if cuts >= ctx.sys.model.controls.max_cuts {
                     return Err(not_converged(ctx, si, increment + 1, target, cuts, &f));
                 }
@@ -264,17 +274,23 @@ struct Controlled {
 /// Newton with the controlled dofs driven to v0 + `shift`: their equations are removed from
 /// the system (rows and columns zeroed, diagonals kept) and their increments imposed; the
 /// first iteration moves the other dofs by −K_fq Δ (tangent predictor), so the controlled
-/// nodes are not pushed alone. Returns the converged internal forces and the iterations.
+/// nodes are not pushed alone. With `extrapolate = Some(r)` the iterations start from the
+/// last converged displacements plus r × the last increment (Δ is then what remains of the
+/// controlled move). Returns the converged internal forces and the iterations.
 fn newton_controlled(
     ctx: &mut PathContext,
     f_ext: &[f64],
     ctl: &[Controlled],
     shift: f64,
+    extrapolate: Option<f64>,
 ) -> Result<(Vec<f64>, usize), NewtonFailure> {
     let controls = ctx.sys.model.controls.clone();
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
     let mut u = ctx.u.clone();
+    if let Some(r) = extrapolate {
+        ctx.sys.extrapolate(&mut u, r);
+    }
     let mut last: Option<Correction> = None;
     for it in 0..=controls.max_iterations {
         let Residual {
@@ -328,13 +344,13 @@ fn newton_controlled(
         if it == 0 {
             // rhs_i = r_i − Σ_q K_iq Δ_q for the free i; rhs_q = K_qq Δ_q.
             for k_ in ctl {
-                let delta = k_.v0 + shift - ctx.u[k_.c];
+                let delta = k_.v0 + shift - u[k_.c];
                 for &(j, pos) in &k_.row_pos {
                     rf[j] -= k[pos] * delta;
                 }
             }
             for k_ in ctl {
-                let delta = k_.v0 + shift - ctx.u[k_.c];
+                let delta = k_.v0 + shift - u[k_.c];
                 rf[k_.q] = k[p.col_ptr[k_.q]] * delta;
             }
         }

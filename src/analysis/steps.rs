@@ -13,7 +13,7 @@ use super::state::DriverState;
 use super::system::System;
 use super::time::{Pair, PairStart};
 use crate::materials::point::TimeContext;
-use crate::model::{Model, Step, StepKind, DEFAULT_START_DAY};
+use crate::model::{Model, Predictor, Step, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
 
 /// Run all steps of the model, reporting to `obs`. Returns the timings.
@@ -209,6 +209,13 @@ fn load_step(
     let tolerance = step.time.and_then(|t| t.tolerance);
     let min_pair = d_level / 1024.0;
     let mut pair = Pair::Probe;
+    // Path extrapolation ([`Predictor`]) in instantaneous load steps only: time steps keep
+    // their error-controlled substeps as they are.
+    let extrapolating = step.kind == StepKind::Load
+        && step.time.is_none()
+        && model.controls.predictor == Predictor::Extrapolated;
+    // Whether the last attempt failed: its retry starts from the last converged state.
+    let mut retry = false;
     while level < 1.0 - 1e-12 {
         let target = pair.target(level, d_level);
         let lam: Vec<f64> = start
@@ -237,6 +244,9 @@ fn load_step(
         });
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
         ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
+        if let (true, false, true, Some(p)) = (extrapolating, retry, increment > 0, prev_size) {
+            ctx.sys.extrapolate(ctx.u, (target - level) / p);
+        }
         match newton(
             ctx.sys,
             ctx.solver,
@@ -287,6 +297,7 @@ fn load_step(
                 discard_trial(ctx);
             }
             Ok((f_int, iterations)) => {
+                retry = false;
                 if let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) {
                     // An accepted pair: the next one as long as the error allows.
                     d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);
@@ -347,6 +358,7 @@ fn load_step(
                 // Throw the trial state away and retry with half the increment (a failed
                 // half of a substep pair: a new pair from the level reached).
                 discard_trial(ctx);
+                retry = true;
                 if let Some(rep) = rep {
                     return Err(AnalysisError::NotConverged(Box::new(rep)));
                 }

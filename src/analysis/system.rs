@@ -706,6 +706,16 @@ impl<'m> System<'m> {
         self.families.commit();
     }
 
+    /// Add `ratio` × the last converged increment (u − u_prev) to the free dofs of `u` [m]:
+    /// the extrapolated start of the next increment ([`crate::model::Predictor`]).
+    pub fn extrapolate(&self, u: &mut [f64], ratio: f64) {
+        for (d, &q) in self.dofs.eq.iter().enumerate() {
+            if q != CONSTRAINED {
+                u[d] += ratio * (self.u[d] - self.u_prev[d]);
+            }
+        }
+    }
+
     /// Gather the free-equation part of a full dof vector (zero on the equations a
     /// construction stage holds).
     pub fn to_free(&self, full: &[f64]) -> Vec<f64> {

@@ -322,6 +322,7 @@ pub struct SolverIn {
     pub energy_tolerance: Option<f64>,
     pub max_iterations: Option<usize>,
     pub max_cuts: Option<usize>,
+    pub predictor: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -6,7 +6,7 @@ use crate::elements::continuum::Integration;
 use crate::input::error::Ctx;
 use crate::input::limits;
 use crate::input::schema::{AnalysisIn, SolverIn};
-use crate::model::{Geometry, Model};
+use crate::model::{Geometry, Model, Predictor};
 
 /// `[analysis] geometry`: linear (default) or nonlinear (total Lagrangian).
 pub(super) fn geometry(ctx: &Ctx, analysis: Option<&AnalysisIn>, model: &mut Model) -> R<()> {
@@ -67,6 +67,20 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
                 ));
             }
             c.max_cuts = v;
+        }
+        if let Some(v) = sv.predictor.as_deref() {
+            c.predictor = match v {
+                "extrapolated" => Predictor::Extrapolated,
+                "last_converged" => Predictor::LastConverged,
+                o => {
+                    return Err(ctx.err(
+                        "solver.predictor",
+                        format!(
+                            "unknown predictor '{o}' (expected extrapolated or last_converged)"
+                        ),
+                    ))
+                }
+            };
         }
     }
     Ok(())
