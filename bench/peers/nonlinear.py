@@ -10,7 +10,8 @@ yield and peak load) with their difference from segfem's.
     python3 bench/peers/nonlinear.py                       # panel and beam, 3 rounds
     python3 bench/peers/nonlinear.py --only beam --rounds 2 --refine 1
 
-OOFEM is not in it yet (docs/performance.md, "Not done").
+OOFEM runs through its Python module from the inputs of bench/peers/oofem_beam.py
+(--oofem-law fcm | idm1 | rcsd; --programs to leave a peer out).
 
 Problems (docs/performance.md, "Nonlinear side by side", lists every difference of laws):
   panel  Vecchio-Collins PV19 (890 mm, 70 mm thick, f_c 19 MPa, rho_x 1.79 % f_y 458 MPa,
@@ -42,6 +43,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import peers  # noqa: E402  (timed(), segfem_bin(), VENV_PY, WORK, CPU_TIMES)
+import oofem_beam  # noqa: E402  (the OOFEM inputs)
 
 # ---------------------------------------------------------------------------------------
 # Panel PV19 (validation/panels/panels.csv)
@@ -433,6 +435,21 @@ def run_opensees(path):
                 data=[tuple(r) for r in res["rows"]], completed=res["completed"])
 
 
+def run_oofem(files, parse):
+    """OOFEM through its Python module (bench/peers/oofem_beam.py writes the input). Its
+    NRSolver here has no cut-back: a step that reaches maxiter is accepted unconverged
+    (counted as `unconverged`); a material's fatal error ends the process (`completed`
+    False, the steps written up to there are kept)."""
+    path, info = files
+    wall, rss, out, err = peers.timed([peers.VENV_PY, path.name], path.parent, ok=range(-64, 256))
+    cpu = peers.CPU_TIMES[-1]
+    per, unconv = oofem_beam.nr_iterations(out + err, info["maxiter"])
+    rows = parse(path.parent, info)
+    done = "TIMES setup" in out and info.get("done", lambda rows: True)(rows)
+    return dict(wall=wall, cpu=cpu, rss=rss, iterations=sum(per), increments=len(rows), data=rows,
+                completed=done, unconverged=unconv)
+
+
 def bench(name, runners, rounds, answers):
     res = {p: [] for p in runners}
     for k in range(rounds):
@@ -449,6 +466,8 @@ def bench(name, runners, rounds, answers):
         its = rs[-1]["iterations"]
         ans = answers(rs[-1]["data"])
         extra = "" if rs[-1].get("completed", True) else " (stopped early)"
+        if rs[-1].get("unconverged"):
+            extra += f" ({rs[-1]['unconverged']} steps accepted unconverged)"
         lines.append(
             f"| {name} | {p}{extra} | {wall:.2f} | {cpu:.2f} | {len(rs)} | {rs[-1]['increments']} | {its} | "
             f"{1e3 * wall / its:.1f} | {1e3 * cpu / its:.1f} | {max(r['rss'] for r in rs) / 2**20:.0f} | "
@@ -466,6 +485,10 @@ def main():
     ap.add_argument("--panel-n", type=int, default=1, help="panel mesh n x n Q4 (OpenSees' RCPS stops at first cracking on n > 1: a uniform panel cracks everywhere at once)")
     ap.add_argument("--refine", type=int, default=1, help="beam mesh refinement (1 = the example)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
+    ap.add_argument("--programs", default="segfem,OpenSees,OOFEM", help="which programs (segfem always runs: the reference)")
+    ap.add_argument("--oofem-law", default="fcm", help="OOFEM concrete of the beam and panel: fcm, idm1, rcsd (oofem_beam.py)")
+    ap.add_argument("--oofem-beta", type=float, default=None, help="constant shear retention of OOFEM's fcm (default: segfem's law tabulated)")
+    ap.add_argument("--oofem-maxiter", type=int, default=30)
     args = ap.parse_args()
     table = [
         "| problem | program | wall [s] (median) | CPU [s] (median) | runs | increments | Newton iterations | wall per iteration [ms] | CPU per iteration [ms] | peak memory [MiB] | answers (difference from segfem) |",
@@ -473,12 +496,16 @@ def main():
     ]
     dump = {}
     only = args.only.split(",")
+    progs = args.programs.split(",")
     if "panel" in only:
         files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}")
+        ofiles = oofem_beam.write_panel(peers.WORK / f"nl_panel_{args.panel_n}" / "oofem", args.oofem_law)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], panel_answers_segfem),
             "OpenSees": lambda: run_opensees(files["OpenSees"]),
+            "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_panel),
         }
+        runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs"
         lines, res = bench(name, runners, args.rounds, panel_answers)
         table += lines
@@ -487,10 +514,15 @@ def main():
     if "beam" in only:
         files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}")
         nodes, _, _, _ = beam_mesh(args.refine)
+        ofiles = oofem_beam.write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}" / "oofem", args.oofem_law,
+                                       beta=args.oofem_beta, maxiter=args.oofem_maxiter)
+        ofiles[1]["done"] = lambda rows: bool(rows) and rows[-1][0] <= -0.024 * (1 - 1e-6)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], beam_rows_segfem),
             "OpenSees": lambda: run_opensees(files["OpenSees"]),
+            "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_beam),
         }
+        runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs"
         lines, res = bench(name, runners, args.rounds, beam_answers)
         table += lines
