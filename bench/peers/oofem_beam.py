@@ -60,9 +60,11 @@ pb.checkProblemConsistency(); pb.setRenumberFlag()
 t1 = time.perf_counter()
 dof = pb.giveDomain(1).giveDofManager({node}).giveDofWithID(oofem.DofIDItem.D_v)
 done = False
+hist = []
 for ims in range(1, {nmsteps} + 1):
     ms = pb.giveMetaStep(ims)
     pb.initMetaStepAttributes(ms)
+    dl = {dls!r}[ims - 1]
     for j in range(ms.giveNumberOfSteps()):
         pb.preInitializeNextStep()
         ts = pb.giveNextStep()
@@ -73,7 +75,14 @@ for ims in range(1, {nmsteps} + 1):
         pb.updateYourself(ts)
         pb.terminate(ts)
         u = dof.giveUnknown(oofem.ValueModeType.VM_Total, ts)
+        hist.append(u)
         if u <= {stop!r}:
+            done = True
+            break
+        # Stalled: 20 steps that together moved the plate less than one step length of
+        # the metastep (arc-length restarts down to tiny steps, no way past).
+        if len(hist) > 20 and hist[-21] - u < dl:
+            print('STALLED at', u, flush=True)
             done = True
             break
     if done:
@@ -107,10 +116,16 @@ def concrete_record(law, h, beta=None):
         return f"idm1 1 {base} e0 {ftm / E!r} gf {gf!r} equivstraintype 1 damlaw 0"
     if law == "rcsd":
         return f"rcsd 1 {base} Gf {gf!r} ft {ftm!r} sdtransitioncoeff 0.5"
+    if law == "cdpm2":
+        # ConcreteDPM2 (Grassl et al. 2013; input name con2dpm), 3D damage-plasticity, plane
+        # stress by OOFEM's iteration on the 3D law: yield from kinit = 0.3 f_cm (segfem's
+        # initial_yield_ratio), exponential tension softening sigma = f_t exp(-w/w_f) with
+        # w_f = G_f/f_t (the same G_f), crack band of the element.
+        return f"con2dpm 1 {base} fc {fcm!r} ft {ftm!r} wf {gf / ftm!r} stype 2 kinit 0.3"
     raise ValueError(law)
 
 
-def write_beam(r, d, law="fcm", beta=None, maxiter=30, stiffmode=1, rtolf=1e-4, control="calm", restarts=8):
+def write_beam(r, d, law="fcm", beta=None, maxiter=30, stiffmode=1, rtolf=1e-3, control="calm", restarts=8, stop_mm=24.0):
     """Write d/beam.in and d/run.py; return (run.py, info for parse_beam).
 
     control "direct": the plate node's displacement prescribed by a time function
@@ -192,7 +207,8 @@ def write_beam(r, d, law="fcm", beta=None, maxiter=30, stiffmode=1, rtolf=1e-4, 
     if control == "direct":
         (d / "run.py").write_text(RUN_PY.format(inp="beam.in"))
     else:
-        (d / "run.py").write_text(RUN_STEPS_PY.format(inp="beam.in", node=ctrl + 1, nmsteps=2, stop=-0.024 * (1 - 1e-9)))
+        (d / "run.py").write_text(RUN_STEPS_PY.format(inp="beam.in", node=ctrl + 1, nmsteps=2, stop=-stop_mm / 1e3 * (1 - 1e-9),
+                                                        dls=[0.0005 / 25, 0.0235 / 120]))
     return d / "run.py", dict(ctrl=ctrl + 1, mid=mid + 1, bottom=bottom, out="beam.out", maxiter=maxiter, control=control)
 
 
@@ -287,6 +303,8 @@ def write_panel(d, law="fcm", steps=200, stiffmode=1):
         conc = f"concretefcm 1 d 0. talpha 0. E {E!r} n 0.2 Gf {gf!r} ft {ftm!r} softtype 1 {shear} ncracks 2 multiplecrackshear"
     elif law == "rcsd":
         conc = f"rcsd 1 d 0. talpha 0. E {E!r} n 0.2 Gf {gf!r} ft {ftm!r} sdtransitioncoeff 0.5"
+    elif law == "cdpm2":
+        conc = f"con2dpm 1 d 0. talpha 0. E {E!r} n 0.2 fc {fc!r} ft {ftm!r} wf {gf / ftm!r} stype 2 kinit 0.3"
     else:
         conc = f"idm1 1 d 0. talpha 0. E {E!r} n 0.2 e0 {ftm / E!r} gf {gf!r} equivstraintype 1 damlaw 0"
     ax, ay = PV["rx"] * t * L / 2, PV["ry"] * t * L / 2
@@ -331,7 +349,7 @@ Set 7 nodes 1 4
 """
     (d / "panel.in").write_text(text)
     (d / "run.py").write_text(RUN_PY.format(inp="panel.in"))
-    return d / "run.py", dict(out="panel.out", L=L)
+    return d / "run.py", dict(out="panel.out", L=L, maxiter=60)
 
 
 def parse_panel(d, info):
