@@ -53,7 +53,7 @@ PV = dict(L=0.89, t=0.07, fc=19.0e6, rx=0.0179, fyx=458e6, ry=0.0071, fyy=299e6,
 PANEL_STOP = 0.02  # shear strain (corner ux / L) that ends the run in both programs
 
 
-def write_panel(n, d):
+def write_panel(n, d, crack="rotating"):
     d.mkdir(parents=True, exist_ok=True)
     L, t = PV["L"], PV["t"]
     nodes = [f"[{L * i / n!r}, {L * j / n!r}]" for j in range(n + 1) for i in range(n + 1)]
@@ -69,8 +69,7 @@ def write_panel(n, d):
 name = "c"
 kind = "concrete"
 fcm = {PV['fc']!r}
-crack_model = "rotating"
-compression_reduction = "vecchio_collins_1993"
+{'crack_model = "rotating"' + chr(10) + 'compression_reduction = "vecchio_collins_1993"' if crack == "rotating" else 'crack_model = "fixed"'}
 [[materials]]
 name = "sx"
 kind = "rebar"
@@ -492,6 +491,8 @@ def main():
     ap.add_argument("--only", default="panel,beam")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--panel-n", type=int, default=1, help="panel mesh n x n Q4 (OpenSees' RCPS stops at first cracking on n > 1: a uniform panel cracks everywhere at once)")
+    ap.add_argument("--panel-crack", default="rotating",
+                    help="segfem's panel concrete: rotating (+ VC93 compression softening, the panel series' best) or fixed (seed beta, OOFEM's ConcreteFCM counterpart)")
     ap.add_argument("--refine", type=int, default=1, help="beam mesh refinement (1 = the example)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
     ap.add_argument("--programs", default="segfem,OpenSees,OOFEM", help="which programs (segfem always runs: the reference)")
@@ -511,7 +512,7 @@ def main():
     only = args.only.split(",")
     progs = args.programs.split(",")
     if "panel" in only:
-        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}")
+        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack)
         ofiles = oofem_beam.write_panel(peers.WORK / f"nl_panel_{args.panel_n}" / "oofem", args.oofem_law)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], panel_answers_segfem),
