@@ -1,29 +1,32 @@
 #!/usr/bin/env python3
 """OOFEM counterparts of the problems of bench/peers/nonlinear.py (issue 21 item 1).
 
-beam  examples/rc-beam.toml: the same Q8 mesh (`qplanestress2d`), IsoLE for the elastic
-      regions, the bars and stirrups as `truss2d` elements with `MisesMat` (linear
-      hardening as segfem's E_t) on the mesh nodes (as in the OpenSees model), the plate's
-      displacement prescribed through a piecewise-linear time function (direct control,
-      `NonLinearStatic controlmode 1`, 25 + 120 steps as the example). The concrete is one
-      of (--law):
+beam  examples/rc-beam.toml: the same Q8 mesh (`qplanestress2d`, nip 9 = segfem's 3 x 3),
+      IsoLE for the elastic regions, the bars and stirrups as `truss2d` elements with
+      `MisesMat` (linear hardening as segfem's E_t) on the mesh nodes (as in the OpenSees
+      model). Control (write_beam's docstring): arc length on the plate node's u_y with
+      restarts (default; Python drives the steps and stops at the plate displacement of
+      the other programs or when the run stalls), or the displacement prescribed (direct).
+      The concrete is one of (--oofem-law of nonlinear.py):
         fcm   ConcreteFCM (OOFEM's fixed orthogonal cracks), exponential softening with
               segfem's f_tm and G_f, shear retention beta(w) tabulated from segfem's
               Cervenka law beta = 1 - (eps/0.005)^0.075 with w = h eps (sheartype 3), or
-              a constant beta (--beta, sheartype 1).
+              a constant beta (sheartype 1).
         idm1  isotropic damage, smooth Rankine equivalent strain (tension only drives
               damage), exponential cohesive softening with G_f (crack band of the element).
         rcsd  rotating crack with scalar damage (RCM2/RCSD), linear softening with G_f.
-      No compression nonlinearity in any of them (segfem's beam does not crush on this
-      mesh; its compression plasticity from 0.3 f_cm is the difference).
+        cdpm2 ConcreteDPM2 (damage-plasticity, yield from 0.3 f_cm as segfem's).
+      Only cdpm2 has compression nonlinearity. Every one stalls at 0.38-0.42 mm, at the
+      first flexural cracks (docs/performance.md, "Nonlinear side by side with OOFEM").
 panel PV19 (nonlinear.py): one `planestress2d` Q4 of the panel, the smeared steel as
       `truss2d` bars along the element's edges (each edge bar half of rho t L: under the
       panel's uniform strain they strain as the smeared steel would), the edge shear as
       nodal forces, arc length with displacement control of the corner (CALM, hpc).
 
 OOFEM's NRSolver in this wheel (2.6.0.dev1) has no cut-back: a step that does not converge
-in maxiter iterations is accepted as it is (the run counts and reports such steps); a
-material's local failure (OOFEM_ERROR) ends the process.
+in maxiter iterations is accepted as it is (the run counts and reports such steps); its
+arc length (CALM) restarts a failed step with a quarter of its length. A material's local
+failure (OOFEM_ERROR) ends the process.
 
     python3 bench/peers/oofem_beam.py beam 1 fcm && cd bench/peers/work/oofem_beam_1_fcm && \\
         ../../.venv/bin/python run.py
