@@ -10,7 +10,8 @@ yield and peak load) with their difference from segfem's.
     python3 bench/peers/nonlinear.py                       # panel and beam, 3 rounds
     python3 bench/peers/nonlinear.py --only beam --rounds 2 --refine 1
 
-OOFEM is not in it yet (docs/performance.md, "Not done").
+OOFEM runs through its Python module from the inputs of bench/peers/oofem_beam.py
+(--oofem-law fcm | idm1 | rcsd; --programs to leave a peer out).
 
 Problems (docs/performance.md, "Nonlinear side by side", lists every difference of laws):
   panel  Vecchio-Collins PV19 (890 mm, 70 mm thick, f_c 19 MPa, rho_x 1.79 % f_y 458 MPa,
@@ -42,6 +43,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import peers  # noqa: E402  (timed(), segfem_bin(), VENV_PY, WORK, CPU_TIMES)
+import oofem_beam  # noqa: E402  (the OOFEM inputs)
 
 # ---------------------------------------------------------------------------------------
 # Panel PV19 (validation/panels/panels.csv)
@@ -51,7 +53,7 @@ PV = dict(L=0.89, t=0.07, fc=19.0e6, rx=0.0179, fyx=458e6, ry=0.0071, fyy=299e6,
 PANEL_STOP = 0.02  # shear strain (corner ux / L) that ends the run in both programs
 
 
-def write_panel(n, d):
+def write_panel(n, d, crack="rotating"):
     d.mkdir(parents=True, exist_ok=True)
     L, t = PV["L"], PV["t"]
     nodes = [f"[{L * i / n!r}, {L * j / n!r}]" for j in range(n + 1) for i in range(n + 1)]
@@ -67,8 +69,7 @@ def write_panel(n, d):
 name = "c"
 kind = "concrete"
 fcm = {PV['fc']!r}
-crack_model = "rotating"
-compression_reduction = "vecchio_collins_1993"
+{'crack_model = "rotating"' + chr(10) + 'compression_reduction = "vecchio_collins_1993"' if crack == "rotating" else 'crack_model = "fixed"'}
 [[materials]]
 name = "sx"
 kind = "rebar"
@@ -285,7 +286,9 @@ def asd_laws(h):
     return te, ts, td, ce, cs
 
 
-def write_beam(r, d, implex=True):
+def write_beam(r, d, implex=True, stop_mm=24.0):
+    """The beam to 24 mm (the example), or only its first `stop_mm` <= 0.5 mm (the first
+    step's 0.02 mm increments: elastic start and first cracking, where OOFEM gets to)."""
     d.mkdir(parents=True, exist_ok=True)
     text = (peers.REPO / "examples" / "rc-beam.toml").read_text()
     # Same output policy as the peer (final state only), the control point's displacement
@@ -295,6 +298,13 @@ def write_beam(r, d, implex=True):
     text = text.replace('rows = 10 }, { region = "top_band", depth = 0.03, rows = 1 }',
                         f'rows = {10 * r} }}, {{ region = "top_band", depth = 0.03, rows = {r} }}')
     text += '\n[[monitors]]\nname = "control_uy"\nkind = "displacement"\npoint = [1.1, 0.53]\ncomponent = "y"\n'
+    if stop_mm < 24.0:
+        n1 = round(stop_mm / 0.02)
+        assert n1 <= 25 and abs(n1 * 0.02 - stop_mm) < 1e-9, "stop_mm: a multiple of 0.02 up to 0.5"
+        head, tail = text.split('[[steps]]\nname = "to_failure"')
+        tail = tail[tail.index("\n[solver]"):]
+        text = head.replace("value = -0.0005 }\nincrements = 25", f"value = {-stop_mm / 1e3!r} }}\nincrements = {n1}") + tail
+        assert f"increments = {n1}" in text
     (d / "segfem.toml").write_text(text)
 
     nodes, elems, idx, (nx, ny_b, ny) = beam_mesh(r)
@@ -377,7 +387,7 @@ def run(total, n):
         if abs(du) < abs(du0):
             du *= 2
     return True
-okk = run(-0.0005, 25) and run(-0.0235, 120)
+okk = {'run(-0.0005, 25) and run(-0.0235, 120)' if stop_mm >= 24.0 else f'run({-stop_mm / 1e3!r}, {round(stop_mm / 0.02)})'}
 t2 = time.perf_counter()
 json.dump({{'rows': rows, 'iterations': iters, 'failed_attempts': fails, 'completed': okk,
            'increments': len(rows), 'setup_s': t1 - t0, 'analysis_s': t2 - t1}}, open('opensees_result.json', 'w'))
@@ -433,6 +443,21 @@ def run_opensees(path):
                 data=[tuple(r) for r in res["rows"]], completed=res["completed"])
 
 
+def run_oofem(files, parse):
+    """OOFEM through its Python module (bench/peers/oofem_beam.py writes the input). Its
+    NRSolver here has no cut-back: a step that reaches maxiter is accepted unconverged
+    (counted as `unconverged`); a material's fatal error ends the process (`completed`
+    False, the steps written up to there are kept)."""
+    path, info = files
+    wall, rss, out, err = peers.timed([peers.VENV_PY, path.name], path.parent, ok=range(-64, 256))
+    cpu = peers.CPU_TIMES[-1]
+    per, unconv = oofem_beam.nr_iterations(out + err, info["maxiter"])
+    rows = parse(path.parent, info)
+    done = "TIMES setup" in out and info.get("done", lambda rows: True)(rows)
+    return dict(wall=wall, cpu=cpu, rss=rss, iterations=sum(per), increments=len(rows), data=rows,
+                completed=done, unconverged=unconv)
+
+
 def bench(name, runners, rounds, answers):
     res = {p: [] for p in runners}
     for k in range(rounds):
@@ -449,6 +474,8 @@ def bench(name, runners, rounds, answers):
         its = rs[-1]["iterations"]
         ans = answers(rs[-1]["data"])
         extra = "" if rs[-1].get("completed", True) else " (stopped early)"
+        if rs[-1].get("unconverged"):
+            extra += f" ({rs[-1]['unconverged']} steps accepted unconverged)"
         lines.append(
             f"| {name} | {p}{extra} | {wall:.2f} | {cpu:.2f} | {len(rs)} | {rs[-1]['increments']} | {its} | "
             f"{1e3 * wall / its:.1f} | {1e3 * cpu / its:.1f} | {max(r['rss'] for r in rs) / 2**20:.0f} | "
@@ -464,8 +491,18 @@ def main():
     ap.add_argument("--only", default="panel,beam")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--panel-n", type=int, default=1, help="panel mesh n x n Q4 (OpenSees' RCPS stops at first cracking on n > 1: a uniform panel cracks everywhere at once)")
+    ap.add_argument("--panel-crack", default="rotating",
+                    help="segfem's panel concrete: rotating (+ VC93 compression softening, the panel series' best) or fixed (seed beta, OOFEM's ConcreteFCM counterpart)")
     ap.add_argument("--refine", type=int, default=1, help="beam mesh refinement (1 = the example)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
+    ap.add_argument("--programs", default="segfem,OpenSees,OOFEM", help="which programs (segfem always runs: the reference)")
+    ap.add_argument("--oofem-law", default="fcm", help="OOFEM concrete of the beam and panel: fcm, idm1, rcsd (oofem_beam.py)")
+    ap.add_argument("--oofem-beta", type=float, default=None, help="constant shear retention of OOFEM's fcm (default: segfem's law tabulated)")
+    ap.add_argument("--oofem-maxiter", type=int, default=30)
+    ap.add_argument("--oofem-rtolf", type=float, default=1e-3,
+                    help="OOFEM's relative force tolerance (its default 1e-3; at 1e-4 its secant iterations stall at 1.5e-4 in the first cracks)")
+    ap.add_argument("--stop-mm", type=float, default=24.0,
+                    help="beam: plate displacement [mm] where all programs stop (24 = the example; <= 0.5: the first 0.02 mm increments)")
     args = ap.parse_args()
     table = [
         "| problem | program | wall [s] (median) | CPU [s] (median) | runs | increments | Newton iterations | wall per iteration [ms] | CPU per iteration [ms] | peak memory [MiB] | answers (difference from segfem) |",
@@ -473,25 +510,35 @@ def main():
     ]
     dump = {}
     only = args.only.split(",")
+    progs = args.programs.split(",")
     if "panel" in only:
-        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}")
+        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack)
+        ofiles = oofem_beam.write_panel(peers.WORK / f"nl_panel_{args.panel_n}" / "oofem", args.oofem_law)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], panel_answers_segfem),
             "OpenSees": lambda: run_opensees(files["OpenSees"]),
+            "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_panel),
         }
+        runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs"
         lines, res = bench(name, runners, args.rounds, panel_answers)
         table += lines
         dump["panel"] = res
         print("\n".join(lines), flush=True)
     if "beam" in only:
-        files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}")
+        files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm)
         nodes, _, _, _ = beam_mesh(args.refine)
+        ofiles = oofem_beam.write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}" / "oofem", args.oofem_law,
+                                       beta=args.oofem_beta, maxiter=args.oofem_maxiter, rtolf=args.oofem_rtolf,
+                                       stop_mm=args.stop_mm)
+        ofiles[1]["done"] = lambda rows: bool(rows) and rows[-1][0] <= -args.stop_mm / 1e3 * (1 - 1e-6)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], beam_rows_segfem),
             "OpenSees": lambda: run_opensees(files["OpenSees"]),
+            "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_beam),
         }
-        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs"
+        runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
+        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm"
         lines, res = bench(name, runners, args.rounds, beam_answers)
         table += lines
         dump["beam"] = res
