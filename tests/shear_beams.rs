@@ -105,13 +105,18 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
 }
 
 /// OA1 with fixed cracks (seed β) and the Rankine tension cut-off
-/// (`principal_stress_limit = "tensile_strength"`, docs/theory-concrete.md §5.5b), coarse
-/// mesh, about 35 s of CPU: no cracked point carries a principal tension above f_tm at an
-/// angle to its crack axes (the cut-off's closed form, round-off 1e-9), and the peak falls
-/// from the seed model's 435 kN (test/predicted 0.76, docs/validation.md) into 0.8–1.2 of
-/// P_u. A known deviation: the run stops by Newton non-convergence soon after the peak
-/// (measured 366 kN, 0.91), so the figure is a lower bound of the model's strength; the
-/// band lets a regression (locking back, ratio < 0.8) and an unexplained change fail.
+/// (`principal_stress_limit = "tensile_strength"`, docs/theory-concrete.md §5.5b), IMPL-EX
+/// as in the bench, coarse mesh, about 12 s of CPU:
+///
+/// * no cracked point carries a principal tension above f_tm at an angle to its crack axes
+///   (the cut-off's closed form, round-off 1e-9);
+/// * the run reaches a limit point ("loss of equilibrium"), not a Newton stall: until
+///   session 14 the cut-off returned its consistent tangent, whose symmetric part is
+///   indefinite, and the run stopped at 319–366 kN on the rising branch ("no convergence");
+/// * the peak, 409.8 kN measured (test/predicted 0.81), within 0.78–0.86: below the
+///   locked model's 435 kN (0.76; the cut-off must lower it) and within ±5 % of the
+///   measured value (the mesh and the data fixed: a change of this size is a change of the
+///   model, not round-off).
 #[test]
 fn oa1_rankine_cut_off_removes_stress_locking() {
     let oa1 = &beam("OA1");
@@ -126,7 +131,7 @@ fn oa1_rankine_cut_off_removes_stress_locking() {
         "OA1 cut-off: {:.1} kN at {:.1} mm, {:?}; {:?}",
         r.p_peak / 1e3,
         r.deflection * 1e3,
-        r.ultimate.as_ref().map(|u| &u.mode),
+        r.ultimate.as_ref().map(|u| (&u.mode, &u.events)),
         r.locking
     );
     assert!(
@@ -134,8 +139,57 @@ fn oa1_rankine_cut_off_removes_stress_locking() {
         "{:?}",
         r.locking
     );
+    assert_eq!(
+        r.ultimate.as_ref().map(|u| u.mode.as_str()),
+        Some("loss of equilibrium")
+    );
     let ratio = oa1.test.0 / r.p_peak;
-    assert!((0.8..1.2).contains(&ratio), "test/predicted {ratio:.3}");
+    assert!((0.78..0.86).contains(&ratio), "test/predicted {ratio:.3}");
+}
+
+/// B1 (stirrups) with the Rankine cut-off, IMPL-EX, coarse mesh, about 13 s of CPU: until
+/// session 14 Newton stalled at 258 kN (the cut-off's indefinite symmetrised tangent); now
+/// the run reaches the limit point by crushing, as the test and the model without the
+/// cut-off: peak within 10 % of P_u (the criterion; 426.0 kN measured, 1.02),
+/// "loss of equilibrium" with concrete crushing among the events, and no cracked point
+/// above f_tm at an angle to its cracks (round-off 1e-9).
+#[test]
+fn b1_rankine_cut_off_reaches_the_measured_peak_by_crushing() {
+    let b1 = &beam("B1");
+    let p_u = b1.test.0;
+    let opts = options();
+    let keys = opts
+        .iter()
+        .find(|o| o.0 == "fixed, seed β, Rankine cut-off")
+        .unwrap()
+        .1;
+    let r = run_beam(b1, keys, 10, -0.02).unwrap();
+    let u = r.ultimate.as_ref().expect("a verdict");
+    eprintln!(
+        "B1 cut-off: {:.1} kN at {:.1} mm, {} {:?}; {:?}",
+        r.p_peak / 1e3,
+        r.deflection * 1e3,
+        u.mode,
+        u.events,
+        r.locking
+    );
+    assert!(
+        (r.p_peak / p_u - 1.0).abs() < 0.10,
+        "peak {:.1} kN vs {:.0} kN",
+        r.p_peak / 1e3,
+        p_u / 1e3
+    );
+    assert_eq!(u.mode, "loss of equilibrium");
+    assert!(
+        u.events.iter().any(|e| e.0 == "concrete crushing"),
+        "{:?}",
+        u.events
+    );
+    assert!(
+        r.locking.max_ratio_inclined <= 1.0 + 1e-9,
+        "{:?}",
+        r.locking
+    );
 }
 
 /// The mean inclined crack spacing of the beams by the CEB-FIP MC90 formula

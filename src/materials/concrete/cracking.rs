@@ -22,7 +22,9 @@
 //! (non-symmetric) and a negative normal entry on the softening branch.
 //! The tangent is *not* consistent (documented algorithmic choice) where the stress is
 //! identically zero but the residual stiffness is returned, when `secant_crack_tangent` is
-//! set, and in the step in which a crack forms (the regime switch is discontinuous).
+//! set, in the step in which a crack forms (the regime switch is discontinuous), and with
+//! IMPL-EX where the Rankine cut-off is active (the crack laws' tangent is returned there,
+//! [`PrincipalStressLimit::TensileStrength`]).
 
 use super::{compression, ConcreteParams, ConcreteState, MaterialError, UpdateResult};
 
@@ -76,7 +78,9 @@ pub enum PrincipalStressLimit {
     #[default]
     None,
     /// Rankine tension cut-off σ1 ≤ f_tm on the stress of the crack laws
-    /// ([`cap_principal_stress`]).
+    /// ([`cap_principal_stress`]). Tangent: the cut-off's consistent one with implicit crack
+    /// laws; with IMPL-EX the crack laws' own (symmetric, positive) tangent, since the
+    /// symmetric part of the consistent one is indefinite (docs/theory-concrete.md §5.5b).
     TensileStrength,
 }
 
@@ -419,7 +423,14 @@ pub fn update_cracked(
             }
         }
         if p.principal_stress_limit == PrincipalStressLimit::TensileStrength {
-            cap_principal_stress(p.ftm, &mut sl, &mut dl, p.shear.beta_min * g);
+            let free = dl;
+            if cap_principal_stress(p.ftm, &mut sl, &mut dl, p.shear.beta_min * g) && p.implex {
+                // IMPL-EX: the stress is the cut-off's, the tangent the crack laws' (symmetric
+                // and positive in the increment). The cut-off's consistent tangent is
+                // non-symmetric, and the symmetric part the solvers take is indefinite
+                // (docs/theory-concrete.md §5.5b): Newton stalled on the beams with it.
+                dl = free;
+            }
         }
     }
     let (s, d) = to_global(&t, &sl, &dl);

@@ -531,6 +531,87 @@ fn principal_stress_limit_tangent_matches_finite_differences() {
     assert!(checked >= 3, "{checked} states checked");
 }
 
+/// Sylvester's criterion: whether the symmetric part of `d` is positive definite.
+fn symmetric_part_is_positive_definite(d: &[[f64; 3]; 3]) -> bool {
+    let s: [[f64; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (d[i][j] + d[j][i])));
+    let m2 = s[0][0] * s[1][1] - s[0][1] * s[1][0];
+    let m3 = s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1])
+        - s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0])
+        + s[0][2] * (s[1][0] * s[2][1] - s[1][1] * s[2][0]);
+    s[0][0] > 0.0 && m2 > 0.0 && m3 > 0.0
+}
+
+/// The Rankine cut-off with IMPL-EX crack laws (the beams' setting, docs/theory-concrete.md
+/// §5.5b): a crack opened in x by IMPL-EX (the formation increment at 1.1 ε0, then one
+/// increment to 3e-4), then slips γ with strains along the crack ε_t at which the cut-off is
+/// active. At each state:
+///
+/// * the stress is the closed form of the Rankine return of the stress without the limit
+///   (σ1 = f_tm, σ2 and the principal direction unchanged; round-off 1e-9 f_tm);
+/// * the tangent is the crack laws' one — the tangent of the update without the limit, bit
+///   for bit — symmetric and positive definite;
+/// * the reason: the cut-off's consistent tangent at the same state (the return applied to
+///   the stress and tangent without the limit, `cap_principal_stress`, whose consistency is
+///   checked against central differences in the test above) is non-symmetric, and its
+///   symmetric part — what the engine's symmetric solvers take — is indefinite. On the
+///   beams every point on the cut-off had such a tangent and Newton stalled.
+#[test]
+fn principal_stress_limit_with_implex_keeps_the_crack_laws_tangent() {
+    let mut p = params();
+    p.implex = true;
+    let free = p.clone();
+    p.principal_stress_limit = cracking::PrincipalStressLimit::TensileStrength;
+    let e0 = p.eps0();
+    let step = |q: &ConcreteParams, c: &ConcreteState, e: [f64; 3], r: f64| {
+        update_extrapolated(q, c, &e, 0.1, r).unwrap()
+    };
+    let c = step(&p, &ConcreteState::new(), [1.1 * e0, 0.0, 0.0], 0.0).0;
+    assert_eq!(c.n_cracks(), 1);
+    let c = step(&p, &c, [3e-4, 0.0, 0.0], 1.0).0;
+    let g_mod = 0.5 * p.ec / (1.0 + p.nu);
+    let mut checked = 0;
+    for (et, g) in [(0.0, 2e-3), (-2e-4, 3e-3), (5e-5, -1.5e-3), (-1e-3, 4e-3)] {
+        let e = [3.2e-4, et, g];
+        let (_, s0, d0) = step(&free, &c, e, 1.0);
+        let (_, s, d) = step(&p, &c, e, 1.0);
+        if principal_max(&s0).0 <= 1.01 * p.ftm {
+            continue;
+        }
+        checked += 1;
+        // The closed form of the return, and the consistent tangent there.
+        let (mut sc, mut dc) = (s0, d0);
+        assert!(cracking::cap_principal_stress(
+            p.ftm,
+            &mut sc,
+            &mut dc,
+            p.shear.beta_min * g_mod
+        ));
+        for i in 0..3 {
+            assert!(
+                (s[i] - sc[i]).abs() < 1e-9 * p.ftm,
+                "σ {s:?} vs {sc:?} at {e:?}"
+            );
+        }
+        assert!((principal_max(&s).0 - p.ftm).abs() < 1e-9 * p.ftm);
+        assert_eq!(d, d0, "the crack laws' tangent at {e:?}");
+        assert!(symmetric_part_is_positive_definite(&d), "{d:?}");
+        let asym = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| (dc[i][j] - dc[j][i]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            asym > 1e-3 * p.ec,
+            "consistent tangent {dc:?} nearly symmetric"
+        );
+        assert!(
+            !symmetric_part_is_positive_definite(&dc),
+            "symmetric part of {dc:?} positive definite at {e:?}"
+        );
+    }
+    assert!(checked >= 3, "{checked} states with the cut-off active");
+}
+
 /// Compression softening driven by the crack opening smeared over the crack spacing
 /// (`spacing` s_rm, docs/theory-concrete.md §5.3): closed forms, round-off tolerance.
 ///
