@@ -247,15 +247,15 @@ impl<'m> System<'m> {
             || {
                 let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
                 let t_order = std::time::Instant::now();
-                // Nested dissection only on meshes of 4-node elements: with the mid-side
-                // nodes of Q8/Q9 its median lines cut through elements and the separators
-                // double (at 1e6 Q8 dofs the factor grew 55 % over AMD's).
+                // Nested dissection on large systems: on meshes of 4-node elements split
+                // along node coordinates; with Q8/Q9 elements (whose mid-side nodes a line
+                // through the nodes would cut off) split along element edges.
                 let all_q4 = model
                     .elements
                     .iter()
                     .all(|e| e.kind == crate::fem::shape::QuadKind::Q4);
-                let ordering =
-                    (all_q4 && dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
+                let ordering = if all_q4 {
+                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
                         super::ordering::nested_dissection(
                             &asm.node_ptr,
                             &asm.node_adj,
@@ -263,7 +263,19 @@ impl<'m> System<'m> {
                             &dofs.eq,
                             dofs.n_eq,
                         )
-                    });
+                    })
+                } else {
+                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
+                        super::ordering::element_dissection(
+                            &asm.node_ptr,
+                            &asm.node_adj,
+                            &model.nodes,
+                            &elem_nodes[..model.elements.len()],
+                            &dofs.eq,
+                            dofs.n_eq,
+                        )
+                    })
+                };
                 let ordering_s = t_order.elapsed().as_secs_f64();
                 (asm, ordering, ordering_s)
             },
