@@ -1,16 +1,32 @@
-//! Fill-reducing ordering of large systems by nested dissection on the node coordinates.
+//! Fill-reducing ordering of large systems by geometric nested dissection.
 //!
-//! The nodes are split recursively at the median coordinate along the longer side of their
-//! bounding box; the nodes of the lower half that touch the upper half form a vertex
-//! separator, numbered after both halves (George's nested dissection, with a geometric
-//! split in place of a graph partitioner). Both dofs of a node stay together. On segfem's
-//! plane meshes the factor is as sparse as with approximate minimum degree (AMD) or
-//! sparser, and the ordering cheaper: at 1e6 dofs, 21 % fewer factor values and a 1.8×
-//! faster numeric factorisation on a clamped square, 4 % more values and the same time on a
-//! 4:1 banded beam, ordering + symbolic analysis 1.4 s against 2.4 s (docs/performance.md).
-//! It is used from [`ND_MIN_EQUATIONS`] on, on meshes of Q4 elements only: with the
-//! mid-side nodes of Q8/Q9 the median lines cut through elements, the separators double and
-//! the factor was 55 % larger than AMD's at 1e6 dofs. Other systems keep AMD.
+//! George's nested dissection with a geometric split in place of a graph partitioner: a
+//! subdomain is cut in two along the longer side of its bounding box, the vertex separator
+//! between the halves is numbered after both, and each half is dissected in turn. Both
+//! dofs of a node stay together. Two variants:
+//!
+//! - [`nested_dissection`] (meshes of Q4 elements): the nodes are split at their median
+//!   coordinate; the nodes of the lower half that touch the upper half form the separator.
+//!   Subdomains of up to 48 nodes are numbered as they come.
+//! - [`element_dissection`] (meshes with Q8/Q9 elements, or mixed): the continuum elements
+//!   are split at their median centroid, so that the cut runs along element edges; the
+//!   separator is the nodes both halves share (corner and mid-side nodes of the common
+//!   edges), with any lower node coupled to an upper one outside the elements (joints,
+//!   tendons); nodes in no element go by their coordinate. Split down to single elements.
+//!   A median line through the nodes, as in the Q4 variant, cuts through quadratic
+//!   elements: the separators double and the factor was 1.5× AMD's on a Q8 square.
+//!
+//! Against faer's approximate minimum degree (AMD), on segfem's plane meshes the factor is
+//! about as sparse or sparser and the ordering cheaper (docs/performance.md): with Q4 at 1e6
+//! dofs, 21 % fewer factor values and a 1.8× faster numeric factorisation on a clamped
+//! square, 4 % more values and the same time on a 4:1 banded beam; with Q8, 3 % fewer
+//! values on the RC beam refined 5× (49,704 equations), 4–31 % fewer on squares and
+//! 4–25 % fewer on 4:1 banded beams from 2e4 to 5e5 dofs, numeric factorisation
+//! 0.46–0.85× AMD's. Both are used from 20,000 equations ([`ND_MIN_EQUATIONS`],
+//! [`ND_MIN_EQUATIONS_QUADRATIC`]). The element variant wins on every Q8/Q9 mesh measured
+//! from there (and on a 40 × 40 Q8 square of 9,760 equations, by 5 %, see the tests); the
+//! threshold is kept where it is so that smaller systems, all the bundled examples among
+//! them, keep AMD and their results to the bit.
 
 /// Systems of Q4 elements with at least this many equations are ordered by nested
 /// dissection ([`nested_dissection`]).
