@@ -6,7 +6,10 @@ use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
 use crate::analysis::bonded_time::BarPointTime;
 use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
-use crate::elements::continuum::{ContinuumElement, Formulation, GaussOutput, NodeBlocks};
+use crate::elements::continuum::{
+    gauss_geometry, rule_points, ContinuumElement, Formulation, GaussGeometry, GaussOutput,
+    Integration, NodeBlocks,
+};
 use crate::elements::{ElementResponse, Response};
 use crate::materials::point::{PointState, TimeContext, UpdateError};
 use crate::materials::steel::SteelState;
@@ -14,6 +17,50 @@ use crate::model::{Geometry, Model};
 
 /// Element force entries per slot of the chunk buffers (2 per node of the largest element).
 pub(super) const ND: usize = 2 * crate::fem::shape::MAX_NODES;
+
+/// The Gauss-point geometry of every continuum element ([`GaussGeometry`], packed), computed
+/// once: it depends on the undeformed coordinates only, and a nonlinear run assembles
+/// hundreds of times (the geometry was 3–5 % of the run's work). Elements with incompatible
+/// modes keep computing theirs (none stored).
+pub struct GeometryCache {
+    /// Start of each element's values in `data` (elements + 1).
+    offset: Vec<usize>,
+    data: Vec<f64>,
+}
+
+impl GeometryCache {
+    /// The geometry of every continuum element of `model`.
+    pub fn new(model: &Model) -> Self {
+        let stored = |e: &crate::model::Element| {
+            if e.integration == Integration::Incompatible {
+                0
+            } else {
+                rule_points(e.kind, e.integration).len() * (2 * e.nodes.len() + 1) + 1
+            }
+        };
+        let mut offset = Vec::with_capacity(model.elements.len() + 1);
+        offset.push(0);
+        let mut data = Vec::with_capacity(model.elements.iter().map(stored).sum());
+        let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+        for el in &model.elements {
+            if stored(el) > 0 {
+                let n = el.nodes.len();
+                for (a, &node) in el.nodes.iter().enumerate() {
+                    coords[a] = model.nodes[node];
+                }
+                gauss_geometry(el.kind, el.integration, &coords[..n]).pack(n, &mut data);
+            }
+            offset.push(data.len());
+        }
+        Self { offset, data }
+    }
+
+    /// The geometry of element `e` (`n` nodes, `n_pts` Gauss points), if stored.
+    fn get(&self, e: usize, n: usize, n_pts: usize) -> Option<GaussGeometry> {
+        let d = &self.data[self.offset[e]..self.offset[e + 1]];
+        (!d.is_empty()).then(|| GaussGeometry::unpack(d, n, n_pts))
+    }
+}
 
 /// What the continuum elements of one chunk share (read-only).
 pub(super) struct HostChunk<'a> {
@@ -44,6 +91,8 @@ pub(super) struct HostChunk<'a> {
     stages: Option<&'a StageState>,
     /// Tangent blocks each element forms (all elements).
     blocks: &'a [NodeBlocks],
+    /// The elements' Gauss-point geometry, if cached.
+    geometry: Option<&'a GeometryCache>,
 }
 
 /// One element's own trial slices: element index, point states, Gauss outputs, bar steel
@@ -71,6 +120,7 @@ pub(super) fn split_chunk<'a>(
     (start, end): (usize, usize),
     stages: Option<&'a StageState>,
     blocks: &'a [NodeBlocks],
+    geometry: Option<&'a GeometryCache>,
 ) -> (HostChunk<'a>, Vec<HostPiece<'a>>) {
     let g0 = gp_offset[start];
     let g1 = gp_offset[end];
@@ -97,6 +147,7 @@ pub(super) fn split_chunk<'a>(
         bar_imposed: thermal.bars.get(b0..b1).unwrap_or(&[]),
         stages,
         blocks,
+        geometry,
     };
     let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
     // Per-element slices.
@@ -152,6 +203,7 @@ impl HostChunk<'_> {
             bar_imposed,
             stages,
             blocks,
+            geometry,
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -190,6 +242,7 @@ impl HostChunk<'_> {
                 v
             });
         let states = owned.as_deref().unwrap_or(base);
+        let cached = geometry.and_then(|c| c.get(e, nn, t.len()));
         let element = ContinuumElement {
             formulation: Formulation::new(el.kind, el.integration, tl),
             coords,
@@ -198,6 +251,7 @@ impl HostChunk<'_> {
             time,
             imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
             blocks: blocks[e],
+            geometry: cached.as_ref(),
         };
         element.response(
             ue,

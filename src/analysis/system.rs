@@ -75,6 +75,9 @@ pub struct System<'m> {
     elem_buf: (Vec<f64>, Vec<f64>),
     /// The tangent blocks each continuum element forms (those the scatter adds).
     blocks: Vec<crate::elements::continuum::NodeBlocks>,
+    /// The continuum elements' Gauss-point geometry, computed once for a nonlinear run
+    /// (None for a linear one, which assembles twice: not worth the memory).
+    geometry: Option<responses::GeometryCache>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -240,22 +243,27 @@ impl<'m> System<'m> {
             })
             .collect();
         assert_eq!(elem_nodes.len(), numbers.total());
+        let linear = model.materials.iter().all(|m| m.law.is_linear())
+            && model.interfaces.is_empty()
+            && model.bars.is_empty()
+            && model.geometry == Geometry::Linear
+            && !model.staging.is_staged();
         // The pattern and ordering, and beside them the material-point states (≈ 0.15 s
         // of fresh pages at 5e5 dofs): independent, built at once on the two sides of a
         // rayon join.
-        let ((asm, ordering, ordering_s), (gp_offset, points, gauss)) = rayon::join(
+        let ((asm, ordering, ordering_s), (gp_offset, points, gauss, geometry)) = rayon::join(
             || {
                 let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
                 let t_order = std::time::Instant::now();
-                // Nested dissection only on meshes of 4-node elements: with the mid-side
-                // nodes of Q8/Q9 its median lines cut through elements and the separators
-                // double (at 1e6 Q8 dofs the factor grew 55 % over AMD's).
+                // Nested dissection on large systems: on meshes of 4-node elements split
+                // along node coordinates; with Q8/Q9 elements (whose mid-side nodes a line
+                // through the nodes would cut off) split along element edges.
                 let all_q4 = model
                     .elements
                     .iter()
                     .all(|e| e.kind == crate::fem::shape::QuadKind::Q4);
-                let ordering =
-                    (all_q4 && dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
+                let ordering = if all_q4 {
+                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
                         super::ordering::nested_dissection(
                             &asm.node_ptr,
                             &asm.node_adj,
@@ -263,7 +271,19 @@ impl<'m> System<'m> {
                             &dofs.eq,
                             dofs.n_eq,
                         )
-                    });
+                    })
+                } else {
+                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
+                        super::ordering::element_dissection(
+                            &asm.node_ptr,
+                            &asm.node_adj,
+                            &model.nodes,
+                            &elem_nodes[..model.elements.len()],
+                            &dofs.eq,
+                            dofs.n_eq,
+                        )
+                    })
+                };
                 let ordering_s = t_order.elapsed().as_secs_f64();
                 (asm, ordering, ordering_s)
             },
@@ -291,14 +311,10 @@ impl<'m> System<'m> {
                     gp_offset,
                     Staged::new(committed),
                     Staged::new(vec![GaussOutput::default(); n_gp]),
+                    (!linear).then(|| responses::GeometryCache::new(model)),
                 )
             },
         );
-        let linear = model.materials.iter().all(|m| m.law.is_linear())
-            && model.interfaces.is_empty()
-            && model.bars.is_empty()
-            && model.geometry == Geometry::Linear
-            && !model.staging.is_staged();
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
             .iter()
@@ -390,6 +406,7 @@ impl<'m> System<'m> {
             stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
             blocks,
+            geometry,
         }
     }
 
@@ -517,6 +534,7 @@ impl<'m> System<'m> {
                 (start, end),
                 stages,
                 &self.blocks,
+                self.geometry.as_ref(),
             );
             let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
                 if stages.is_some_and(|s| !s.element_acts(p.0)) {

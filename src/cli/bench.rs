@@ -674,6 +674,8 @@ pub struct RcRow {
     pub deflection: f64,
     /// How the run ended ("completed" or the first line of the error).
     pub end: String,
+    /// Solver and assembly figures (zero when the run ended without converging).
+    pub timings: steps::Timings,
 }
 
 /// Counts increments and iterations, follows the control force and the midspan deflection.
@@ -718,8 +720,12 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = RcWatch::default();
+    let mut timings = steps::Timings::default();
     let end = match steps::run(&model, &mut obs) {
-        Ok(_) => "completed".to_string(),
+        Ok(t) => {
+            timings = t;
+            "completed".to_string()
+        }
         Err(e) => e.to_string().lines().next().unwrap_or("").to_string(),
     };
     let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
@@ -733,6 +739,7 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         p_max: obs.p_max,
         deflection: obs.deflection,
         end,
+        timings,
     })
 }
 

@@ -132,18 +132,33 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
     );
     for r in refine {
         match super::bench::rc_case(r) {
-            Ok(x) => outln!(
-                "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>8.2} {:>9.1} {:>9.2}  {}",
-                x.case,
-                x.equations,
-                x.increments,
-                x.iterations,
-                x.total_s,
-                x.cpu_s,
-                x.p_max / 1e3,
-                x.deflection * 1e3,
-                x.end
-            ),
+            Ok(x) => {
+                outln!(
+                    "{:>18} {:>9} {:>5} {:>6} {:>8.2} {:>8.2} {:>9.1} {:>9.2}  {}",
+                    x.case,
+                    x.equations,
+                    x.increments,
+                    x.iterations,
+                    x.total_s,
+                    x.cpu_s,
+                    x.p_max / 1e3,
+                    x.deflection * 1e3,
+                    x.end
+                );
+                let (t, s) = (&x.timings, &x.timings.solver);
+                outln!(
+                    "{:>18} assembly {:.2} s, ordering + symbolic {:.3} s, {} factorisations ({} LDLT) {:.2} s ({:.1} ms each, factor {} values), solves {:.2} s",
+                    "",
+                    t.assembly_s,
+                    s.symbolic_s,
+                    s.factorisations,
+                    s.ldlt_factorisations,
+                    s.numeric_s,
+                    1e3 * s.numeric_s / s.factorisations.max(1) as f64,
+                    s.factor_nnz,
+                    s.solve_s
+                );
+            }
             Err(e) => {
                 eprintln!("error: {e}");
                 return ExitCode::from(3);

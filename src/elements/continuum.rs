@@ -68,8 +68,7 @@ impl Formulation {
 /// The signature of [`response_at`] and the total Lagrangian response.
 type ResponseFn = fn(
     QuadKind,
-    Integration,
-    &[[f64; 2]],
+    &GaussGeometry,
     f64,
     &Material,
     &[PointState],
@@ -101,6 +100,8 @@ pub struct ContinuumElement<'a> {
     pub imposed: &'a [f64],
     /// The node blocks of the tangent to form (the assembly wants one of (a, b), (b, a)).
     pub blocks: NodeBlocks,
+    /// The Gauss-point geometry if already known (a cache; None: computed from `coords`).
+    pub geometry: Option<&'a GaussGeometry>,
 }
 
 impl super::ElementResponse for ContinuumElement<'_> {
@@ -140,10 +141,17 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 return Ok(true);
             }
         };
+        let computed;
+        let geometry = match self.geometry {
+            Some(g) => g,
+            None => {
+                computed = gauss_geometry(kind, integration, c);
+                &computed
+            }
+        };
         respond(
             kind,
-            integration,
-            c,
+            geometry,
             t,
             m,
             committed,
@@ -249,10 +257,25 @@ pub fn response_with_time(
     out: &mut [GaussOutput],
     time: &TimeContext,
 ) -> Result<(), UpdateError> {
+    if integration == Integration::Incompatible {
+        debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
+        return super::incompatible::response_at(
+            coords,
+            thickness,
+            mat,
+            committed,
+            u,
+            f,
+            Some(k),
+            trial,
+            out,
+            time,
+            &[],
+        );
+    }
     response_at(
         kind,
-        integration,
-        coords,
+        &gauss_geometry(kind, integration, coords),
         thickness,
         mat,
         committed,
@@ -267,15 +290,61 @@ pub fn response_with_time(
     )
 }
 
-/// Cartesian shape derivatives and w·det J [m²] at every Gauss point of the rule (first
-/// `n` entries), and the characteristic length h = √(Σ w det J) [m] of the element, which
-/// the material update may need (crack band): computed for all points before any update.
-#[allow(clippy::type_complexity)]
-pub(crate) fn gauss_geometry(
+/// The geometry of an element at its Gauss points: for each point of the rule (first
+/// `n_pts` entries) the Cartesian shape derivatives (∂N/∂x, ∂N/∂y per node) and w·det J [m²],
+/// and the characteristic length h = √(Σ w det J) [m], which the material update may need
+/// (crack band). It depends on the undeformed node coordinates only.
+#[derive(Debug, Clone, Copy)]
+pub struct GaussGeometry {
+    /// Points of the rule.
+    pub n_pts: usize,
+    /// Shape derivatives and w·det J of each point.
+    pub points: [([[f64; 2]; MAX_NODES], f64); 9],
+    /// Characteristic length [m].
+    pub h: f64,
+}
+
+impl GaussGeometry {
+    /// Append the values for an element of `n` nodes to `out` (point by point: derivatives
+    /// then w·det J; h last).
+    pub fn pack(&self, n: usize, out: &mut Vec<f64>) {
+        for (dn, w) in &self.points[..self.n_pts] {
+            for d in &dn[..n] {
+                out.extend_from_slice(d);
+            }
+            out.push(*w);
+        }
+        out.push(self.h);
+    }
+
+    /// The geometry of an element of `n` nodes and `n_pts` points from its packed values
+    /// (the same bits as computed).
+    pub fn unpack(data: &[f64], n: usize, n_pts: usize) -> Self {
+        let mut g = GaussGeometry {
+            n_pts,
+            points: [([[0.0; 2]; MAX_NODES], 0.0); 9],
+            h: data[n_pts * (2 * n + 1)],
+        };
+        for (p, chunk) in g.points[..n_pts]
+            .iter_mut()
+            .zip(data.chunks_exact(2 * n + 1))
+        {
+            for a in 0..n {
+                p.0[a] = [chunk[2 * a], chunk[2 * a + 1]];
+            }
+            p.1 = chunk[2 * n];
+        }
+        g
+    }
+}
+
+/// The Gauss-point geometry of an element of `kind` with nodes at `coords` under the rule
+/// `integration` (computed for all points before any material update).
+pub fn gauss_geometry(
     kind: QuadKind,
     integration: Integration,
     coords: &[[f64; 2]],
-) -> (usize, [([[f64; 2]; MAX_NODES], f64); 9], f64) {
+) -> GaussGeometry {
     let pts = rule_points(kind, integration);
     let mut geo = [([[0.0; 2]; MAX_NODES], 0.0); 9];
     let mut area = 0.0;
@@ -283,19 +352,23 @@ pub(crate) fn gauss_geometry(
         geo[g] = point_derivatives(kind, coords, p);
         area += geo[g].1;
     }
-    (pts.len(), geo, area.sqrt())
+    GaussGeometry {
+        n_pts: pts.len(),
+        points: geo,
+        h: area.sqrt(),
+    }
 }
 
-/// As [`response_with_time`]; the tangent is formed only when `k` is given (a residual
-/// check or a stress recovery needs forces and stresses alone). `imposed` holds the
-/// stress-free normal strain θ of each Gauss point (empty: none): the material sees
-/// ε − θ (1, 1, 0), the output keeps the total strain ε. Only the node blocks `blocks` of
-/// the tangent are formed (the others are zero; [`NodeBlocks::ALL`]: all).
+/// As [`response_with_time`] for an element of `kind` whose Gauss-point geometry (full or
+/// reduced rule) is `geometry` ([`gauss_geometry`]); the tangent is formed only when `k` is
+/// given (a residual check or a stress recovery needs forces and stresses alone). `imposed`
+/// holds the stress-free normal strain θ of each Gauss point (empty: none): the material
+/// sees ε − θ (1, 1, 0), the output keeps the total strain ε. Only the node blocks `blocks`
+/// of the tangent are formed (the others are zero; [`NodeBlocks::ALL`]: all).
 #[allow(clippy::too_many_arguments)]
 pub fn response_at(
     kind: QuadKind,
-    integration: Integration,
-    coords: &[[f64; 2]],
+    geometry: &GaussGeometry,
     thickness: f64,
     mat: &Material,
     committed: &[PointState],
@@ -308,19 +381,13 @@ pub fn response_at(
     imposed: &[f64],
     blocks: NodeBlocks,
 ) -> Result<(), UpdateError> {
-    if integration == Integration::Incompatible {
-        debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
-        return super::incompatible::response_at(
-            coords, thickness, mat, committed, u, f, k, trial, out, time, imposed,
-        );
-    }
     let n = kind.n_nodes();
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);
     if let Some(k) = k.as_deref_mut() {
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
-    let (n_pts, geo, h) = gauss_geometry(kind, integration, coords);
+    let (n_pts, geo, h) = (geometry.n_pts, &geometry.points, geometry.h);
     // Size-dependent material constants once per element (same values as per point).
     let local = crate::materials::point::for_element(mat, h)?;
     let mat = local.as_ref().unwrap_or(mat);

@@ -14,7 +14,7 @@
 //! states is stored and a cut step retries cleanly. The element then returns
 //! f = ∫ Bᵀ σ t dA and the condensed tangent K = K_uu − K_uα K_αα⁻¹ K_αu.
 
-use super::continuum::{gauss_geometry, rule_points, GaussOutput, Integration};
+use super::continuum::{gauss_geometry, rule_points, GaussGeometry, GaussOutput, Integration};
 use crate::fem::shape::{jacobian, QuadKind, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
@@ -129,7 +129,11 @@ pub fn response_at(
     imposed: &[f64],
 ) -> Result<(), UpdateError> {
     let pts = rule_points(QuadKind::Q4, Integration::Full);
-    let (n_pts, geo, h) = gauss_geometry(QuadKind::Q4, Integration::Full, coords);
+    let GaussGeometry {
+        n_pts,
+        points: geo,
+        h,
+    } = gauss_geometry(QuadKind::Q4, Integration::Full, coords);
     let mut gm = [[[0.0; 2]; 2]; 4];
     for g in 0..n_pts {
         gm[g] = mode_derivatives(coords, pts[g].0, pts[g].1);

@@ -14,7 +14,7 @@
 //! - f = ∫ B_Lᵀ S t dA₀; K = ∫ B_Lᵀ D B_L t dA₀ + ∫ (∇N_aᵀ Ŝ ∇N_b) I₂ t dA₀ (the
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
-use super::continuum::{GaussOutput, Integration, NodeBlocks};
+use super::continuum::{GaussOutput, NodeBlocks};
 use crate::fem::shape::QuadKind;
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 
@@ -51,8 +51,7 @@ pub fn displacement_gradient(dn: &[[f64; 2]], u: &[f64], n: usize) -> [[f64; 2];
 #[allow(clippy::too_many_arguments)]
 pub fn response_tl(
     kind: QuadKind,
-    integration: Integration,
-    coords: &[[f64; 2]],
+    geometry: &super::continuum::GaussGeometry,
     thickness: f64,
     mat: &Material,
     committed: &[PointState],
@@ -72,7 +71,7 @@ pub fn response_tl(
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
     // Characteristic length of the undeformed element (strains are referred to it).
-    let (n_pts, geo, h_len) = super::continuum::gauss_geometry(kind, integration, coords);
+    let (n_pts, geo, h_len) = (geometry.n_pts, &geometry.points, geometry.h);
     // Size-dependent material constants once per element (same values as per point).
     let local = crate::materials::point::for_element(mat, h_len)?;
     let mat = local.as_ref().unwrap_or(mat);
@@ -176,7 +175,7 @@ pub fn response_tl(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elements::continuum::{response_at, rule_points};
+    use crate::elements::continuum::{gauss_geometry, response_at, rule_points, Integration};
     use crate::fem::shape::NODE_XI;
 
     const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];
@@ -222,8 +221,7 @@ mod tests {
         let (mut f, mut k) = (vec![0.0; nd], vec![0.0; nd * nd]);
         response_tl(
             kind,
-            Integration::Full,
-            &c,
+            &gauss_geometry(kind, Integration::Full, &c),
             0.3,
             &mat,
             &committed,
@@ -276,8 +274,7 @@ mod tests {
                     };
                     respond(
                         kind,
-                        Integration::Full,
-                        &c,
+                        &gauss_geometry(kind, Integration::Full, &c),
                         0.3,
                         &elastic(),
                         &committed,
@@ -383,8 +380,7 @@ mod tests {
             let mut fl = vec![0.0; nd];
             response_at(
                 kind,
-                Integration::Full,
-                &x,
+                &gauss_geometry(kind, Integration::Full, &x),
                 0.3,
                 &elastic(),
                 &committed,
@@ -418,8 +414,7 @@ mod tests {
             let mut fl = vec![0.0; nd];
             response_at(
                 kind,
-                Integration::Full,
-                &coords(kind),
+                &gauss_geometry(kind, Integration::Full, &coords(kind)),
                 0.3,
                 &elastic(),
                 &committed,
