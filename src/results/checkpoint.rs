@@ -72,8 +72,8 @@ pub struct Checkpoint {
     /// History rows and field-file list so far.
     pub recorder: RecorderState,
     /// The committed analysis state; `None` in the checkpoint written before the first
-    /// step, whose state is the one the model starts from (at 5e5 dofs it spares 57 MB of
-    /// Gauss-point outputs and material points that a restart rebuilds from the model).
+    /// step, whose state is the one the model starts from (at 5e5 dofs it spares the 9 MB
+    /// of displacements and material points that a restart rebuilds from the model).
     pub system: Option<SystemState>,
 }
 
@@ -122,7 +122,7 @@ static LAST_LEN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize
 
 /// Encode the checkpoint now (the state may change once this returns) and digest and write
 /// it into `dir` atomically on another thread: at 5e5 dofs the digest and the write of the
-/// 57 MB took 0.2 s, which then overlap the analysis. [`Pending::wait`] before the next
+/// 57 MB of format 7 took 0.2 s (9 MB since format 8), which then overlap the analysis. [`Pending::wait`] before the next
 /// checkpoint and before the run ends. `after`: field files being written that the
 /// recorder's state lists; the checkpoint is put in place only once they are (their write
 /// error is then the checkpoint's).
