@@ -263,7 +263,18 @@ pub(crate) mod layout {
                             strain: [4.0, 5.0, 6.0],
                         },
                     ]),
-                    gauss: Staged::new(vec![GaussOutput::default(); 3]),
+                    // The elastic point's outputs are not saved (read back as zero).
+                    gauss: Staged::new(vec![
+                        GaussOutput::default(),
+                        GaussOutput {
+                            strain: [1.0, 2.0, 3.0],
+                            stress: [4.0, 5.0, 6.0],
+                        },
+                        GaussOutput {
+                            strain: [7.0, 8.0, 9.0],
+                            stress: [10.0, 11.0, 12.0],
+                        },
+                    ]),
                     holds: Holds::default(),
                 },
                 joints: JointBlock {

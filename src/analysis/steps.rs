@@ -72,6 +72,9 @@ pub fn run_with(
                 )));
             }
             sys.restore(s).map_err(AnalysisError::Restore)?;
+            // The checkpoint leaves the elastic points' outputs out.
+            sys.recover_elastic_outputs(&d.factors)
+                .map_err(AnalysisError::Restore)?;
             solver.negative_pivots = d.solver_negative_pivots;
             timings.increments = d.increments;
             timings.iterations = d.iterations;

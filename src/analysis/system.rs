@@ -619,6 +619,83 @@ impl<'m> System<'m> {
         })
     }
 
+    /// Recompute the committed Gauss outputs of the linear elastic points at the committed
+    /// displacements, with the imposed strains of the load-case `factors` (those the state was
+    /// committed at): a checkpoint leaves them out ([`ContinuumBlock`]). The same element
+    /// routine as the assembly at the committed displacements, so the outputs are the ones
+    /// the run had, bit for bit. Other states are left as they are (their trial copies are
+    /// reset to the committed ones).
+    pub fn recover_elastic_outputs(&mut self, factors: &[f64]) -> Result<(), String> {
+        let model = self.model;
+        let elastic = |e: usize| {
+            let gs = self.gp_offset[e]..self.gp_offset[e + 1];
+            self.families.continuum.points.committed[gs]
+                .iter()
+                .any(super::families::is_elastic)
+        };
+        let n_el = model.elements.len();
+        let which: Vec<bool> = (0..n_el).map(elastic).collect();
+        if !which.contains(&true) {
+            return Ok(());
+        }
+        let thermal = self.thermal.at(factors);
+        let mut buf = std::mem::take(&mut self.elem_buf);
+        let time = self.time;
+        let mut start = 0;
+        while start < n_el {
+            let end = (start + CHUNK).min(n_el);
+            if which[start..end].contains(&true) {
+                let (chunk, pieces) = responses::split_chunk(
+                    model,
+                    &mut self.families,
+                    &self.gp_offset,
+                    &self.bar_gps,
+                    &self.bar_offset,
+                    &thermal,
+                    &self.u,
+                    &time,
+                    false,
+                    (start, end),
+                    self.stages.as_ref(),
+                    &self.blocks,
+                );
+                let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
+                    if !which[p.0] {
+                        return Ok(None);
+                    }
+                    chunk.element(p, fe, ke).map(|()| Some(true))
+                });
+                if let Some((i, Err(err))) = results.into_iter().enumerate().find(|r| r.1.is_err())
+                {
+                    self.elem_buf = buf;
+                    return Err(format!(
+                        "element {}: its Gauss outputs cannot be recomputed: {err}",
+                        start + i + 1
+                    ));
+                }
+            }
+            start = end;
+        }
+        self.elem_buf = buf;
+        let c = &mut self.families.continuum;
+        for ((p, out), trial) in c
+            .points
+            .committed
+            .iter()
+            .zip(c.gauss.committed.iter_mut())
+            .zip(&c.gauss.trial)
+        {
+            if super::families::is_elastic(p) {
+                *out = *trial;
+            }
+        }
+        c.points.revert();
+        c.gauss.revert();
+        self.families.bars.steel.revert();
+        self.families.bars.out.revert();
+        Ok(())
+    }
+
     /// Prestressing operations at the start of step `step`: external tendons assigned to it
     /// are built on the current deformed geometry with their span stresses (post-tensioning
     /// against the concrete as it stands); bonded post-tensioned tendons are locked off or

@@ -67,6 +67,13 @@ impl Thermal {
         !self.cases.is_empty()
     }
 
+    /// A copy with the strains of the load-case `factors`.
+    pub(super) fn at(&self, factors: &[f64]) -> Self {
+        let mut t = self.clone();
+        t.set(factors);
+        t
+    }
+
     /// Set the current strains for the load-case `factors`.
     fn set(&mut self, factors: &[f64]) {
         let Some(first) = self.cases.first() else {
