@@ -658,6 +658,7 @@ impl<'m> System<'m> {
                     (start, end),
                     self.stages.as_ref(),
                     &self.blocks,
+                    self.geometry.as_ref(),
                 );
                 let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
                     if !which[p.0] {
