@@ -24,8 +24,9 @@ const MAGIC: &str = "segfem checkpoint";
 /// fails until it is). 2: trailing checksum; 3: state saved by element family; 4: creep state
 /// of creeping concrete points; 5: tendon spans keep the shared steel state `SteelState`; 6: concrete points without the
 /// IMPL-EX kink side; 7: the system state is optional (absent in the checkpoint written
-/// before the first step, which is the model's initial state).
-const VERSION: u32 = 7;
+/// before the first step, which is the model's initial state); 8: concrete points keep the
+/// softening cut-off's history (`cutoff_max`, `cutoff_max_old`).
+const VERSION: u32 = 8;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -40,6 +41,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (5, 10_812_821_786_394_591_690),
     (6, 17_771_896_231_766_552_362),
     (7, 2_879_888_328_409_885_521),
+    (8, 15_325_971_208_509_099_921),
 ];
 
 #[derive(Serialize, Deserialize)]

@@ -217,6 +217,9 @@ pub fn cap_softening(
     for _ in 0..200 {
         let (f, df) = cap(k);
         let v = p.ec * k + f - s1;
+        if v.abs() <= 1e-13 * p.ftm || (hi - lo) <= 1e-15 * hi {
+            break;
+        }
         if v < 0.0 {
             lo = k;
         } else {
@@ -229,9 +232,6 @@ pub fn cap_softening(
         } else {
             0.5 * (lo + hi)
         };
-        if (hi - lo) <= 1e-15 * hi.abs() || v.abs() <= 1e-13 * p.ftm {
-            break;
-        }
     }
     let (f, df) = cap(k);
     cap_principal_stress_with(f, df / (p.ec + df), sl, dl, k_min);

@@ -569,6 +569,12 @@ impl ConcreteState {
         self.crack_max
     }
 
+    /// Largest inclined cut-off crack strain reached [-] (softening tension cut-off,
+    /// [`cracking::PrincipalStressLimit::Softening`]; 0 without it).
+    pub fn max_cutoff_strain(&self) -> f64 {
+        self.cutoff_max
+    }
+
     /// Equivalent plastic strain [-]: κ of the uncracked plasticity plus the compressive
     /// plastic strains of the crack-axis directions.
     pub fn equivalent_plastic_strain(&self) -> f64 {
