@@ -25,7 +25,8 @@ const MAGIC: &str = "segfem checkpoint";
 /// of creeping concrete points; 5: tendon spans keep the shared steel state `SteelState`; 6: concrete points without the
 /// IMPL-EX kink side; 7: the system state is optional (absent in the checkpoint written
 /// before the first step, which is the model's initial state); 8: no Gauss outputs of linear
-/// elastic points (a restart recomputes them from the displacements).
+/// elastic points (a restart recomputes them from the displacements), and concrete points
+/// keep the softening cut-off's history (`cutoff_max`, `cutoff_max_old`).
 const VERSION: u32 = 8;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
@@ -41,7 +42,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (5, 10_812_821_786_394_591_690),
     (6, 17_771_896_231_766_552_362),
     (7, 2_879_888_328_409_885_521),
-    (8, 18_107_608_555_970_394_015),
+    (8, 13_423_329_791_089_162_975),
 ];
 
 #[derive(Serialize, Deserialize)]

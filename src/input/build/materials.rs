@@ -532,10 +532,11 @@ fn shear_options(ctx: &Ctx, i: usize, m: &MaterialIn, p: &mut ConcreteParams) ->
     p.principal_stress_limit = match m.principal_stress_limit.as_deref() {
         None | Some("none") => PrincipalStressLimit::None,
         Some("tensile_strength") => PrincipalStressLimit::TensileStrength,
+        Some("softening") => PrincipalStressLimit::Softening,
         Some(o) => {
             return Err(ctx.err(
                 k("principal_stress_limit"),
-                format!("unknown value '{o}' (expected none or tensile_strength)"),
+                format!("unknown value '{o}' (expected none, tensile_strength or softening)"),
             ))
         }
     };

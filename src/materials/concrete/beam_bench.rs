@@ -407,6 +407,10 @@ pub fn options() -> Vec<(&'static str, &'static str)> {
             "crack_integration = \"implex\"\nprincipal_stress_limit = \"tensile_strength\"\n",
         ),
         (
+            "fixed, seed β, softening cut-off",
+            "crack_integration = \"implex\"\nprincipal_stress_limit = \"softening\"\n",
+        ),
+        (
             "rotating, VC93",
             "crack_integration = \"implex\"\ncrack_model = \"rotating\"\ncompression_reduction = \"vecchio_collins_1993\"\n",
         ),

@@ -82,6 +82,15 @@ pub enum PrincipalStressLimit {
     /// laws; with IMPL-EX the crack laws' own (symmetric, positive) tangent, since the
     /// symmetric part of the consistent one is indefinite (docs/theory-concrete.md §5.5b).
     TensileStrength,
+    /// Rankine cut-off that softens with its own inclined crack (a simplified
+    /// multi-directional crack, de Borst & Nauta 1985): σ1 ≤ f(κ) = σ_env(ε0 + κ) =
+    /// f_tm exp(−κ/α), the crack laws' tension-softening envelope (same α, so the same
+    /// crack-band regularisation by the element's band width), κ the largest cut-off crack
+    /// strain reached, the strain the return removes along the principal direction,
+    /// (σ1_free − σ1)/E ([`cap_softening`]). With IMPL-EX the cap is f(κ̃) at the extrapolated
+    /// κ̃ and the tangent the crack laws' one, as for [`Self::TensileStrength`]
+    /// (docs/theory-concrete.md §5.5b).
+    Softening,
 }
 
 /// Rankine tension cut-off of a fixed-cracked point's stress: if the largest principal
@@ -93,6 +102,26 @@ pub enum PrincipalStressLimit {
 /// principal axes), plus the regularising stiffness `k_min` [Pa] along n1 (perfect
 /// plasticity has none). Returns whether the cut-off is active.
 pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k_min: f64) -> bool {
+    cap_principal_stress_with(f, 0.0, sl, dl, k_min)
+}
+
+/// Principal stresses σ1 ≥ σ2 [Pa] of `s` = (σ_a, σ_b, τ_ab).
+fn principal_pair(s: &[f64; 3]) -> (f64, f64) {
+    let c = 0.5 * (s[0] + s[1]);
+    let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+    (c + r, c - r)
+}
+
+/// As [`cap_principal_stress`] with a cap that moves with the stress: dσ1 = `a1` dσ1_free
+/// (`a1` [-] = 0 for a fixed cap; a softening cap's f'/(E + f'), [`cap_softening`]); a
+/// capped σ2 follows σ1.
+fn cap_principal_stress_with(
+    f: f64,
+    a1: f64,
+    sl: &mut [f64; 3],
+    dl: &mut [[f64; 3]; 3],
+    k_min: f64,
+) -> bool {
     let c = 0.5 * (sl[0] + sl[1]);
     let r = (0.25 * (sl[0] - sl[1]).powi(2) + sl[2] * sl[2]).sqrt();
     let (s1, s2) = (c + r, c - r);
@@ -108,9 +137,9 @@ pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k
         [-cs * sn, cs * sn, cs * cs - sn * sn],
     ];
     let (s2c, a) = if s2 > f {
-        (f, [0.0, 0.0, 0.0])
+        (f, [a1, 0.0, 0.0])
     } else {
-        (s2, [0.0, 1.0, (f - s2) / (s1 - s2)])
+        (s2, [a1, 1.0, (f - s2) / (s1 - s2)])
     };
     // A Q dl, with the regularising k_min along n1 (dσ_11 = k_min dε_11, ε_11 = T[0]·ε').
     let mut aqd = [[0.0; 3]; 3];
@@ -118,6 +147,10 @@ pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k
         for j in 0..3 {
             aqd[i][j] = a[i] * (0..3).map(|k| q[i][k] * dl[k][j]).sum::<f64>();
         }
+    }
+    if s2 > f {
+        // σ2 = f(κ) too: it moves with σ1.
+        aqd[1] = aqd[0];
     }
     for j in 0..3 {
         aqd[0][j] += k_min * t[0][j];
@@ -132,6 +165,77 @@ pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k
     *sl = std::array::from_fn(|i| (0..3).map(|k| t[k][i] * sp[k]).sum());
     *dl = d;
     true
+}
+
+/// Softening Rankine cut-off ([`PrincipalStressLimit::Softening`]) of the crack laws'
+/// stress `sl` [Pa] and tangent `dl` [Pa] (crack axes), with committed largest cut-off crack
+/// strain `kappa_n` [-], crack-law decay strain `alpha` [-] and regularising stiffness
+/// `k_min` [Pa]. The cap is f(κ) = σ_env(ε0 + κ) = f_tm exp(−κ/α), the crack laws'
+/// envelope past its peak, and κ = max(κ_n, (σ1_free − f(κ))/E): the strain the return
+/// removes along the principal direction, measured with E as the return is that of
+/// Rankine plasticity with ν = 0 ([`cap_principal_stress`]).
+///
+/// * `extrapolated` = Some(κ̃) (IMPL-EX): the cap is f(κ̃), fixed in the increment, and κ
+///   is updated afterwards from the stress removed; the tangent is left to the caller.
+/// * None (implicit): κ solves E κ + f(κ) = σ1_free (bisection with Newton steps on
+///   [κ_n, σ1_free/E], where the left side goes from below σ1_free to above; the first
+///   root if the point snaps back, E < |f'|), and the tangent is the consistent one of a
+///   cap moving as dσ1 = f'/(E + f') dσ1_free while κ grows.
+///
+/// Returns the new κ if the cut-off is active, None otherwise (`sl`, `dl` untouched).
+pub fn cap_softening(
+    p: &ConcreteParams,
+    alpha: f64,
+    kappa_n: f64,
+    extrapolated: Option<f64>,
+    sl: &mut [f64; 3],
+    dl: &mut [[f64; 3]; 3],
+    k_min: f64,
+) -> Option<f64> {
+    let e0 = p.eps0();
+    let cap = |k: f64| tension_envelope(p, alpha, e0 + k.max(0.0));
+    let (s1, _) = principal_pair(sl);
+    if let Some(kx) = extrapolated {
+        let f = cap(kx).0;
+        if !cap_principal_stress_with(f, 0.0, sl, dl, k_min) {
+            return None;
+        }
+        return Some(kappa_n.max((s1 - f) / p.ec));
+    }
+    let (f_n, _) = cap(kappa_n);
+    if s1 <= f_n {
+        return None;
+    }
+    let h = |k: f64| p.ec * k + cap(k).0 - s1;
+    if h(kappa_n) >= 0.0 {
+        // The stress removed at the committed cap is within κ_n: the cap stays at f(κ_n).
+        cap_principal_stress_with(f_n, 0.0, sl, dl, k_min);
+        return Some(kappa_n);
+    }
+    let (mut lo, mut hi) = (kappa_n, s1 / p.ec);
+    let mut k = lo;
+    for _ in 0..200 {
+        let (f, df) = cap(k);
+        let v = p.ec * k + f - s1;
+        if v.abs() <= 1e-13 * p.ftm || (hi - lo) <= 1e-15 * hi {
+            break;
+        }
+        if v < 0.0 {
+            lo = k;
+        } else {
+            hi = k;
+        }
+        let slope = p.ec + df;
+        let newton = k - v / slope;
+        k = if slope > 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    let (f, df) = cap(k);
+    cap_principal_stress_with(f, df / (p.ec + df), sl, dl, k_min);
+    Some(k)
 }
 
 /// Strain transformation ε' = T ε to axes rotated by `phi` (engineering shear).
@@ -350,6 +454,7 @@ pub fn update_cracked(
     st.dir_ebar = [r0.ebar, r1.ebar];
     st.dir_plastic = [r0.plastic, r1.plastic];
     st.crack_max_old = committed.crack_max;
+    st.cutoff_max_old = committed.cutoff_max;
     if formed_second {
         st.crack_max_old[1] = st.crack_max[1];
     }
@@ -422,14 +527,39 @@ pub fn update_cracked(
                 dl[2][imax] = if consistent { sgn * dv } else { 0.0 };
             }
         }
-        if p.principal_stress_limit == PrincipalStressLimit::TensileStrength {
-            let free = dl;
-            if cap_principal_stress(p.ftm, &mut sl, &mut dl, p.shear.beta_min * g) && p.implex {
-                // IMPL-EX: the stress is the cut-off's, the tangent the crack laws' (symmetric
-                // and positive in the increment). The cut-off's consistent tangent is
-                // non-symmetric, and the symmetric part the solvers take is indefinite
-                // (docs/theory-concrete.md §5.5b): Newton stalled on the beams with it.
-                dl = free;
+        let free = dl;
+        match p.principal_stress_limit {
+            PrincipalStressLimit::None => {}
+            PrincipalStressLimit::TensileStrength => {
+                if cap_principal_stress(p.ftm, &mut sl, &mut dl, p.shear.beta_min * g) && p.implex {
+                    // IMPL-EX: the stress is the cut-off's, the tangent the crack laws'
+                    // (symmetric and positive in the increment). The cut-off's consistent
+                    // tangent is non-symmetric, and the symmetric part the solvers take is
+                    // indefinite (docs/theory-concrete.md §5.5b): Newton stalled on the beams
+                    // with it.
+                    dl = free;
+                }
+            }
+            PrincipalStressLimit::Softening => {
+                let kn = committed.cutoff_max;
+                let extrapolated = p
+                    .implex
+                    .then(|| kn + ratio.max(0.0) * (kn - committed.cutoff_max_old).max(0.0));
+                if let Some(k) = cap_softening(
+                    p,
+                    alpha,
+                    kn,
+                    extrapolated,
+                    &mut sl,
+                    &mut dl,
+                    p.shear.beta_min * g,
+                ) {
+                    st.cutoff_max = k;
+                    if p.implex {
+                        // As for the fixed cut-off: the crack laws' tangent.
+                        dl = free;
+                    }
+                }
             }
         }
     }

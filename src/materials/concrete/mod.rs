@@ -501,6 +501,14 @@ pub struct ConcreteState {
     /// [`crate::materials::point::plastic_base`]); always false in committed states.
     #[serde(default)]
     pub(crate) hold_plastic: bool,
+    /// Largest inclined cut-off crack strain reached [-] (the strain the return of the
+    /// softening tension cut-off removes along the principal direction,
+    /// [`cracking::PrincipalStressLimit::Softening`]; 0 otherwise).
+    #[serde(default)]
+    pub(crate) cutoff_max: f64,
+    /// `cutoff_max` of the state before the committed one [-] (IMPL-EX extrapolation).
+    #[serde(default)]
+    pub(crate) cutoff_max_old: f64,
     /// Creep state (chain, total strain, shrinkage) of a creeping concrete point (None
     /// without the creep option or before its first update; see [`creep`]). With creep,
     /// `strain` above is the concrete law's input ε_m, not the total strain.
@@ -533,6 +541,8 @@ impl ConcreteState {
             frozen: [0; 2],
             crack_max_old: [0.0; 2],
             hold_plastic: false,
+            cutoff_max: 0.0,
+            cutoff_max_old: 0.0,
             creep: None,
         }
     }
@@ -557,6 +567,12 @@ impl ConcreteState {
     /// Largest crack-normal strains reached [-].
     pub fn max_crack_strains(&self) -> [f64; 2] {
         self.crack_max
+    }
+
+    /// Largest inclined cut-off crack strain reached [-] (softening tension cut-off,
+    /// [`cracking::PrincipalStressLimit::Softening`]; 0 without it).
+    pub fn max_cutoff_strain(&self) -> f64 {
+        self.cutoff_max
     }
 
     /// Equivalent plastic strain [-]: κ of the uncracked plasticity plus the compressive
@@ -818,6 +834,8 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
         frozen,
         crack_max_old,
         hold_plastic,
+        cutoff_max,
+        cutoff_max_old,
         creep,
     } = c;
     out.strain = *strain;
@@ -835,6 +853,8 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
     out.frozen = *frozen;
     out.crack_max_old = *crack_max_old;
     out.hold_plastic = *hold_plastic;
+    out.cutoff_max = *cutoff_max;
+    out.cutoff_max_old = *cutoff_max_old;
     out.creep.clone_from(creep);
 }
 

@@ -755,3 +755,158 @@ fn rotating_secant_tangent_is_the_secant() {
         }
     }
 }
+
+/// The softening cut-off's closed form (`principal_stress_limit = Softening`, implicit crack
+/// laws): pure shear after cracking as in the test above (crack opened in x, ε_x = 3e-4
+/// held), γ_xy raised to 1.2e-2 in committed increments. At every increment where the
+/// cut-off is active, with σ1_free, σ2_free the principal stresses without the limit at the
+/// same strain and committed crack history, and κ the returned history:
+///
+/// * κ = (σ1_free − σ1)/E — the inclined crack strain is the stress removed over E;
+/// * σ1 = f_tm exp(−κ/α) = σ_env(ε0 + κ), the crack laws' envelope with the element's α —
+///   stress against inclined crack strain is the softening curve;
+/// * σ2 = σ2_free, and κ never decreases (also not when γ is then reduced).
+///
+/// Tolerance 1e-9 f_tm (the scalar solve stops at 1e-13 f_tm). The run must soften
+/// (σ1 < 0.8 f_tm at the end), so that the curve is checked past its peak.
+#[test]
+fn softening_cut_off_follows_the_tension_softening_curve() {
+    let mut p = params();
+    let free = p.clone();
+    p.principal_stress_limit = cracking::PrincipalStressLimit::Softening;
+    let alpha = p.softening_alpha(0.1);
+    let eig = |s: &[f64; 3]| {
+        let c = 0.5 * (s[0] + s[1]);
+        let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+        (c + r, c - r)
+    };
+    let mut st = upd(&p, &ConcreteState::new(), [3e-4, 0.0, 0.0]).0;
+    assert_eq!(st.n_cracks(), 1);
+    let (mut active, mut last_s1, mut kmax) = (0, p.ftm, 0.0);
+    let path: Vec<f64> = (0..=60)
+        .map(|k| 1.2e-2 * k as f64 / 60.0)
+        .chain((0..10).map(|k| 1.2e-2 * (1.0 - 0.05 * k as f64)))
+        .collect();
+    for g in path {
+        let e = [3e-4, 0.0, g];
+        let (s1f, s2f) = eig(&upd(&free, &st, e).1);
+        let (next, s, _) = upd(&p, &st, e);
+        let k = next.max_cutoff_strain();
+        assert!(k >= st.max_cutoff_strain(), "κ fell: {k} at γ = {g}");
+        let (s1, s2) = eig(&s);
+        let tol = 1e-9 * p.ftm;
+        if k > st.max_cutoff_strain() {
+            active += 1;
+            assert!(
+                (k - (s1f - s1) / p.ec).abs() * p.ec < tol,
+                "κ {k} at γ = {g}: s1f {s1f:.6e} s1 {s1:.6e} kn {} alpha {alpha:.3e}",
+                st.max_cutoff_strain()
+            );
+            let curve = p.ftm * (-k / alpha).exp();
+            assert!(
+                (s1 - curve).abs() < tol,
+                "σ1 {s1:.6e} vs {curve:.6e} at γ = {g}"
+            );
+            assert!((s2 - s2f).abs() < tol, "σ2 {s2:.6e} vs {s2f:.6e}");
+            last_s1 = s1;
+        } else {
+            // Off the cut-off or on it at the committed cap: never above it.
+            let cap = p.ftm * (-k / alpha).exp();
+            assert!(s1 <= cap + tol, "σ1 {s1:.6e} above the cap {cap:.6e}");
+        }
+        kmax = k;
+        st = next;
+    }
+    assert!(active >= 20, "{active} increments on the softening cut-off");
+    assert!(last_s1 < 0.8 * p.ftm, "no softening: {last_s1:.3e}");
+    assert!(kmax > 0.0);
+}
+
+/// Tangent of the softening cut-off (implicit crack laws) against central differences,
+/// same states and tolerance as the fixed cut-off's check above (1e-5 E), from a committed
+/// state already on the cut-off (κ > 0), so that the cap moves: dσ1 = f'/(E + f') dσ1_free.
+#[test]
+fn softening_cut_off_tangent_matches_finite_differences() {
+    let mut p = fd_params();
+    p.principal_stress_limit = cracking::PrincipalStressLimit::Softening;
+    p.shear.beta_min = 0.0;
+    let st = upd(&p, &ConcreteState::new(), [3e-4, 0.0, 0.0]).0;
+    let st = upd(&p, &st, [3e-4, 0.0, 2e-3]).0;
+    assert!(st.max_cutoff_strain() > 0.0);
+    let mut checked = 0;
+    for (en, et, g) in [
+        (3.5e-4, 0.0, 3e-3),
+        (2.5e-4, -2e-4, 4e-3),
+        (4e-4, 5e-5, 3.5e-3),
+        (2e-4, -1e-3, 5e-3),
+    ] {
+        let e = [en, et, g];
+        let next = upd(&p, &st, e).0;
+        assert!(
+            next.max_cutoff_strain() > st.max_cutoff_strain(),
+            "cut-off not loading at {e:?}"
+        );
+        if let Some(err) = fd_error(&p, &st, e) {
+            assert!(err < 1e-5 * p.ec, "err {err} at {e:?}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "{checked} states checked");
+}
+
+/// The softening cut-off under IMPL-EX (the beams' setting): the cap is f(κ̃) at the
+/// extrapolated history κ̃ = κ_n + r (κ_n − κ_{n−1}), the history updated afterwards as
+/// max(κ_n, (σ1_free − f(κ̃))/E), and the tangent the crack laws' one bit for bit (as for
+/// the fixed cut-off, `principal_stress_limit_with_implex_keeps_the_crack_laws_tangent`).
+/// Pure shear after an IMPL-EX crack in x, committed increments of γ with r = 1;
+/// tolerance 1e-9 f_tm (closed form). The state round-trips through the checkpoint's
+/// encoding (postcard) with its cut-off history.
+#[test]
+fn softening_cut_off_with_implex_uses_the_extrapolated_history() {
+    let mut p = params();
+    p.implex = true;
+    let free = p.clone();
+    p.principal_stress_limit = cracking::PrincipalStressLimit::Softening;
+    let alpha = p.softening_alpha(0.1);
+    let e0 = p.eps0();
+    let step = |q: &ConcreteParams, c: &ConcreteState, e: [f64; 3], r: f64| {
+        update_extrapolated(q, c, &e, 0.1, r).unwrap()
+    };
+    let mut c = step(&p, &ConcreteState::new(), [1.1 * e0, 0.0, 0.0], 0.0).0;
+    c = step(&p, &c, [3e-4, 0.0, 0.0], 1.0).0;
+    let mut grew = 0;
+    for k in 1..=40 {
+        let e = [3e-4, 0.0, 1e-2 * k as f64 / 40.0];
+        let (_, s0, d0) = step(&free, &c, e, 1.0);
+        let (next, s, d) = step(&p, &c, e, 1.0);
+        let kn = c.max_cutoff_strain();
+        let kx = kn + (kn - c.cutoff_max_old).max(0.0);
+        let f = p.ftm * (-kx / alpha).exp();
+        let s1f = principal_max(&s0).0;
+        if s1f > f {
+            let s1 = principal_max(&s).0;
+            assert!((s1 - f).abs() < 1e-9 * p.ftm, "σ1 {s1:.6e} vs f(κ̃) {f:.6e}");
+            let want = kn.max((s1f - f) / p.ec);
+            assert!((next.max_cutoff_strain() - want).abs() * p.ec < 1e-9 * p.ftm);
+            assert_eq!(d, d0, "the crack laws' tangent");
+        } else {
+            assert_eq!(s, s0);
+            assert_eq!(next.max_cutoff_strain(), kn);
+        }
+        assert!(next.max_cutoff_strain() >= kn);
+        assert_eq!(next.cutoff_max_old, kn);
+        if next.max_cutoff_strain() > kn {
+            grew += 1;
+        }
+        c = next;
+    }
+    assert!(grew >= 10, "{grew} increments with a growing κ");
+    assert!(
+        c.max_cutoff_strain() > alpha,
+        "κ {} not past α",
+        c.max_cutoff_strain()
+    );
+    let bytes = postcard::to_stdvec(&c).unwrap();
+    let back: ConcreteState = postcard::from_bytes(&bytes).unwrap();
+    assert_eq!(back, c);
+}
