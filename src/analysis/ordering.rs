@@ -47,6 +47,33 @@ const ELEMENT_LEAF_NODES: usize = 4;
 /// Separator marker in the part labels.
 const SEPARATOR: u32 = u32::MAX;
 
+/// Reorder `items` so that those below the median of their points' coordinate along the
+/// longer side of the points' bounding box come first; items tied with the median go to
+/// the upper part. Returns the size of the lower part (half, if every item is tied), the
+/// axis split (0: x, 1: y) and the median coordinate on it [m].
+fn median_split(items: &mut [u32], point: impl Fn(u32) -> [f64; 2]) -> (usize, usize, f64) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for &v in items.iter() {
+        let p = point(v);
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| point(*a)[axis].total_cmp(&point(*b)[axis]));
+    let v = point(items[mid])[axis];
+    let mut split = 0;
+    for i in 0..mid {
+        if point(items[i])[axis] < v {
+            items.swap(i, split);
+            split += 1;
+        }
+    }
+    (if split == 0 { mid } else { split }, axis, v)
+}
+
 struct Dissection<'a> {
     node_ptr: &'a [usize],
     node_adj: &'a [u32],
@@ -89,33 +116,10 @@ impl<'a> Dissection<'a> {
             out.extend_from_slice(nodes);
             return;
         }
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &v in nodes.iter() {
-            let p = self.coords[v as usize];
-            for c in 0..2 {
-                lo[c] = lo[c].min(p[c]);
-                hi[c] = hi[c].max(p[c]);
-            }
-        }
-        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
-        let mid = nodes.len() / 2;
-        let coords = self.coords;
-        nodes.select_nth_unstable_by(mid, |a, b| {
-            coords[*a as usize][axis].total_cmp(&coords[*b as usize][axis])
-        });
         // Nodes tied with the median go to the upper half, so that a grid line is never
         // split between the halves (the separator would be up to twice as large).
-        let v = coords[nodes[mid] as usize][axis];
-        let mut split = 0;
-        for i in 0..mid {
-            if coords[nodes[i] as usize][axis] < v {
-                nodes.swap(i, split);
-                split += 1;
-            }
-        }
-        if split == 0 {
-            split = mid;
-        }
+        let coords = self.coords;
+        let (split, _, _) = median_split(nodes, |v| coords[v as usize]);
         let (lower, upper) = nodes.split_at_mut(split);
         let up = self.label();
         for &v in upper.iter() {
@@ -199,33 +203,10 @@ impl Dissection<'_> {
         elems: &mut [u32],
         nodes: &mut [u32],
     ) -> (usize, usize, usize) {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &e in elems.iter() {
-            let p = el.centroid[e as usize];
-            for c in 0..2 {
-                lo[c] = lo[c].min(p[c]);
-                hi[c] = hi[c].max(p[c]);
-            }
-        }
-        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
-        let mid = elems.len() / 2;
-        let centroid = &el.centroid;
-        elems.select_nth_unstable_by(mid, |a, b| {
-            centroid[*a as usize][axis].total_cmp(&centroid[*b as usize][axis])
-        });
         // Elements tied with the median go to the upper half: a column (row) of elements
         // is never split, the separator is one line of element edges.
-        let v = centroid[elems[mid] as usize][axis];
-        let mut split = 0;
-        for i in 0..mid {
-            if centroid[elems[i] as usize][axis] < v {
-                elems.swap(i, split);
-                split += 1;
-            }
-        }
-        if split == 0 {
-            split = mid;
-        }
+        let centroid = &el.centroid;
+        let (split, axis, v) = median_split(elems, |e| centroid[e as usize]);
         let (low, up) = (self.label(), self.label());
         for (i, &e) in elems.iter().enumerate() {
             el.part[e as usize] = if i < split { low } else { up };
