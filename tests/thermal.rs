@@ -128,6 +128,24 @@ point = [4.0, 0.0]
 uy = 0.0
 "#;
 
+/// Both end lines held in x, one corner in y: free to expand in y, no end rotation.
+const ENDS_HELD_IN_X: &str = r#"
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.4]]
+ux = 0.0
+
+[[supports]]
+name = "right"
+line = [[4.0, 0.0], [4.0, 0.4]]
+ux = 0.0
+
+[[supports]]
+name = "vertical"
+point = [0.0, 0.0]
+uy = 0.0
+"#;
+
 /// Largest stress component magnitude over all Gauss points [Pa].
 fn max_stress(last: &Last) -> f64 {
     last.stress
@@ -170,23 +188,7 @@ fn free_beam_expands_and_bends_without_stress() {
 /// everywhere and σy = τ = 0 (exact in plane stress whatever ν).
 #[test]
 fn restrained_bar_takes_minus_e_alpha_dt() {
-    let supports = r#"
-[[supports]]
-name = "left"
-line = [[0.0, 0.0], [0.0, 0.4]]
-ux = 0.0
-
-[[supports]]
-name = "right"
-line = [[4.0, 0.0], [4.0, 0.4]]
-ux = 0.0
-
-[[supports]]
-name = "vertical"
-point = [0.0, 0.0]
-uy = 0.0
-"#;
-    let (_, last) = solve(&rect_beam(0.2, supports, "{ uniform = 20.0 }"));
+    let (_, last) = solve(&rect_beam(0.2, ENDS_HELD_IN_X, "{ uniform = 20.0 }"));
     let s0 = -E * ALPHA * 20.0;
     for s in &last.stress {
         // A uniform state, exact in the elements: round-off.
@@ -710,23 +712,7 @@ fn elastic_outputs_left_out_of_a_checkpoint_are_recomputed_exactly() {
             Ok(())
         }
     }
-    let supports = r#"
-[[supports]]
-name = "left"
-line = [[0.0, 0.0], [0.0, 0.4]]
-ux = 0.0
-
-[[supports]]
-name = "right"
-line = [[4.0, 0.0], [4.0, 0.4]]
-ux = 0.0
-
-[[supports]]
-name = "left_y"
-point = [0.0, 0.0]
-uy = 0.0
-"#;
-    let text = rect_beam(0.2, supports, "{ linear = 10.0 }");
+    let text = rect_beam(0.2, ENDS_HELD_IN_X, "{ linear = 10.0 }");
     let built = segfem::input::parse(&text, "thermal.toml").unwrap_or_else(|e| panic!("{e}"));
     let mut saved = Saved::default();
     steps::run(&built.model, &mut saved).expect("runs");

@@ -162,6 +162,29 @@ struct Elements {
     part: Vec<u32>,
 }
 
+impl Elements {
+    /// The elements `elements` (node lists) of a mesh with nodes at `coords` [m], all in
+    /// part 1.
+    fn new(elements: &[Vec<usize>], coords: &[[f64; 2]]) -> Self {
+        let (inc_ptr, inc) = crate::fem::assembly::incidence(coords.len(), elements);
+        let centroid = elements
+            .iter()
+            .map(|el| {
+                let s = el
+                    .iter()
+                    .fold([0.0; 2], |s, &a| [s[0] + coords[a][0], s[1] + coords[a][1]]);
+                [s[0] / el.len() as f64, s[1] / el.len() as f64]
+            })
+            .collect();
+        Elements {
+            inc_ptr,
+            inc,
+            centroid,
+            part: vec![1; elements.len()],
+        }
+    }
+}
+
 impl Dissection<'_> {
     /// Append the elimination order of `nodes` (all labelled `id`), the free nodes of the
     /// elements `elems` (all labelled `id` in `el.part`) and nodes in no element, to `out`.
@@ -318,38 +341,7 @@ pub fn element_dissection(
 ) -> Vec<usize> {
     let n_nodes = coords.len();
     let mut nodes = free_nodes(eq, n_eq, n_nodes);
-    let mut inc_ptr = vec![0usize; n_nodes + 1];
-    for el in elements {
-        for &a in el {
-            inc_ptr[a + 1] += 1;
-        }
-    }
-    for a in 0..n_nodes {
-        inc_ptr[a + 1] += inc_ptr[a];
-    }
-    let mut fill = inc_ptr.clone();
-    let mut inc = vec![0u32; inc_ptr[n_nodes]];
-    for (e, el) in elements.iter().enumerate() {
-        for &a in el {
-            inc[fill[a]] = e as u32;
-            fill[a] += 1;
-        }
-    }
-    let centroid = elements
-        .iter()
-        .map(|el| {
-            let s = el
-                .iter()
-                .fold([0.0; 2], |s, &a| [s[0] + coords[a][0], s[1] + coords[a][1]]);
-            [s[0] / el.len() as f64, s[1] / el.len() as f64]
-        })
-        .collect();
-    let mut el = Elements {
-        inc_ptr,
-        inc,
-        centroid,
-        part: vec![1; elements.len()],
-    };
+    let mut el = Elements::new(elements, coords);
     let mut elems: Vec<u32> = (0..elements.len() as u32).collect();
     let mut d = Dissection::new(node_ptr, node_adj, coords, &nodes);
     let mut order = Vec::with_capacity(nodes.len());
@@ -616,30 +608,7 @@ mod tests {
             let asm = Assembler::new(xy.len(), &couplings, &dofs);
             let mut nodes: Vec<u32> = (0..xy.len() as u32).collect();
             let mut d = Dissection::new(&asm.node_ptr, &asm.node_adj, &xy, &nodes);
-            let mut inc_ptr = vec![0; xy.len() + 1];
-            let mut inc = vec![];
-            for a in 0..xy.len() {
-                inc.extend(
-                    (0..elements.len() as u32).filter(|&e| elements[e as usize].contains(&a)),
-                );
-                inc_ptr[a + 1] = inc.len();
-            }
-            let centroid = elements
-                .iter()
-                .map(|e| {
-                    let n = e.len() as f64;
-                    [
-                        e.iter().map(|&a| xy[a][0]).sum::<f64>() / n,
-                        e.iter().map(|&a| xy[a][1]).sum::<f64>() / n,
-                    ]
-                })
-                .collect();
-            let mut el = Elements {
-                inc_ptr,
-                inc,
-                centroid,
-                part: vec![1; elements.len()],
-            };
+            let mut el = Elements::new(&elements, &xy);
             let mut elems: Vec<u32> = (0..elements.len() as u32).collect();
             if extra == 0 && nx == 10 {
                 // 20 × 6 elements: the top split is between columns 10 and 11, at the

@@ -45,31 +45,38 @@ pub fn zeroed_values(n: usize) -> Vec<f64> {
     v
 }
 
+/// Node → element incidence in compressed rows: the elements holding node a are
+/// `inc[inc_ptr[a]..inc_ptr[a + 1]]`, in increasing order; `elem_nodes[e]` lists the nodes of
+/// element e.
+pub fn incidence(n_nodes: usize, elem_nodes: &[Vec<usize>]) -> (Vec<usize>, Vec<u32>) {
+    let mut inc_ptr = vec![0usize; n_nodes + 1];
+    for nodes in elem_nodes {
+        for &a in nodes {
+            inc_ptr[a + 1] += 1;
+        }
+    }
+    for a in 0..n_nodes {
+        inc_ptr[a + 1] += inc_ptr[a];
+    }
+    let mut fill = inc_ptr.clone();
+    let mut inc = vec![0u32; inc_ptr[n_nodes]];
+    for (e, nodes) in elem_nodes.iter().enumerate() {
+        for &a in nodes {
+            inc[fill[a]] = e as u32;
+            fill[a] += 1;
+        }
+    }
+    (inc_ptr, inc)
+}
+
 impl Assembler {
     /// Build the pattern from node connectivities (each element couples all dofs of its
     /// nodes); `elem_nodes[e]` lists the nodes of element e.
     pub fn new(n_nodes: usize, elem_nodes: &[Vec<usize>], dofs: &DofMap) -> Self {
-        // Node → elements incidence (compressed rows), then each node's neighbours: the
-        // nodes of its elements, sorted and unique. Flat arrays built chunk-parallel: no
-        // allocation per node (a Vec per node cost more than the sorting at 1e6 dofs).
-        let mut inc_ptr = vec![0usize; n_nodes + 1];
-        for nodes in elem_nodes {
-            for &a in nodes {
-                inc_ptr[a + 1] += 1;
-            }
-        }
-        for a in 0..n_nodes {
-            inc_ptr[a + 1] += inc_ptr[a];
-        }
-        let mut fill = inc_ptr.clone();
-        let mut inc = vec![0u32; inc_ptr[n_nodes]];
-        for (e, nodes) in elem_nodes.iter().enumerate() {
-            for &a in nodes {
-                inc[fill[a]] = e as u32;
-                fill[a] += 1;
-            }
-        }
-        drop(fill);
+        // Node → elements incidence, then each node's neighbours: the nodes of its elements,
+        // sorted and unique. Flat arrays built chunk-parallel: no allocation per node (a Vec
+        // per node cost more than the sorting at 1e6 dofs).
+        let (inc_ptr, inc) = incidence(n_nodes, elem_nodes);
         let chunks: Vec<(Vec<u32>, Vec<usize>)> = (0..n_nodes.div_ceil(NODE_CHUNK))
             .into_par_iter()
             .map(|c| {

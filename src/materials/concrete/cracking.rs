@@ -105,13 +105,6 @@ pub fn cap_principal_stress(f: f64, sl: &mut [f64; 3], dl: &mut [[f64; 3]; 3], k
     cap_principal_stress_with(f, 0.0, sl, dl, k_min)
 }
 
-/// Principal stresses σ1 ≥ σ2 [Pa] of `s` = (σ_a, σ_b, τ_ab).
-fn principal_pair(s: &[f64; 3]) -> (f64, f64) {
-    let c = 0.5 * (s[0] + s[1]);
-    let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
-    (c + r, c - r)
-}
-
 /// As [`cap_principal_stress`] with a cap that moves with the stress: dσ1 = `a1` dσ1_free
 /// (`a1` [-] = 0 for a fixed cap; a softening cap's f'/(E + f'), [`cap_softening`]); a
 /// capped σ2 follows σ1.
@@ -194,7 +187,7 @@ pub fn cap_softening(
 ) -> Option<f64> {
     let e0 = p.eps0();
     let cap = |k: f64| tension_envelope(p, alpha, e0 + k.max(0.0));
-    let (s1, _) = principal_pair(sl);
+    let (s1, _) = super::principal_max(sl);
     if let Some(kx) = extrapolated {
         let f = cap(kx).0;
         if !cap_principal_stress_with(f, 0.0, sl, dl, k_min) {
