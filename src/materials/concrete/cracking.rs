@@ -71,7 +71,9 @@ impl CrackShearLimit {
 /// locking (Rots 1988), where the shear retained across an inclined crack builds a
 /// principal tension at an angle to the crack axes that no crack check sees (the second
 /// crack is checked at 90° to the first only), so that cracked concrete carries tension
-/// well past f_tm (docs/theory-concrete.md §5.5b).
+/// well past f_tm (docs/theory-concrete.md §5.5b). Both cut-offs cap the principal tension
+/// in every direction, also near the crack axes: restricting them to directions inclined to
+/// the cracks was probed on the beams (session 15) and undid the cut-off on OA1.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum PrincipalStressLimit {
     /// No limit (the seed's model).
