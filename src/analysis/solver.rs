@@ -294,6 +294,23 @@ impl Drop for SparseCholesky {
 }
 
 impl SparseCholesky {
+    /// Floating-point operations of one numeric LLᵀ with this analysis: Σ c² over the
+    /// factor's columns, c the stored values of the column (diagonal included), as the
+    /// supernodes store them. 0 for a simplicial analysis or before a background one is joined.
+    pub fn factor_flops(&self) -> f64 {
+        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+            return 0.0;
+        };
+        let (begin, end) = (s.supernode_begin(), s.supernode_end());
+        (0..s.n_supernodes())
+            .map(|k| {
+                let w = end[k] - begin[k];
+                let r = (w + s.supernode(k).pattern().len()) as f64;
+                (0..w).map(|j| (r - j as f64).powi(2)).sum::<f64>()
+            })
+            .sum()
+    }
+
     /// Ordering (AMD) and symbolic analysis of `pattern`; done once per pattern.
     pub fn new(pattern: &LowerPattern) -> Result<Self, SolverError> {
         Self::with_threshold(pattern, FACTOR_KIND)
