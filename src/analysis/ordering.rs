@@ -39,9 +39,9 @@ pub const ND_MIN_EQUATIONS_QUADRATIC: usize = 20_000;
 /// Subdomains of at most this many nodes are not split further (numbered as they come).
 /// Larger leaves filled more: on the clamped Q4 square of 499,000 equations 48-node leaves
 /// gave 61.6 million factor values and 19.7 Gflop (Σ c²), 4-node leaves 56.7 million and
-/// 19.2 Gflop, and a 6–8 % faster numeric factorisation; at 1e6 equations 132.7 and 120.8
-/// million values, 5–8 % faster (docs/performance.md, session 15). 2 and 8 nodes were
-/// within 1 % of 4.
+/// 19.2 Gflop, and a 9 % faster numeric factorisation (median CPU time); at 1e6 equations
+/// 132.7 and 120.8 million values, 5 % faster (docs/performance.md, session 15). 2 and 8
+/// nodes came within 2 % of 4.
 const LEAF_NODES: usize = 4;
 
 /// As [`LEAF_NODES`] for the element dissection: split down to single elements. Larger
