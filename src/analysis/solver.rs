@@ -70,6 +70,10 @@ const FACTOR_KIND: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
 /// its limit point (where LDLᵀ takes over anyway).
 const TINY_PIVOT: f64 = 1e-11;
 
+/// Systems from this many equations on have the pivots of an LLᵀ factor checked in parallel
+/// ([`SparseCholesky::tiny_pivot`]).
+const PARALLEL_PIVOT_CHECK: usize = 1 << 16;
+
 /// Which factor the solver holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Factor {
@@ -206,15 +210,31 @@ impl Storage {
     /// Write one byte of every page of both buffers. A fresh buffer is only reserved: the
     /// kernel maps and zeroes each page at its first write, which for a large factor
     /// (0.5 GB at 5e5 equations) took 0.6 s of the first factorisation on one core.
+    ///
+    /// The pages are faulted in by two threads (this one and one more, each half of the
+    /// values): the analysis that started this ends about when the assembly does, so the
+    /// first factorisation waits for the touching with the other core idle.
     fn touch(mut self) -> Self {
-        for v in self.l_values.iter_mut().step_by(Self::PAGE / 8) {
-            // Volatile: a plain store of zero into calloc'ed memory may be optimised away.
-            // SAFETY: `v` is a valid, aligned, exclusive reference.
-            unsafe { std::ptr::write_volatile(v, 0.0) };
+        fn touch_values(values: &mut [f64]) {
+            for v in values.iter_mut().step_by(Storage::PAGE / 8) {
+                // Volatile: a plain store of zero into calloc'ed memory may be optimised
+                // away. SAFETY: `v` is a valid, aligned, exclusive reference.
+                unsafe { std::ptr::write_volatile(v, 0.0) };
+            }
         }
-        for b in self.mem.iter_mut().step_by(Self::PAGE) {
-            *b = std::mem::MaybeUninit::new(0);
-        }
+        // The split on a page boundary of the values (any boundary is correct: the halves
+        // are disjoint).
+        let n = self.l_values.len();
+        let half = (n / 2).next_multiple_of(Self::PAGE / 8).min(n);
+        let (first, second) = self.l_values.split_at_mut(half);
+        let mem = &mut self.mem;
+        std::thread::scope(|s| {
+            s.spawn(|| touch_values(second));
+            touch_values(first);
+            for b in mem.iter_mut().step_by(Self::PAGE) {
+                *b = std::mem::MaybeUninit::new(0);
+            }
+        });
         self
     }
 
@@ -294,6 +314,23 @@ impl Drop for SparseCholesky {
 }
 
 impl SparseCholesky {
+    /// Floating-point operations of one numeric LLᵀ with this analysis: Σ c² over the
+    /// factor's columns, c the stored values of the column (diagonal included), as the
+    /// supernodes store them. 0 for a simplicial analysis or before a background one is joined.
+    pub fn factor_flops(&self) -> f64 {
+        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+            return 0.0;
+        };
+        let (begin, end) = (s.supernode_begin(), s.supernode_end());
+        (0..s.n_supernodes())
+            .map(|k| {
+                let w = end[k] - begin[k];
+                let r = (w + s.supernode(k).pattern().len()) as f64;
+                (0..w).map(|j| (r - j as f64).powi(2)).sum::<f64>()
+            })
+            .sum()
+    }
+
     /// Ordering (AMD) and symbolic analysis of `pattern`; done once per pattern.
     pub fn new(pattern: &LowerPattern) -> Result<Self, SolverError> {
         Self::with_threshold(pattern, FACTOR_KIND)
@@ -315,12 +352,14 @@ impl SparseCholesky {
     /// 5e5 equations faer's symbolic analysis takes 0.3–0.4 s on one core. Errors of the
     /// analysis come with that factorisation. Smaller systems are analysed at once.
     pub fn in_background(
-        pattern: &LowerPattern,
+        pattern: &std::sync::Arc<LowerPattern>,
         order: Option<&[usize]>,
     ) -> Result<Self, SolverError> {
         if pattern.n < BACKGROUND_MIN_EQUATIONS {
             return Self::with_ordering(pattern, order);
         }
+        // The pattern shared, not copied (a copy was 36 MB of fresh pages at 5e5 equations,
+        // on the caller's thread before the assembly).
         let (pattern, order) = (pattern.clone(), order.map(<[usize]>::to_vec));
         let handle =
             std::thread::spawn(move || Self::build(&pattern, FACTOR_KIND, order.as_deref()));
@@ -642,7 +681,7 @@ impl SparseCholesky {
     fn tiny_pivot(&self, pattern: &LowerPattern, values: &[f64]) -> Option<usize> {
         let l = self.ldlt_diagonal();
         let perm = self.symbolic.perm().map(|p| p.arrays().0);
-        (0..l.len()).find(|&k| {
+        let tiny = |k: usize| {
             let a = match (&self.pre, perm) {
                 (Some(p), _) => {
                     let (cp, ri) = (p.pattern.col_ptr(), p.pattern.row_idx());
@@ -652,7 +691,18 @@ impl SparseCholesky {
                 (None, None) => pattern.position(k, k).map(|q| values[q]),
             };
             a.is_some_and(|a| l[k] * l[k] <= TINY_PIVOT * a.abs())
-        })
+        };
+        // On both cores for a large system (random reads of the matrix diagonal: ~30 ms at
+        // 5e5 equations, with the other core idle); the first such equation either way.
+        if l.len() >= PARALLEL_PIVOT_CHECK {
+            use rayon::prelude::*;
+            (0..l.len())
+                .into_par_iter()
+                .with_min_len(PARALLEL_PIVOT_CHECK / 4)
+                .find_first(|&k| tiny(k))
+        } else {
+            (0..l.len()).find(|&k| tiny(k))
+        }
     }
 
     /// Diagonal of the last factor (permuted order): D of LDLᵀ, or the diagonal of L of LLᵀ.

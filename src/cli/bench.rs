@@ -608,6 +608,9 @@ pub struct BareRow {
     pub amd_numeric_s: f64,
     /// Stored factor values after AMD.
     pub amd_factor_nnz: usize,
+    /// Floating-point operations of one numeric LLᵀ after AMD (Σ c² over the factor's
+    /// columns).
+    pub amd_factor_flops: f64,
     /// segfem's ordering (nested dissection above its size threshold) and faer's symbolic
     /// analysis with it [s].
     pub own_symbolic_s: f64,
@@ -615,6 +618,8 @@ pub struct BareRow {
     pub own_numeric_s: f64,
     /// Stored factor values after segfem's ordering.
     pub own_factor_nnz: usize,
+    /// Floating-point operations of one numeric LLᵀ after segfem's ordering.
+    pub own_factor_flops: f64,
 }
 
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
@@ -631,25 +636,33 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         .k_values
         .expect("tangent requested");
     let pattern = &sys.asm.pattern;
-    let time = |order: Option<&[usize]>, extra: f64| -> Result<(f64, f64, usize), String> {
+    type Figures = (f64, f64, usize, f64);
+    let time = |order: Option<&[usize]>, extra: f64| -> Result<Figures, String> {
         let t = Instant::now();
         let mut s = SparseCholesky::with_ordering(pattern, order).map_err(|e| e.to_string())?;
         let sym = t.elapsed().as_secs_f64() + extra;
         let t = Instant::now();
         s.factorize(pattern, &k).map_err(|e| e.to_string())?;
-        Ok((sym, t.elapsed().as_secs_f64(), s.stats.factor_nnz))
+        Ok((
+            sym,
+            t.elapsed().as_secs_f64(),
+            s.stats.factor_nnz,
+            s.factor_flops(),
+        ))
     };
-    let (amd_symbolic_s, amd_numeric_s, amd_factor_nnz) = time(None, 0.0)?;
-    let (own_symbolic_s, own_numeric_s, own_factor_nnz) =
+    let (amd_symbolic_s, amd_numeric_s, amd_factor_nnz, amd_factor_flops) = time(None, 0.0)?;
+    let (own_symbolic_s, own_numeric_s, own_factor_nnz, own_factor_flops) =
         time(sys.ordering.as_deref(), sys.ordering_s)?;
     Ok(BareRow {
         equations: pattern.n,
         amd_symbolic_s,
         amd_numeric_s,
         amd_factor_nnz,
+        amd_factor_flops,
         own_symbolic_s,
         own_numeric_s,
         own_factor_nnz,
+        own_factor_flops,
     })
 }
 

@@ -13,8 +13,9 @@ const SKIP: u32 = u32::MAX;
 /// Pattern and scatter maps for a list of element dof lists.
 #[derive(Debug, Clone)]
 pub struct Assembler {
-    /// Lower-triangle pattern over the free equations.
-    pub pattern: LowerPattern,
+    /// Lower-triangle pattern over the free equations (shared with the symbolic analysis
+    /// running on a thread of its own: [`crate::analysis::solver::SparseCholesky::in_background`]).
+    pub pattern: std::sync::Arc<LowerPattern>,
     /// Node graph (compressed rows): the neighbours of node a, itself included, sorted, are
     /// `node_adj[node_ptr[a]..node_ptr[a + 1]]`. Kept for the fill-reducing ordering.
     pub node_ptr: Vec<usize>,
@@ -203,7 +204,7 @@ impl Assembler {
                 }
             });
         Self {
-            pattern,
+            pattern: std::sync::Arc::new(pattern),
             node_ptr,
             node_adj,
             scatter,
