@@ -7,7 +7,7 @@
 //!
 //! - [`nested_dissection`] (meshes of Q4 elements): the nodes are split at their median
 //!   coordinate; the nodes of the lower half that touch the upper half form the separator.
-//!   Subdomains of up to 4 nodes are numbered as they come.
+//!   Subdomains of up to 48 nodes are numbered as they come.
 //! - [`element_dissection`] (meshes with Q8/Q9 elements, or mixed): the continuum elements
 //!   are split at their median centroid, so that the cut runs along element edges; the
 //!   separator is the nodes both halves share (corner and mid-side nodes of the common
@@ -37,12 +37,12 @@ pub const ND_MIN_EQUATIONS: usize = 20_000;
 pub const ND_MIN_EQUATIONS_QUADRATIC: usize = 20_000;
 
 /// Subdomains of at most this many nodes are not split further (numbered as they come).
-/// Larger leaves filled more: on the clamped Q4 square of 499,000 equations 48-node leaves
-/// gave 61.6 million factor values and 19.7 Gflop (Σ c²), 4-node leaves 56.7 million and
-/// 19.2 Gflop, and a 9 % faster numeric factorisation (median CPU time); at 1e6 equations
-/// 132.7 and 120.8 million values, 5 % faster (docs/performance.md, session 15). 2 and 8
-/// nodes came within 2 % of 4.
-const LEAF_NODES: usize = 4;
+/// 4-node leaves give a smaller factor (clamped Q4 square of 499,000 equations: 56.7
+/// instead of 61.6 million values, numeric factorisation 9 % faster; docs/performance.md,
+/// session 15) but were not adopted: their round-off path stops a Q4 RC beam of 23,870
+/// equations in its cracked phase (20.6 mm, no convergence) where 48- and 32-node leaves
+/// complete it, and a run that stops is outside the tolerance for ordering changes.
+const LEAF_NODES: usize = 48;
 
 /// As [`LEAF_NODES`] for the element dissection: split down to single elements. Larger
 /// leaves, numbered as they come, filled more: the factor of the RC beam refined 5× (49,704
