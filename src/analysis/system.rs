@@ -29,8 +29,10 @@ const CHUNK: usize = 4096;
 /// chunk's scatter leaves a core idle.
 const MIN_CHUNKS: usize = 8;
 
-/// Smallest continuum chunk [elements].
-const MIN_CHUNK: usize = 256;
+/// Smallest continuum chunk [elements]: a small model (the seed beam, a few hundred
+/// elements, an assembly in about a millisecond) keeps one chunk, whose scatter has nothing
+/// to overlap, rather than pay a hand-over per chunk.
+const MIN_CHUNK: usize = 1024;
 
 /// Elements per chunk of the continuum loop of an assembly of `n_el` elements.
 fn continuum_chunk(n_el: usize) -> usize {
