@@ -143,6 +143,9 @@ pub struct Timings {
     pub setup_s: f64,
     /// Element loops and scatter.
     pub assembly_s: f64,
+    /// Element loops of the displacement driver's line searches (residual checks along a
+    /// correction; not in `assembly_s`).
+    pub line_search_s: f64,
     /// Linear solver figures.
     pub solver: SolverStats,
     /// Observers (output writing).

@@ -24,6 +24,21 @@ use rayon::prelude::*;
 /// element-matrix buffer a few tens of MB.
 const CHUNK: usize = 4096;
 
+/// Fewest continuum chunks of an assembly (down to [`MIN_CHUNK`] elements each): the scatter
+/// of a chunk, sequential, runs beside the element work of the next one, so only the last
+/// chunk's scatter leaves a core idle.
+const MIN_CHUNKS: usize = 8;
+
+/// Smallest continuum chunk [elements]: a small model (the seed beam, a few hundred
+/// elements, an assembly in about a millisecond) keeps one chunk, whose scatter has nothing
+/// to overlap, rather than pay a hand-over per chunk.
+const MIN_CHUNK: usize = 1024;
+
+/// Elements per chunk of the continuum loop of an assembly of `n_el` elements.
+fn continuum_chunk(n_el: usize) -> usize {
+    n_el.div_ceil(MIN_CHUNKS).clamp(MIN_CHUNK, CHUNK)
+}
+
 /// The state of the discretised model between and during increments.
 pub struct System<'m> {
     /// The model.
@@ -73,6 +88,9 @@ pub struct System<'m> {
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
     elem_buf: (Vec<f64>, Vec<f64>),
+    /// The second buffer of the continuum loop, which fills one chunk's buffer while the
+    /// other's responses are scattered.
+    elem_buf2: (Vec<f64>, Vec<f64>),
     /// The tangent blocks each continuum element forms (those the scatter adds).
     blocks: Vec<crate::elements::continuum::NodeBlocks>,
     /// The continuum elements' Gauss-point geometry, computed once for a nonlinear run
@@ -405,6 +423,7 @@ impl<'m> System<'m> {
             thermal,
             stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
+            elem_buf2: (Vec::new(), Vec::new()),
             blocks,
             geometry,
         }
@@ -516,11 +535,20 @@ impl<'m> System<'m> {
         let mut buf = std::mem::take(&mut self.elem_buf);
         let time = self.time;
         let stages = self.stages.as_ref();
-        // Continuum elements with the bars they host.
+        // Continuum elements with the bars they host: chunk c is computed (in parallel) while
+        // chunk c − 1 is scattered (in element order, as before), each into its own buffer.
         let n_el = model.elements.len();
+        let size = continuum_chunk(n_el);
+        let mut other = std::mem::take(&mut self.elem_buf2);
+        // The computed chunk waiting for its scatter: outcomes and first element.
+        let mut pending: Option<(Vec<Outcome>, usize)> = None;
+        let of = |e: usize| {
+            let nodes = &model.elements[e].nodes;
+            (nodes.as_slice(), numbers.number(Family::Continuum, e))
+        };
         let mut start = 0;
         while start < n_el {
-            let end = (start + CHUNK).min(n_el);
+            let end = (start + size).min(n_el);
             let (chunk, pieces) = responses::split_chunk(
                 model,
                 &mut self.families,
@@ -536,18 +564,38 @@ impl<'m> System<'m> {
                 &self.blocks,
                 self.geometry.as_ref(),
             );
-            let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
-                if stages.is_some_and(|s| !s.element_acts(p.0)) {
-                    return Ok(None);
-                }
-                chunk.element(p, fe, ke).map(|()| Some(true))
-            });
-            sc.add_chunk(results, start, responses::ND, &mut buf, |e| {
-                let nodes = &model.elements[e].nodes;
-                (nodes, numbers.number(Family::Continuum, e))
-            })?;
+            // `buf` takes this chunk; `other` holds the pending chunk's responses.
+            std::mem::swap(&mut buf, &mut other);
+            let (results, scattered) = rayon::join(
+                || {
+                    compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
+                        if stages.is_some_and(|s| !s.element_acts(p.0)) {
+                            return Ok(None);
+                        }
+                        chunk.element(p, fe, ke).map(|()| Some(true))
+                    })
+                },
+                || match pending.take() {
+                    Some((results, first)) => {
+                        sc.add_chunk(results, first, responses::ND, &mut other, of)
+                    }
+                    None => Ok(()),
+                },
+            );
+            if let Err(e) = scattered {
+                (self.elem_buf, self.elem_buf2) = (buf, other);
+                return Err(e);
+            }
+            pending = Some((results, start));
             start = end;
         }
+        if let Some((results, first)) = pending {
+            if let Err(e) = sc.add_chunk(results, first, responses::ND, &mut buf, of) {
+                (self.elem_buf, self.elem_buf2) = (buf, other);
+                return Err(e);
+            }
+        }
+        self.elem_buf2 = other;
         // Joint contact elements.
         let joints = &mut self.families.joints.points;
         let nd = max_dofs(model.interfaces.iter().map(|i| i.nodes.len()));

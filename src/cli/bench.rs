@@ -694,6 +694,7 @@ pub struct RcRow {
 /// Counts increments and iterations, follows the control force and the midspan deflection.
 #[derive(Default)]
 struct RcWatch {
+    equations: usize,
     increments: usize,
     iterations: usize,
     p_max: f64,
@@ -702,6 +703,7 @@ struct RcWatch {
 
 impl Observer for RcWatch {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        self.equations = snap.system.dofs.n_eq;
         self.increments += 1;
         self.iterations += snap.iterations;
         self.p_max = self.p_max.max(-snap.control_force.unwrap_or(0.0));
@@ -741,7 +743,12 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         }
         Err(e) => e.to_string().lines().next().unwrap_or("").to_string(),
     };
-    let equations = segfem::analysis::system::System::new(&model).dofs.n_eq;
+    // From the run itself, not from a second system built inside the timed span (pattern,
+    // ordering, geometry cache, states); a run with no converged increment builds it.
+    let equations = match obs.equations {
+        0 => segfem::analysis::system::System::new(&model).dofs.n_eq,
+        n => n,
+    };
     Ok(RcRow {
         case: format!("RC beam, {} rows", 10 * r),
         equations,

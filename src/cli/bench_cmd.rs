@@ -147,9 +147,10 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
                 );
                 let (t, s) = (&x.timings, &x.timings.solver);
                 outln!(
-                    "{:>18} assembly {:.2} s, ordering + symbolic {:.3} s, {} factorisations ({} LDLT) {:.2} s ({:.1} ms each, factor {} values), solves {:.2} s",
+                    "{:>18} assembly {:.2} s, line searches {:.2} s, ordering + symbolic {:.3} s, {} factorisations ({} LDLT) {:.2} s ({:.1} ms each, factor {} values), solves {:.2} s",
                     "",
                     t.assembly_s,
+                    t.line_search_s,
                     s.symbolic_s,
                     s.factorisations,
                     s.ldlt_factorisations,
