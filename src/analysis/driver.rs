@@ -154,6 +154,26 @@ pub struct Timings {
     /// Limit points or bifurcations passed (the number of negative pivots changed), one
     /// message each.
     pub limit_points: Vec<String>,
+    /// IMPL-EX error control (`[solver] implex_tolerance`): increments retried at half the
+    /// size because their IMPL-EX error exceeded the tolerance.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_cuts: usize,
+    /// Increments accepted with their IMPL-EX error above the tolerance (at the smallest
+    /// size `max_cuts` allows).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_over_tolerance: usize,
+    /// The largest IMPL-EX error of an accepted increment [-] (fraction of f_tm; 0 when the
+    /// control is off).
+    #[serde(skip_serializing_if = "is_zero_f")]
+    pub implex_max_error: f64,
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
+}
+
+fn is_zero_f(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// After a converged increment inside a step: stop if an observer asks (the step end
@@ -197,4 +217,41 @@ pub(super) fn note_limit_point(
         ));
         *last = now;
     }
+}
+
+/// IMPL-EX error control after a converged increment (`[solver] implex_tolerance`,
+/// docs/theory-concrete.md §5.2): true if the increment is to be thrown away and retried at
+/// half its size — its largest IMPL-EX error exceeds the tolerance and it is larger than
+/// the smallest size, the step's nominal increment halved `max_cuts` times (`size` and
+/// `nominal` in any common unit). An increment kept above the tolerance at the smallest size
+/// is counted in `timings`. Always false without the option.
+pub(super) fn implex_retry(
+    sys: &super::system::System,
+    timings: &mut Timings,
+    size: f64,
+    nominal: f64,
+) -> bool {
+    let controls = &sys.model.controls;
+    let Some(tol) = controls.implex_tolerance else {
+        return false;
+    };
+    let err = sys.implex_error();
+    let smallest = nominal * 0.5_f64.powi(controls.max_cuts as i32);
+    if err > tol && 0.5 * size >= smallest * (1.0 - 1e-9) {
+        timings.implex_cuts += 1;
+        if controls.verbose {
+            eprintln!("    IMPL-EX error {err:.3} f_tm > {tol} f_tm: increment halved");
+        }
+        return true;
+    }
+    if err > tol {
+        timings.implex_over_tolerance += 1;
+        if controls.verbose {
+            eprintln!(
+                "    IMPL-EX error {err:.3} f_tm > {tol} f_tm at the smallest increment: accepted"
+            );
+        }
+    }
+    timings.implex_max_error = timings.implex_max_error.max(err);
+    false
 }

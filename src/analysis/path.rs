@@ -3,7 +3,9 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
-use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
+use super::driver::{
+    check_stop, implex_retry, note_limit_point, AnalysisError, Observer, Snapshot, Timings,
+};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
@@ -223,6 +225,17 @@ fn displacement_step(
             .then(|| prev_size.map(|p| (target - level) / p))
             .flatten();
         match newton_controlled(ctx, &f_ext, &ctl, shift, extrapolate) {
+            Ok((_, iterations))
+                if implex_retry(ctx.sys, ctx.timings, target - level, 1.0 / n_inc as f64) =>
+            {
+                // The IMPL-EX error is above the tolerance: retried at half the size, as
+                // after a failed attempt (not counted against the step's cuts).
+                ctx.timings.iterations += iterations;
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                retry = true;
+                d_level *= 0.5;
+            }
             Ok((f_int, iterations)) => {
                 retry = false;
                 let u = ctx.u.clone();
@@ -544,6 +557,24 @@ fn arc_length_step(
         };
         let dl_try = dl;
         match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
+            Ok(inc)
+                if implex_retry(
+                    ctx.sys,
+                    ctx.timings,
+                    dl.unwrap_or(0.0),
+                    if dl0 == 0.0 { dl.unwrap_or(0.0) } else { dl0 },
+                ) =>
+            {
+                // The IMPL-EX error is above the tolerance: the arc retried at half its
+                // length (not counted against the cuts).
+                ctx.timings.iterations += inc.iterations;
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                if dl0 == 0.0 {
+                    dl0 = dl.expect("set by the first increment");
+                }
+                dl = dl.map(|l| 0.5 * l);
+            }
             Ok(inc) => {
                 prev_dl = dl_try.or(dl);
                 if dl0 == 0.0 {
