@@ -213,6 +213,8 @@ fn displacement_step(
     let mut prev_size: Option<f64> = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
     // Whether the last attempt failed: its retry starts from the last converged state.
     let mut retry = false;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while level < 1.0 - 1e-12 {
         let target = (level + d_level).min(1.0);
         let shift = (value - v0) * target;
@@ -226,7 +228,12 @@ fn displacement_step(
             .flatten();
         match newton_controlled(ctx, &f_ext, &ctl, shift, extrapolate) {
             Ok((_, iterations))
-                if implex_retry(ctx.sys, ctx.timings, target - level, 1.0 / n_inc as f64) =>
+                if implex_retry(
+                    ctx.sys,
+                    ctx.timings,
+                    (target - level, 1.0 / n_inc as f64),
+                    &mut implex_last,
+                ) =>
             {
                 // The IMPL-EX error is above the tolerance: retried at half the size, as
                 // after a failed attempt (not counted against the step's cuts).
@@ -549,6 +556,8 @@ fn arc_length_step(
     };
     let mut failed_dl: Option<f64> = None;
     let mut prev_dl: Option<f64> = None;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while increment < a.max_increments {
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
         ctx.sys.time.extrapolation = match (prev_dl, dl) {
@@ -561,8 +570,11 @@ fn arc_length_step(
                 if implex_retry(
                     ctx.sys,
                     ctx.timings,
-                    dl.unwrap_or(0.0),
-                    if dl0 == 0.0 { dl.unwrap_or(0.0) } else { dl0 },
+                    (
+                        dl.unwrap_or(0.0),
+                        if dl0 == 0.0 { dl.unwrap_or(0.0) } else { dl0 },
+                    ),
+                    &mut implex_last,
                 ) =>
             {
                 // The IMPL-EX error is above the tolerance: the arc retried at half its

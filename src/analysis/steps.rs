@@ -219,6 +219,8 @@ fn load_step(
         && model.controls.predictor == Predictor::Extrapolated;
     // Whether the last attempt failed: its retry starts from the last converged state.
     let mut retry = false;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while level < 1.0 - 1e-12 {
         let target = pair.target(level, d_level);
         let lam: Vec<f64> = start
@@ -301,7 +303,12 @@ fn load_step(
             }
             Ok((_, iterations))
                 if step.kind != StepKind::Linear
-                    && implex_retry(ctx.sys, ctx.timings, target - level, 1.0 / n_inc as f64) =>
+                    && implex_retry(
+                        ctx.sys,
+                        ctx.timings,
+                        (target - level, 1.0 / n_inc as f64),
+                        &mut implex_last,
+                    ) =>
             {
                 // The IMPL-EX error is above the tolerance: retried at half the size, as
                 // after a failed attempt (not counted against the step's cuts).

@@ -108,9 +108,10 @@ pub fn direction_error(p: &ConcreteParams, alpha: f64, (ex, emax): (f64, f64), e
 /// "Error control"), `committed` the state the increment started from, `trial` its converged
 /// state, `char_length` [m] the crack band width and `ratio` [-] the extrapolation ratio the
 /// increment used. σ_implicit is the stress the implicit crack law would give at the same
-/// crack strain from the committed history. A crack that forms in the increment (elastic in
-/// it under IMPL-EX) is measured against the envelope at its strain. 0 without IMPL-EX, for
-/// crushed points and for uncracked ones.
+/// crack strain from the committed history. Only the directions cracked in the committed
+/// state are measured (a fixed crack forming in the increment, elastic in it, is not; a
+/// rotating point's first increment past ε0 is, against the envelope). 0 without IMPL-EX,
+/// for crushed points and for uncracked ones.
 pub fn point_error(
     p: &ConcreteParams,
     committed: &ConcreteState,
@@ -147,14 +148,11 @@ pub fn point_error(
                 if e <= 0.0 {
                     continue;
                 }
+                // A crack formed in this increment (elastic in it) is not measured: where it
+                // forms at a jump of the strain, the jump does not shrink with the increment.
                 if i < committed.n_cracks as usize {
                     let emax = committed.crack_max[i];
                     err = err.max(direction_error(p, alpha, (extrapolated(i), emax), e));
-                } else {
-                    // Formed in this increment: elastic (E ε) under IMPL-EX, on the envelope
-                    // (from ε_max = 0) under the implicit law.
-                    let elastic = p.ec * e;
-                    err = err.max((elastic - tension_envelope(p, alpha, e).0).abs());
                 }
             }
         }
