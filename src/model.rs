@@ -423,6 +423,11 @@ pub struct SolverControls {
     /// Start of the Newton iterations of an increment of a displacement-controlled or
     /// instantaneous load step.
     pub predictor: Predictor,
+    /// IMPL-EX error control (`[solver] implex_tolerance`, a fraction of f_tm): an increment
+    /// whose largest IMPL-EX crack-stress error exceeds it is retried at half the size, at
+    /// most `max_cuts` times (docs/theory-concrete.md §5.2). None (the default): off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub implex_tolerance: Option<f64>,
     /// Print every Newton iteration's residual and energy norms to standard error
     /// (set by `segfem run --verbose`, not by the model file).
     pub verbose: bool,
@@ -436,6 +441,7 @@ impl Default for SolverControls {
             max_iterations: 25,
             max_cuts: 6,
             predictor: Predictor::LastConverged,
+            implex_tolerance: None,
             verbose: false,
         }
     }

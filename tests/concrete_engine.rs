@@ -943,3 +943,57 @@ increments = 3000
         rho * fy
     );
 }
+
+/// IMPL-EX error control (`[solver] implex_tolerance`, docs/theory-concrete.md §5.2): one
+/// element in uniaxial tension to 20 ε0 in 20 displacement increments (Hinton softening),
+/// run implicit, IMPL-EX, and IMPL-EX with the tolerance 0.05 f_tm. The implicit run follows
+/// the envelope σ_env(ε) (checked to 1e-6 f_tm, a uniform element); IMPL-EX without control
+/// forms the crack one increment late (elastic to ≈ 2 ε0) and lags the envelope by a
+/// first-order error. With the control the run must cut, report no increment above the
+/// tolerance (the smallest size, ε0/64, meets it), and land closer to the implicit run: its
+/// largest deviation from the envelope at its converged points at most half of the
+/// uncontrolled one's, and its peak stress (f_tm in the implicit run) closer to the implicit
+/// peak by at least half the uncontrolled overshoot.
+#[test]
+fn implex_error_control_cuts_and_lands_closer_to_the_implicit_run() {
+    let p = ConcreteParams::from_mc90(38e6, 0.2);
+    let (e0, ft) = (p.eps0(), p.ftm);
+    let alpha = p.softening_alpha(0.1);
+    let env = |e: f64| segfem::materials::concrete::cracking::tension_envelope(&p, alpha, e).0;
+    let u_end = 20.0 * e0 * 0.1;
+    let go = |extra: &str, solver: &str| {
+        let m = model(&(block(&[(u_end, 20)], extra) + solver));
+        let mut t = Trace {
+            dof: 2,
+            ..Default::default()
+        };
+        let timings = steps::run(&m, &mut t).unwrap_or_else(|e| panic!("{e}"));
+        // Largest |σ − σ_env(ε)| / f_tm over the converged points, and the peak stress.
+        let dev = t
+            .rows
+            .iter()
+            .map(|r| (r.1 / 0.01 - env(r.2 / 0.1)).abs() / ft)
+            .fold(0.0, f64::max);
+        let peak = t.rows.iter().map(|r| r.1 / 0.01).fold(0.0, f64::max);
+        (dev, peak, timings)
+    };
+    let implex = "crack_integration = \"implex\"";
+    let (dev_i, peak_i, _) = go("", "");
+    let (dev_x, peak_x, t_x) = go(implex, "");
+    let (dev_c, peak_c, t_c) = go(implex, "\n[solver]\nimplex_tolerance = 0.05\n");
+    eprintln!(
+        "deviation from the envelope: implicit {dev_i:.2e}, IMPL-EX {dev_x:.3}, controlled {dev_c:.3} f_tm; \
+         peak σ {peak_i:.4e} / {peak_x:.4e} / {peak_c:.4e} Pa; cuts {}, increments {}",
+        t_c.implex_cuts, t_c.increments
+    );
+    assert!(dev_i < 1e-6, "implicit off the envelope by {dev_i} f_tm");
+    assert_eq!(t_x.implex_cuts, 0);
+    assert!(t_c.implex_cuts > 0 && t_c.increments > 20);
+    assert_eq!(t_c.implex_over_tolerance, 0);
+    assert!(t_c.implex_max_error <= 0.05);
+    assert!(
+        dev_c <= 0.5 * dev_x,
+        "controlled {dev_c}, uncontrolled {dev_x}"
+    );
+    assert!((peak_c - peak_i).abs() < 0.5 * (peak_x - peak_i).abs());
+}

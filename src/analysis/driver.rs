@@ -157,6 +157,26 @@ pub struct Timings {
     /// Limit points or bifurcations passed (the number of negative pivots changed), one
     /// message each.
     pub limit_points: Vec<String>,
+    /// IMPL-EX error control (`[solver] implex_tolerance`): increments retried at half the
+    /// size because their IMPL-EX error exceeded the tolerance.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_cuts: usize,
+    /// Increments accepted with their IMPL-EX error above the tolerance (at the smallest
+    /// size `max_cuts` allows).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_over_tolerance: usize,
+    /// The largest IMPL-EX error of an accepted increment [-] (fraction of f_tm; 0 when the
+    /// control is off).
+    #[serde(skip_serializing_if = "is_zero_f")]
+    pub implex_max_error: f64,
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
+}
+
+fn is_zero_f(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// After a converged increment inside a step: stop if an observer asks (the step end
@@ -200,4 +220,50 @@ pub(super) fn note_limit_point(
         ));
         *last = now;
     }
+}
+
+/// A halving must bring the IMPL-EX error of an increment below this fraction of the last
+/// attempt's, or the increment is kept as it is (the error is not controlled by the size).
+const IMPLEX_MIN_REDUCTION: f64 = 0.9;
+
+/// IMPL-EX error control after a converged increment (`[solver] implex_tolerance`,
+/// docs/theory-concrete.md §5.2): true if the increment is to be thrown away and retried at
+/// half its size — its largest IMPL-EX error exceeds the tolerance, it is larger than the
+/// smallest size (the step's nominal increment halved `max_cuts` times; `size` and
+/// `nominal` in any common unit), and the error fell with the last halving (below 0.9 of the
+/// error `last` of the previous attempt of this increment, which this updates; a crack that
+/// jumps open at fixed load keeps its error whatever the size). An increment kept above the
+/// tolerance is counted in `timings`. Always false without the option.
+pub(super) fn implex_retry(
+    sys: &super::system::System,
+    timings: &mut Timings,
+    (size, nominal): (f64, f64),
+    last: &mut Option<f64>,
+) -> bool {
+    let controls = &sys.model.controls;
+    let Some(tol) = controls.implex_tolerance else {
+        return false;
+    };
+    let err = sys.implex_error();
+    let smallest = nominal * 0.5_f64.powi(controls.max_cuts as i32);
+    let falls = last.is_none_or(|l| err < IMPLEX_MIN_REDUCTION * l);
+    if err > tol && falls && 0.5 * size >= smallest * (1.0 - 1e-9) {
+        timings.implex_cuts += 1;
+        *last = Some(err);
+        if controls.verbose {
+            eprintln!("    IMPL-EX error {err:.3} f_tm > {tol} f_tm: increment halved");
+        }
+        return true;
+    }
+    *last = None;
+    if err > tol {
+        timings.implex_over_tolerance += 1;
+        if controls.verbose {
+            eprintln!(
+                "    IMPL-EX error {err:.3} f_tm > {tol} f_tm kept (smallest increment, or not reduced by halving)"
+            );
+        }
+    }
+    timings.implex_max_error = timings.implex_max_error.max(err);
+    false
 }

@@ -3,7 +3,9 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
-use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
+use super::driver::{
+    check_stop, implex_retry, note_limit_point, AnalysisError, Observer, Snapshot, Timings,
+};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
@@ -241,6 +243,8 @@ fn displacement_step(
     let mut prev_size: Option<f64> = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
     // Whether the last attempt failed: its retry starts from the last converged state.
     let mut retry = false;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while level < 1.0 - 1e-12 {
         let target = (level + d_level).min(1.0);
         let shift = (value - v0) * target;
@@ -253,6 +257,22 @@ fn displacement_step(
             .then(|| prev_size.map(|p| (target - level) / p))
             .flatten();
         match newton_controlled(ctx, &f_ext, &ctl, shift, extrapolate) {
+            Ok((_, iterations))
+                if implex_retry(
+                    ctx.sys,
+                    ctx.timings,
+                    (target - level, 1.0 / n_inc as f64),
+                    &mut implex_last,
+                ) =>
+            {
+                // The IMPL-EX error is above the tolerance: retried at half the size, as
+                // after a failed attempt (not counted against the step's cuts).
+                ctx.timings.iterations += iterations;
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                retry = true;
+                d_level *= 0.5;
+            }
             Ok((f_int, iterations)) => {
                 retry = false;
                 let u = ctx.u.clone();
@@ -595,6 +615,8 @@ fn arc_length_step(
     };
     let mut failed_dl: Option<f64> = None;
     let mut prev_dl: Option<f64> = None;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while increment < a.max_increments {
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
         ctx.sys.time.extrapolation = match (prev_dl, dl) {
@@ -603,6 +625,27 @@ fn arc_length_step(
         };
         let dl_try = dl;
         match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
+            Ok(inc)
+                if implex_retry(
+                    ctx.sys,
+                    ctx.timings,
+                    (
+                        dl.unwrap_or(0.0),
+                        if dl0 == 0.0 { dl.unwrap_or(0.0) } else { dl0 },
+                    ),
+                    &mut implex_last,
+                ) =>
+            {
+                // The IMPL-EX error is above the tolerance: the arc retried at half its
+                // length (not counted against the cuts).
+                ctx.timings.iterations += inc.iterations;
+                ctx.u.copy_from_slice(&ctx.sys.u);
+                ctx.sys.unlatch();
+                if dl0 == 0.0 {
+                    dl0 = dl.expect("set by the first increment");
+                }
+                dl = dl.map(|l| 0.5 * l);
+            }
             Ok(inc) => {
                 prev_dl = dl_try.or(dl);
                 if dl0 == 0.0 {

@@ -1,7 +1,7 @@
 //! The step driver: load-controlled increments solved by Newton–Raphson with automatic
 //! step cutting; every converged increment is reported to an observer.
 
-use super::driver::{check_stop, note_limit_point};
+use super::driver::{check_stop, implex_retry, note_limit_point};
 pub use super::driver::{
     AnalysisError, Observer, RunOptions, Snapshot, StepEnd, StopReason, Timings,
 };
@@ -219,6 +219,8 @@ fn load_step(
         && model.controls.predictor == Predictor::Extrapolated;
     // Whether the last attempt failed: its retry starts from the last converged state.
     let mut retry = false;
+    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
+    let mut implex_last = None;
     while level < 1.0 - 1e-12 {
         let target = pair.target(level, d_level);
         let lam: Vec<f64> = start
@@ -299,8 +301,33 @@ fn load_step(
                     .map_err(AnalysisError::Mechanism)?;
                 discard_trial(ctx);
             }
+            Ok((_, iterations))
+                if step.kind != StepKind::Linear
+                    && implex_retry(
+                        ctx.sys,
+                        ctx.timings,
+                        (target - level, 1.0 / n_inc as f64),
+                        &mut implex_last,
+                    ) =>
+            {
+                // The IMPL-EX error is above the tolerance: retried at half the size, as
+                // after a failed attempt (not counted against the step's cuts).
+                ctx.timings.iterations += iterations;
+                discard_trial(ctx);
+                retry = true;
+                d_level *= 0.5;
+                pair = Pair::Probe;
+            }
             Ok((f_int, iterations)) => {
                 retry = false;
+                // With the IMPL-EX error control the increments grow back after cuts, as in
+                // displacement control (time steps with substep pairs set their own).
+                if model.controls.implex_tolerance.is_some()
+                    && tolerance.is_none()
+                    && iterations <= 4
+                {
+                    d_level = (2.0 * d_level).min(1.0 / n_inc as f64);
+                }
                 if let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) {
                     // An accepted pair: the next one as long as the error allows.
                     d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);

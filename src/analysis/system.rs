@@ -842,6 +842,62 @@ impl<'m> System<'m> {
         .expect("tendon geometry checked at input")
     }
 
+    /// True if some continuum material integrates its cracks by IMPL-EX.
+    pub fn has_implex(&self) -> bool {
+        self.model.materials.iter().any(|m| {
+            matches!(&m.law, crate::materials::point::Material::Concrete { params, .. } if params.implex)
+        })
+    }
+
+    /// The largest IMPL-EX error of the trial states of the last assembly [-] (fraction of
+    /// f_tm, [`crate::materials::concrete::implex::point_error`]) over all IMPL-EX concrete
+    /// points, with the extrapolation ratio of the current increment; 0 if there are none.
+    /// The points are checked in parallel (each element's crack band width is the square
+    /// root of its area, as in its update).
+    pub fn implex_error(&self) -> f64 {
+        use crate::materials::point::Material;
+        let model = self.model;
+        let c = &self.families.continuum;
+        let gp_offset = &self.gp_offset;
+        let ratio = self.time.extrapolation;
+        (0..model.elements.len())
+            .into_par_iter()
+            .map(|e| {
+                let el = &model.elements[e];
+                let Material::Concrete { params, .. } =
+                    &model.materials[model.regions[el.region].material].law
+                else {
+                    return 0.0;
+                };
+                if !params.implex {
+                    return 0.0;
+                }
+                let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+                for (a, &n) in el.nodes.iter().enumerate() {
+                    coords[a] = model.nodes[n];
+                }
+                let (kind, rule) = match el.integration {
+                    crate::elements::continuum::Integration::Incompatible => (
+                        crate::fem::shape::QuadKind::Q4,
+                        crate::elements::continuum::Integration::Full,
+                    ),
+                    i => (el.kind, i),
+                };
+                let h = continuum::gauss_geometry(kind, rule, &coords[..el.nodes.len()]).h;
+                (gp_offset[e]..gp_offset[e + 1])
+                    .map(|g| match (&c.points.committed[g], &c.points.trial[g]) {
+                        (PointState::Concrete(cs), PointState::Concrete(ts)) => {
+                            crate::materials::concrete::implex::point_error(
+                                params, cs, ts, h, ratio,
+                            )
+                        }
+                        _ => 0.0,
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .reduce(|| 0.0, f64::max)
+    }
+
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
         self.commit_time_dependent();

@@ -323,6 +323,7 @@ pub struct SolverIn {
     pub max_iterations: Option<usize>,
     pub max_cuts: Option<usize>,
     pub predictor: Option<String>,
+    pub implex_tolerance: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -68,6 +68,9 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
             }
             c.max_cuts = v;
         }
+        if let Some(v) = sv.implex_tolerance {
+            c.implex_tolerance = Some(positive(ctx, "solver.implex_tolerance", v)?);
+        }
         if let Some(v) = sv.predictor.as_deref() {
             c.predictor = match v {
                 "extrapolated" => Predictor::Extrapolated,

@@ -1,6 +1,6 @@
 //! The IMPL-EX tension law within an increment (`implex.rs`, docs/theory-concrete.md §5.2).
 
-use super::super::implex::{exp_e1, secant_integral, tension};
+use super::super::implex::{exp_e1, point_error, secant_integral, tension};
 use super::*;
 
 /// E₁(x) against the exponential integral tabulated to 17 digits (mpmath `e1`), on both
@@ -130,4 +130,95 @@ fn implex_crack_point_has_no_kink_at_the_extrapolated_strain() {
             d[0][0]
         );
     }
+}
+
+/// The IMPL-EX error measure (`implex::point_error`, docs/theory-concrete.md §5.2 "Error
+/// control") against hand values for a crack along x with the Hinton envelope
+/// σ_env(x) = f_tm exp(−(x − ε0)/α) written out here: the crack forms at 1.1 ε0 and opens
+/// to 3.1 ε0, so the next increment of the same size extrapolates ẽ = 5.1 ε0.
+/// * opening past ẽ (to 8 ε0): the overshoot is σ_env(ẽ) + ∫_ẽ^ε σ_env(x)/x dx − σ_env(ε),
+///   the integral by Simpson's rule (error ~1e-12 f_tm); tolerance 1e-9 of f_tm;
+/// * between ε_max and ẽ (4 ε0): the secant at ẽ against the envelope (below it);
+/// * unloading below ε_max (2 ε0): the secant at ẽ against the committed secant, and no error
+///   without extrapolation (ratio 0: both are the committed secant);
+/// * compression: no error (both integrations share the compression law);
+/// * a crack forming in the increment (elastic in it, at 3 ε0) is not measured (0), and the
+///   next increment's opening past ẽ = 3 ε0 (rate 0: no extrapolation) to 5 ε0 is again the
+///   integral form.
+#[test]
+fn implex_error_measure_matches_hand_values() {
+    let mut p = params();
+    p.implex = true;
+    let alpha = p.softening_alpha(0.1);
+    let (e0, ft) = (p.eps0(), p.ftm);
+    let env = |x: f64| ft * (-(x - e0) / alpha).exp();
+    let mut c = ConcreteState::new();
+    for (i, e) in [1.1 * e0, 3.1 * e0].into_iter().enumerate() {
+        let ratio = if i > 0 { 1.0 } else { 0.0 };
+        c = update_extrapolated(&p, &c, &[e, 0.0, 0.0], 0.1, ratio)
+            .unwrap()
+            .0;
+    }
+    let (emax, ex) = (3.1 * e0, 5.1 * e0);
+    assert!((c.crack_max[0] - emax).abs() < 1e-12 * emax);
+    let err = |e: f64, ratio: f64| {
+        let t = update_extrapolated(&p, &c, &[e, 0.0, 0.0], 0.1, ratio)
+            .unwrap()
+            .0;
+        point_error(&p, &c, &t, 0.1, ratio)
+    };
+    let want = [
+        (
+            8.0 * e0,
+            (env(ex) + simpson(&p, alpha, ex, 8.0 * e0, 4000) - env(8.0 * e0)) / ft,
+        ),
+        (
+            4.0 * e0,
+            (env(ex) / ex * 4.0 * e0 - env(4.0 * e0)).abs() / ft,
+        ),
+        (
+            2.0 * e0,
+            (env(ex) / ex - env(emax) / emax).abs() * 2.0 * e0 / ft,
+        ),
+        (-2.0 * e0, 0.0),
+    ];
+    for (e, w) in want {
+        let got = err(e, 1.0);
+        assert!(
+            (got - w).abs() < 1e-9,
+            "at {} ε0: error {got:.12} f_tm, want {w:.12}",
+            e / e0
+        );
+    }
+    // The overshoot past ẽ is positive and larger than between ε_max and ẽ.
+    assert!(want[0].1 > want[1].1);
+    assert!(
+        err(2.0 * e0, 0.0).abs() < 1e-12,
+        "no extrapolation, no error"
+    );
+    // Formation: the point cracks at 3 ε0 in its first increment.
+    let v = ConcreteState::new();
+    let t = update_extrapolated(&p, &v, &[3.0 * e0, 0.0, 0.0], 0.1, 0.0)
+        .unwrap()
+        .0;
+    assert_eq!(t.n_cracks, 1);
+    assert_eq!(
+        point_error(&p, &v, &t, 0.1, 0.0),
+        0.0,
+        "formation not measured"
+    );
+    let n = update_extrapolated(&p, &t, &[5.0 * e0, 0.0, 0.0], 0.1, 1.0)
+        .unwrap()
+        .0;
+    let got = point_error(&p, &t, &n, 0.1, 1.0);
+    let (a, b) = (3.0 * e0, 5.0 * e0);
+    let w = (env(a) + simpson(&p, alpha, a, b, 4000) - env(b)) / ft;
+    assert!(
+        (got - w).abs() < 1e-9,
+        "after formation: {got:.12} f_tm, want {w:.12}"
+    );
+    // Off without IMPL-EX.
+    let mut q = p.clone();
+    q.implex = false;
+    assert_eq!(point_error(&q, &v, &t, 0.1, 0.0), 0.0);
 }
