@@ -128,8 +128,8 @@ point = [4.0, 0.0]
 uy = 0.0
 "#;
 
-/// Both end lines held in x, one corner in y: free to expand in y, no end rotation.
-const ENDS_HELD_IN_X: &str = r#"
+/// Both end lines held in x (no end rotation); the y supports are added to it.
+const END_LINES_IN_X: &str = r#"
 [[supports]]
 name = "left"
 line = [[0.0, 0.0], [0.0, 0.4]]
@@ -139,12 +139,19 @@ ux = 0.0
 name = "right"
 line = [[4.0, 0.0], [4.0, 0.4]]
 ux = 0.0
+"#;
 
+/// Both end lines held in x, one corner in y: free to expand in y, no end rotation.
+fn ends_held_in_x() -> String {
+    format!(
+        r#"{END_LINES_IN_X}
 [[supports]]
 name = "vertical"
 point = [0.0, 0.0]
 uy = 0.0
-"#;
+"#
+    )
+}
 
 /// Largest stress component magnitude over all Gauss points [Pa].
 fn max_stress(last: &Last) -> f64 {
@@ -188,7 +195,7 @@ fn free_beam_expands_and_bends_without_stress() {
 /// everywhere and σy = τ = 0 (exact in plane stress whatever ν).
 #[test]
 fn restrained_bar_takes_minus_e_alpha_dt() {
-    let (_, last) = solve(&rect_beam(0.2, ENDS_HELD_IN_X, "{ uniform = 20.0 }"));
+    let (_, last) = solve(&rect_beam(0.2, &ends_held_in_x(), "{ uniform = 20.0 }"));
     let s0 = -E * ALPHA * 20.0;
     for s in &last.stress {
         // A uniform state, exact in the elements: round-off.
@@ -202,17 +209,8 @@ fn restrained_bar_takes_minus_e_alpha_dt() {
 /// the end moment E I α ΔT_M / h and no deflection.
 #[test]
 fn clamped_beam_under_linear_gradient_takes_e_i_alpha_dt_over_h() {
-    let supports = r#"
-[[supports]]
-name = "left"
-line = [[0.0, 0.0], [0.0, 0.4]]
-ux = 0.0
-
-[[supports]]
-name = "right"
-line = [[4.0, 0.0], [4.0, 0.4]]
-ux = 0.0
-
+    let supports = format!(
+        r#"{END_LINES_IN_X}
 [[supports]]
 name = "left_y"
 point = [0.0, 0.0]
@@ -222,8 +220,9 @@ uy = 0.0
 name = "right_y"
 point = [4.0, 0.0]
 uy = 0.0
-"#;
-    let (model, last) = solve(&rect_beam(0.2, supports, "{ linear = 10.0 }"));
+"#
+    );
+    let (model, last) = solve(&rect_beam(0.2, &supports, "{ linear = 10.0 }"));
     let (h, b) = (0.4, 0.3);
     let gps = gauss_points(&model);
     for (s, x) in last.stress.iter().zip(&gps) {
@@ -712,7 +711,7 @@ fn elastic_outputs_left_out_of_a_checkpoint_are_recomputed_exactly() {
             Ok(())
         }
     }
-    let text = rect_beam(0.2, ENDS_HELD_IN_X, "{ linear = 10.0 }");
+    let text = rect_beam(0.2, &ends_held_in_x(), "{ linear = 10.0 }");
     let built = segfem::input::parse(&text, "thermal.toml").unwrap_or_else(|e| panic!("{e}"));
     let mut saved = Saved::default();
     steps::run(&built.model, &mut saved).expect("runs");

@@ -45,6 +45,13 @@ impl PathContext<'_, '_> {
     }
 
     /// Assemble at `u` with the tangent, factorise it (LDLᵀ fallback).
+    /// Throw the trial state of an attempt away: the displacements back to the committed
+    /// ones and the iteration's crack holds released.
+    pub(super) fn back_to_committed(&mut self) {
+        self.u.copy_from_slice(&self.sys.u);
+        self.sys.unlatch();
+    }
+
     /// Internal forces, tangent values and the element-force scale (the residual reference
     /// that stays finite under self-equilibrated loading) at displacements `u`.
     fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
@@ -138,6 +145,10 @@ struct Kept {
     /// Its assembly, with the tangent.
     assembled: Assembled,
 }
+
+/// What a line search gives: the step length (None: the full step) and, when the search
+/// ended on its last trial point, that point's assembly with the tangent.
+type Searched = (Option<f64>, Option<Kept>);
 
 /// Whether two vectors hold the same bits.
 fn same_bits(a: &[f64], b: &[f64]) -> bool {
@@ -268,8 +279,7 @@ fn displacement_step(
                 // The IMPL-EX error is above the tolerance: retried at half the size, as
                 // after a failed attempt (not counted against the step's cuts).
                 ctx.timings.iterations += iterations;
-                ctx.u.copy_from_slice(&ctx.sys.u);
-                ctx.sys.unlatch();
+                ctx.back_to_committed();
                 retry = true;
                 d_level *= 0.5;
             }
@@ -298,8 +308,7 @@ fn displacement_step(
                 }
             }
             Err(f) => {
-                ctx.u.copy_from_slice(&ctx.sys.u);
-                ctx.sys.unlatch();
+                ctx.back_to_committed();
                 retry = true;
                 if cuts >= ctx.sys.model.controls.max_cuts {
                     return Err(not_converged(ctx, si, increment + 1, target, cuts, &f));
@@ -507,7 +516,6 @@ fn controlled_residual(
 /// assembly comes back with it ([`Kept`]) for the Newton iteration that continues from
 /// there. On the RC beam 8 of 10 searches that pass s = 1 end on their last point, and a
 /// tangent assembly costs about 1.4 residual-only ones.
-type Searched = (Option<f64>, Option<Kept>);
 fn line_search(
     ctx: &mut PathContext,
     u: &[f64],
@@ -639,8 +647,7 @@ fn arc_length_step(
                 // The IMPL-EX error is above the tolerance: the arc retried at half its
                 // length (not counted against the cuts).
                 ctx.timings.iterations += inc.iterations;
-                ctx.u.copy_from_slice(&ctx.sys.u);
-                ctx.sys.unlatch();
+                ctx.back_to_committed();
                 if dl0 == 0.0 {
                     dl0 = dl.expect("set by the first increment");
                 }
@@ -727,8 +734,7 @@ fn arc_length_step(
                 }
             }
             Err(f) => {
-                ctx.u.copy_from_slice(&ctx.sys.u);
-                ctx.sys.unlatch();
+                ctx.back_to_committed();
                 if cuts >= max_cuts || dl.is_none() {
                     return Err(not_converged(ctx, si, increment + 1, lambda, cuts, &f));
                 }

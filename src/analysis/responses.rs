@@ -55,11 +55,37 @@ impl GeometryCache {
         Self { offset, data }
     }
 
+    /// The characteristic length h [m] of element `e` (the last packed value), if stored.
+    fn h(&self, e: usize) -> Option<f64> {
+        self.data[self.offset[e]..self.offset[e + 1]]
+            .last()
+            .copied()
+    }
+
     /// The geometry of element `e` (`n` nodes, `n_pts` Gauss points), if stored.
     fn get(&self, e: usize, n: usize, n_pts: usize) -> Option<GaussGeometry> {
         let d = &self.data[self.offset[e]..self.offset[e + 1]];
         (!d.is_empty()).then(|| GaussGeometry::unpack(d, n, n_pts))
     }
+}
+
+/// The crack band width h [m] of continuum element `e` as its material update takes it
+/// ([`GaussGeometry::h`]; an element with incompatible modes uses its Q4 rule's): from
+/// `cache` where stored, else computed.
+pub(super) fn crack_band_width(model: &Model, cache: Option<&GeometryCache>, e: usize) -> f64 {
+    if let Some(h) = cache.and_then(|c| c.h(e)) {
+        return h;
+    }
+    let el = &model.elements[e];
+    let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+    for (a, &n) in el.nodes.iter().enumerate() {
+        coords[a] = model.nodes[n];
+    }
+    let (kind, rule) = match el.integration {
+        Integration::Incompatible => (crate::fem::shape::QuadKind::Q4, Integration::Full),
+        i => (el.kind, i),
+    };
+    gauss_geometry(kind, rule, &coords[..el.nodes.len()]).h
 }
 
 /// What the continuum elements of one chunk share (read-only).

@@ -404,11 +404,10 @@ fn load_step(
 /// Throw the trial state of a failed (or probing) increment away: the displacements back to
 /// the committed ones, prescribed values kept, the iteration holds released.
 fn discard_trial(ctx: &mut super::path::PathContext) {
-    ctx.u.copy_from_slice(&ctx.sys.u);
+    ctx.back_to_committed();
     for &(d, v) in &ctx.sys.dofs.prescribed {
         ctx.u[d] = v;
     }
-    ctx.sys.unlatch();
 }
 
 /// Enter the construction stage of step `si` at time `clock` [d]: the external forces of

@@ -852,8 +852,8 @@ impl<'m> System<'m> {
     /// The largest IMPL-EX error of the trial states of the last assembly [-] (fraction of
     /// f_tm, [`crate::materials::concrete::implex::point_error`]) over all IMPL-EX concrete
     /// points, with the extrapolation ratio of the current increment; 0 if there are none.
-    /// The points are checked in parallel (each element's crack band width is the square
-    /// root of its area, as in its update).
+    /// The points are checked in parallel (each element's crack band width as in its
+    /// update).
     pub fn implex_error(&self) -> f64 {
         use crate::materials::point::Material;
         let model = self.model;
@@ -872,18 +872,7 @@ impl<'m> System<'m> {
                 if !params.implex {
                     return 0.0;
                 }
-                let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
-                for (a, &n) in el.nodes.iter().enumerate() {
-                    coords[a] = model.nodes[n];
-                }
-                let (kind, rule) = match el.integration {
-                    crate::elements::continuum::Integration::Incompatible => (
-                        crate::fem::shape::QuadKind::Q4,
-                        crate::elements::continuum::Integration::Full,
-                    ),
-                    i => (el.kind, i),
-                };
-                let h = continuum::gauss_geometry(kind, rule, &coords[..el.nodes.len()]).h;
+                let h = responses::crack_band_width(model, self.geometry.as_ref(), e);
                 (gp_offset[e]..gp_offset[e + 1])
                     .map(|g| match (&c.points.committed[g], &c.points.trial[g]) {
                         (PointState::Concrete(cs), PointState::Concrete(ts)) => {

@@ -403,10 +403,7 @@ pub fn update_cracked(
     let mut n_cracks = committed.n_cracks;
     let mut crack_max = committed.crack_max;
     // IMPL-EX: e_max extrapolated linearly from the last two committed states.
-    let extrapolate = |i: usize| {
-        let (m, o) = (committed.crack_max[i], committed.crack_max_old[i]);
-        m + ratio.max(0.0) * (m - o).max(0.0)
-    };
+    let extrapolate = |i: usize| super::implex::extrapolated_max(committed, i, ratio);
     // Compression softening of each direction by the other one's tensile strain.
     let lateral = |j: usize| (el[j] + committed.dir_plastic[j]).max(0.0);
     let red = [

@@ -82,6 +82,14 @@ pub fn exp_e1(x: f64) -> f64 {
     }
 }
 
+/// IMPL-EX largest crack strain of direction `i` [-] for an increment with extrapolation
+/// ratio `ratio` [-] (its size over the last one's): the committed largest strain
+/// extrapolated linearly from the last two committed states, never backwards.
+pub fn extrapolated_max(committed: &ConcreteState, i: usize, ratio: f64) -> f64 {
+    let (m, o) = (committed.crack_max[i], committed.crack_max_old[i]);
+    m + ratio.max(0.0) * (m - o).max(0.0)
+}
+
 /// The stress [Pa] the implicit crack law gives at crack strain `e` ≥ 0 [-] from the
 /// committed largest strain `emax` [-]: on the envelope if `e` passes `emax` (or nothing has
 /// opened), else on the committed secant.
@@ -123,10 +131,7 @@ pub fn point_error(
         return 0.0;
     }
     let alpha = p.softening_alpha(char_length);
-    let extrapolated = |i: usize| {
-        let (m, o) = (committed.crack_max[i], committed.crack_max_old[i]);
-        m + ratio.max(0.0) * (m - o).max(0.0)
-    };
+    let extrapolated = |i: usize| extrapolated_max(committed, i, ratio);
     let mut err: f64 = 0.0;
     match p.crack_model {
         CrackModel::Rotating => {

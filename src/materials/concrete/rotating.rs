@@ -227,9 +227,8 @@ fn evaluate(
     // the point has cracked: elastic up to f_tm, then the capped line).
     let ex = |i: usize| {
         p.implex.then(|| {
-            let (m, o) = (c.crack_max[i], c.crack_max_old[i]);
             if c.n_cracks > 0 {
-                m + ratio.max(0.0) * (m - o).max(0.0)
+                super::implex::extrapolated_max(c, i, ratio)
             } else {
                 p.eps0()
             }
