@@ -211,6 +211,18 @@ enum Command {
         /// file's stiffness matrix, the baseline of the whole-process time; prints JSON.
         #[arg(long)]
         model: Option<PathBuf>,
+        /// Beams case: plate increment [mm] (default 0.2; brittle shear peaks with IMPL-EX
+        /// need 0.05 or less, docs/validation.md).
+        #[arg(long)]
+        plate_increment_mm: Option<f64>,
+        /// Beams case: element rows through the depth of each run, comma separated
+        /// (default 10,20).
+        #[arg(long, value_delimiter = ',')]
+        rows: Vec<usize>,
+        /// Beams case: run only this model option (its name as the report prints it, e.g.
+        /// "rotating, VC93"); repeat for several (default: all).
+        #[arg(long = "option")]
+        options: Vec<String>,
     },
     /// Draw figures (PNG and SVG) of a finished run: curves, mesh, deformed shape, fields.
     Plot(PlotArgs),
@@ -340,6 +352,9 @@ fn main() -> ExitCode {
             case,
             refine,
             model,
+            plate_increment_mm,
+            rows,
+            options,
         } => match case.as_str() {
             _ if model.is_some() && case != "panels" && case != "beams" => {
                 bench_bare(model.as_deref().expect("checked"))
@@ -354,7 +369,19 @@ fn main() -> ExitCode {
             "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
             "panels" => bench_panels(model.as_deref()),
-            "beams" => bench_beams(model.as_deref()),
+            "beams" => {
+                let mut set = segfem::materials::concrete::beam_bench::SeriesSettings {
+                    options,
+                    ..Default::default()
+                };
+                if let Some(mm) = plate_increment_mm {
+                    set.plate_increment = 1e-3 * mm;
+                }
+                if !rows.is_empty() {
+                    set.rows = rows;
+                }
+                bench_beams(model.as_deref(), &set)
+            }
             o => {
                 eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, long_term_concrete, seed-failure, seed-failure-concrete, rc, viaduct, material-point, panels or beams)");
                 ExitCode::from(2)

@@ -1,7 +1,9 @@
 //! Shear-critical beam OA1 of Vecchio & Shim (2004), no stirrups, through the engine
 //! (docs/validation.md, "Shear beams"; data and sources in validation/beams/).
 
-use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam, Beam};
+use segfem::materials::concrete::beam_bench::{
+    options, read_beams, run_beam, Beam, PLATE_INCREMENT,
+};
 
 /// The beam `id` of validation/beams/beams.csv.
 fn beam(id: &str) -> Beam {
@@ -37,8 +39,15 @@ fn option(name: &str) -> &'static str {
 fn oa1_peaks_bracket_the_test_and_the_failure_is_brittle() {
     let oa1 = &beam("OA1");
     let p_u = oa1.test.0;
-    let fixed = run_beam(oa1, option("fixed, aggregate β, VC93"), 10, -0.02).unwrap();
-    let rot = run_beam(oa1, option("rotating, VC93"), 10, -0.02).unwrap();
+    let fixed = run_beam(
+        oa1,
+        option("fixed, aggregate β, VC93"),
+        10,
+        -0.02,
+        PLATE_INCREMENT,
+    )
+    .unwrap();
+    let rot = run_beam(oa1, option("rotating, VC93"), 10, -0.02, PLATE_INCREMENT).unwrap();
     eprintln!(
         "OA1: fixed {:.1} kN (end {:.2} of peak, {:?}), rotating {:.1} kN ({:?}); test {:.0} kN",
         fixed.p_peak / 1e3,
@@ -86,7 +95,7 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
     let b1 = &beam("B1");
     let p_u = b1.test.0;
     let keys = option("fixed, seed β");
-    let r = run_beam(b1, keys, 10, -0.02).unwrap();
+    let r = run_beam(b1, keys, 10, -0.02, PLATE_INCREMENT).unwrap();
     let u = r.ultimate.as_ref().expect("a verdict");
     eprintln!(
         "B1: {:.1} kN at {:.1} mm, {} {:?}; test {:.0} kN",
@@ -127,7 +136,7 @@ fn b1_default_model_reaches_the_measured_peak_by_crushing() {
 fn oa1_rankine_cut_off_removes_stress_locking() {
     let oa1 = &beam("OA1");
     let keys = option("fixed, seed β, Rankine cut-off");
-    let r = run_beam(oa1, keys, 10, -0.02).unwrap();
+    let r = run_beam(oa1, keys, 10, -0.02, PLATE_INCREMENT).unwrap();
     eprintln!(
         "OA1 cut-off: {:.1} kN at {:.1} mm, {:?}; {:?}",
         r.p_peak / 1e3,
@@ -163,7 +172,7 @@ fn oa1_rankine_cut_off_removes_stress_locking() {
 fn oa1_softening_cut_off_softens_past_the_peak() {
     let oa1 = &beam("OA1");
     let keys = option("fixed, seed β, softening cut-off");
-    let r = run_beam(oa1, keys, 10, -0.02).unwrap();
+    let r = run_beam(oa1, keys, 10, -0.02, PLATE_INCREMENT).unwrap();
     eprintln!(
         "OA1 softening cut-off: {:.1} kN at {:.1} mm, end {:.3}, {:?}; {:?}",
         r.p_peak / 1e3,
@@ -197,7 +206,7 @@ fn b1_rankine_cut_off_reaches_the_measured_peak_by_crushing() {
     let b1 = &beam("B1");
     let p_u = b1.test.0;
     let keys = option("fixed, seed β, Rankine cut-off");
-    let r = run_beam(b1, keys, 10, -0.02).unwrap();
+    let r = run_beam(b1, keys, 10, -0.02, PLATE_INCREMENT).unwrap();
     let u = r.ultimate.as_ref().expect("a verdict");
     eprintln!(
         "B1 cut-off: {:.1} kN at {:.1} mm, {} {:?}; {:?}",

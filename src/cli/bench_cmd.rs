@@ -185,10 +185,13 @@ pub(crate) fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
 }
 
 /// Print the shear-beam series (validation/beams/beams.csv, or `file`) under each concrete
-/// model option on two meshes.
-pub(crate) fn bench_beams(file: Option<&std::path::Path>) -> ExitCode {
+/// model option (or those of `set`) on two meshes (or those of `set`).
+pub(crate) fn bench_beams(
+    file: Option<&std::path::Path>,
+    set: &segfem::materials::concrete::beam_bench::SeriesSettings,
+) -> ExitCode {
     let path = file.unwrap_or(std::path::Path::new("validation/beams/beams.csv"));
-    match segfem::materials::concrete::beam_bench::series(path) {
+    match segfem::materials::concrete::beam_bench::series(path, set) {
         Ok((report, secs)) => {
             outln!("{report}");
             outln!("total time of the series: {secs:.1} s");

@@ -117,9 +117,15 @@ fn layout(beam: &Beam, rows: usize) -> (f64, usize, usize) {
     (dx, n_half, n_over)
 }
 
+/// The bench's plate increment [m]: 0.2 mm. Brittle shear peaks with IMPL-EX crack
+/// integration are not converged at this size (docs/validation.md, "IMPL-EX increment
+/// study"); `segfem bench --case beams --plate-increment-mm` sets another.
+pub const PLATE_INCREMENT: f64 = 2e-4;
+
 /// Input text of the half beam with `rows` element rows through the depth and the extra
-/// concrete keys `keys`; the plate on the symmetry line is pushed down by `push` [m].
-pub fn beam_toml(beam: &Beam, keys: &str, rows: usize, push: f64) -> String {
+/// concrete keys `keys`; the plate on the symmetry line is pushed down by `push` [m] in
+/// increments of `increment` [m] (at least 10; `PLATE_INCREMENT` in the bench).
+pub fn beam_toml(beam: &Beam, keys: &str, rows: usize, push: f64, increment: f64) -> String {
     // "{s_rm}" in the keys: the beam's crack spacing (`crack_spacing`).
     let keys = &keys.replace("{s_rm}", &format!("{:.4}", crack_spacing(beam)));
     let (dx, n_half, n_over) = layout(beam, rows);
@@ -238,8 +244,7 @@ max_cuts = 8
         xb0 = xs - 0.5 * PLATE,
         xb1 = xs + 0.5 * PLATE,
         nx = n_half + n_over,
-        // Increments of 0.2 mm of the plate.
-        inc = ((push.abs() / 2e-4).ceil() as usize).max(10),
+        inc = ((push.abs() / increment).ceil() as usize).max(10),
     )
 }
 
@@ -339,10 +344,17 @@ impl Observer for Watch {
 }
 
 /// Run a beam with the concrete keys `keys` and `rows` element rows through the depth,
-/// pushed down to `push` [m] (negative) or to failure.
-pub fn run_beam(beam: &Beam, keys: &str, rows: usize, push: f64) -> Result<BeamRun, String> {
+/// pushed down to `push` [m] (negative) or to failure in plate increments of `increment`
+/// [m] (`PLATE_INCREMENT` in the bench).
+pub fn run_beam(
+    beam: &Beam,
+    keys: &str,
+    rows: usize,
+    push: f64,
+    increment: f64,
+) -> Result<BeamRun, String> {
     let t0 = std::time::Instant::now();
-    let text = beam_toml(beam, keys, rows, push);
+    let text = beam_toml(beam, keys, rows, push, increment);
     let built =
         crate::input::parse(&text, &format!("beam {}", beam.id)).map_err(|e| e.to_string())?;
     let model = &built.model;
@@ -514,24 +526,78 @@ pub fn read_beams(path: &std::path::Path) -> Result<Vec<Beam>, String> {
     Ok(out)
 }
 
-/// Run every beam under every option on 10 and 20 rows through the depth; returns a
-/// Markdown report (test/predicted peak per run, the mesh difference, the verdicts) and
-/// the total time [s].
-pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
+/// What `series` runs: the plate increment, the meshes and the model options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesSettings {
+    /// Plate increment [m] (`PLATE_INCREMENT` by default).
+    pub plate_increment: f64,
+    /// Element rows through the depth of each run (10 and 20 by default).
+    pub rows: Vec<usize>,
+    /// Names of the options of `options()` to run (all if empty).
+    pub options: Vec<String>,
+}
+
+impl Default for SeriesSettings {
+    fn default() -> Self {
+        SeriesSettings {
+            plate_increment: PLATE_INCREMENT,
+            rows: vec![10, 20],
+            options: Vec::new(),
+        }
+    }
+}
+
+/// Run every beam under every option (or those of `set`) on each mesh of `set` (10 and 20
+/// rows by default); returns a Markdown report (test/predicted peak per run, the mesh
+/// difference of the first and the last mesh, the verdicts) and the total time [s].
+pub fn series(path: &std::path::Path, set: &SeriesSettings) -> Result<(String, f64), String> {
     let start = std::time::Instant::now();
     let beams = read_beams(path)?;
-    let mut s = String::from(
-        "| beam | P_test [kN] | model | P 10 rows [kN] | test/pred 10 | P 20 rows [kN] | test/pred 20 | 20 vs 10 rows |\n|---|---|---|---|---|---|---|---|\n",
-    );
+    let all = options();
+    if let Some(o) = set.options.iter().find(|o| !all.iter().any(|a| a.0 == *o)) {
+        let names: Vec<&str> = all.iter().map(|a| a.0).collect();
+        return Err(format!(
+            "no beam option {o:?} (options: {})",
+            names.join("; ")
+        ));
+    }
+    if set.rows.is_empty() || set.rows.contains(&0) {
+        return Err("rows: at least one mesh of one or more rows".into());
+    }
+    if !(set.plate_increment > 0.0) {
+        return Err(format!(
+            "plate increment {} m: must be positive",
+            set.plate_increment
+        ));
+    }
+    let chosen: Vec<(&str, &str)> = all
+        .into_iter()
+        .filter(|o| set.options.is_empty() || set.options.iter().any(|n| n == o.0))
+        .collect();
+    let rows = &set.rows;
+    let mut s = String::from("| beam | P_test [kN] | model |");
+    for r in rows {
+        s.push_str(&format!(" P {r} rows [kN] | test/pred {r} |"));
+    }
+    let two = rows.len() >= 2;
+    if two {
+        s.push_str(&format!(" {} vs {} rows |", rows[rows.len() - 1], rows[0]));
+    }
+    s.push_str("\n|---|---|---|");
+    s.push_str(&"---|---|".repeat(rows.len()));
+    if two {
+        s.push_str("---|");
+    }
+    s.push('\n');
     let mut notes = String::new();
     for b in &beams {
         // Pushed to twice the measured peak deflection, at least 20 mm.
         let push = -(2.0 * b.test.1).max(0.02);
-        for (name, keys) in options() {
-            let runs: Vec<Result<BeamRun, String>> = [10, 20]
+        for &(name, keys) in &chosen {
+            let runs: Vec<Result<BeamRun, String>> = rows
                 .iter()
                 .map(|&r| {
-                    let out = run_beam(b, keys, r, push);
+                    let out = run_beam(b, keys, r, push, set.plate_increment);
                     // Progress on stderr: a series takes minutes.
                     match &out {
                         Ok(x) => eprintln!(
@@ -550,18 +616,19 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
                 Ok(r) => format!("{:.0} | {:.2}", r.p_peak / 1e3, b.test.0 / r.p_peak),
                 Err(_) => "failed | –".into(),
             };
-            let diff = match (&runs[0], &runs[1]) {
-                (Ok(a), Ok(c)) => format!("{:+.1} %", 100.0 * (c.p_peak / a.p_peak - 1.0)),
-                _ => "–".into(),
-            };
-            s.push_str(&format!(
-                "| {} | {:.0} | {name} | {} | {} | {diff} |\n",
-                b.id,
-                b.test.0 / 1e3,
-                cell(&runs[0]),
-                cell(&runs[1])
-            ));
-            for (rows, r) in [10, 20].iter().zip(&runs) {
+            s.push_str(&format!("| {} | {:.0} | {name} |", b.id, b.test.0 / 1e3));
+            for r in &runs {
+                s.push_str(&format!(" {} |", cell(r)));
+            }
+            if two {
+                let diff = match (&runs[0], &runs[runs.len() - 1]) {
+                    (Ok(a), Ok(c)) => format!("{:+.1} %", 100.0 * (c.p_peak / a.p_peak - 1.0)),
+                    _ => "–".into(),
+                };
+                s.push_str(&format!(" {diff} |"));
+            }
+            s.push('\n');
+            for (rows, r) in rows.iter().zip(&runs) {
                 match r {
                     Ok(r) => notes.push_str(&format!(
                         "{} / {name} / {rows} rows: P = {:.1} kN at {:.1} mm (test {:.0} kN at {:.1} mm, {}); end of run {:.0} % of the peak; {}; {} increments, {:.1} s\n",
@@ -581,7 +648,10 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
             }
         }
     }
-    s.push_str("\nRuns (peak, deflection, drop after the peak, verdict):\n\n```\n");
+    s.push_str(&format!(
+        "\nRuns (peak, deflection, drop after the peak, verdict), plate increments of {} mm:\n\n```\n",
+        set.plate_increment * 1e3
+    ));
     s.push_str(&notes);
     s.push_str("```\n");
     Ok((s, start.elapsed().as_secs_f64()))
