@@ -564,7 +564,7 @@ pub fn series(path: &std::path::Path, set: &SeriesSettings) -> Result<(String, f
     if set.rows.is_empty() || set.rows.contains(&0) {
         return Err("rows: at least one mesh of one or more rows".into());
     }
-    if !(set.plate_increment > 0.0) {
+    if !set.plate_increment.is_finite() || set.plate_increment <= 0.0 {
         return Err(format!(
             "plate increment {} m: must be positive",
             set.plate_increment
