@@ -23,6 +23,11 @@ pub enum MaterialError {
     /// Non-finite strain passed to the update.
     #[error("non-finite strain [{}, {}, {}]", .0[0], .0[1], .0[2])]
     NonFiniteStrain([f64; 3]),
+    /// A local iteration other than the return mapping (e.g. creep in series with cracking)
+    /// did not converge for this strain increment: like a return mapping that did not
+    /// converge, the caller cuts the step and retries.
+    #[error("local iteration not converged: {0}")]
+    LocalNotConverged(String),
     /// Inconsistent material parameters.
     #[error("invalid material parameters: {0}")]
     InvalidParams(String),

@@ -263,9 +263,9 @@ impl From<crate::materials::error::MaterialError> for UpdateError {
         match e {
             // The input checks every parameter: an invalid one here is a bug.
             MaterialError::InvalidParams(_) => UpdateError::Internal(e.to_string()),
-            MaterialError::ReturnMappingNotConverged { .. } | MaterialError::NonFiniteStrain(_) => {
-                UpdateError::NotConverged(e.to_string())
-            }
+            MaterialError::ReturnMappingNotConverged { .. }
+            | MaterialError::LocalNotConverged(_)
+            | MaterialError::NonFiniteStrain(_) => UpdateError::NotConverged(e.to_string()),
         }
     }
 }

@@ -223,7 +223,9 @@ pub fn update(
             continue;
         }
         if it == MAX_LOCAL {
-            return Err(MaterialError::InvalidParams(format!(
+            // A strain increment too large for the local series (a crack opening or a
+            // strut softening within it), not a bug: the driver cuts the step.
+            return Err(MaterialError::LocalNotConverged(format!(
                 "creeping concrete: the series of creep and cracking did not converge \
                  (residual {:.3e} after {MAX_LOCAL} local iterations)",
                 g.iter().fold(0.0_f64, |a, &v| a.max(v.abs()))
@@ -238,7 +240,7 @@ pub fn update(
         };
         let dx = inv3(&gp).map(|gi| matvec(&gi, &g));
         let Some(dx) = dx else {
-            return Err(MaterialError::InvalidParams(
+            return Err(MaterialError::LocalNotConverged(
                 "creeping concrete: creep in series with a softening crack snaps back \
                  (local tangent singular); use smaller time steps or a ductile tension law"
                     .into(),
@@ -267,7 +269,7 @@ pub fn update(
     let tangent = match inv3(&gp) {
         Some(gi) => matmul(&d, &gi),
         None => {
-            return Err(MaterialError::InvalidParams(
+            return Err(MaterialError::LocalNotConverged(
                 "creeping concrete: creep in series with a softening crack snaps back \
                  (tangent singular); use smaller time steps or a ductile tension law"
                     .into(),
