@@ -1519,6 +1519,6 @@ fn seed_beam_life_with_compression_softening_cuts_steps_instead_of_panicking() {
         assert!(msg.contains("did not converge"), "{msg}");
     }
     // The service phase (step 1, 10⁴ days) is complete: the push is the last step.
-    let last_service = life.rows.iter().filter(|r| r.step == 1).last().unwrap();
+    let last_service = life.rows.iter().rfind(|r| r.step == 1).unwrap();
     assert!(last_service.time > 9_999.0, "{}", last_service.time);
 }
