@@ -187,9 +187,10 @@ pub struct LineSearchStats {
     pub full_step: usize,
     /// Trial points assembled without the tangent (s = 1).
     pub residual_trials: usize,
-    /// Searches after an overshoot whose full step (s = 1) was the iterate just assembled,
-    /// its work taken from there instead of assembling it again.
-    pub full_step_known: usize,
+    /// Of these, full steps that were the iterate just assembled (after an overshoot),
+    /// computed again only in the elements of the points latched since
+    /// (`System::reassemble_after_latch`).
+    pub full_step_again: usize,
     /// Trial points assembled with the tangent (inside (0, 1)).
     pub tangent_trials: usize,
     /// Tangent trial assemblies the next Newton iteration took over.

@@ -55,8 +55,7 @@ impl PathContext<'_, '_> {
     /// Internal forces, tangent values and the element-force scale (the residual reference
     /// that stays finite under self-equilibrated loading) at displacements `u`.
     fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
-        let (f_int, k, scale, _) = self.tangent_reusing(u, None)?;
-        Ok((f_int, k, scale))
+        self.tangent_reusing(u, None)
     }
 
     /// As [`PathContext::tangent`], taking the assembly the line search made at its last
@@ -68,7 +67,7 @@ impl PathContext<'_, '_> {
         &mut self,
         u: &[f64],
         kept: Option<Kept>,
-    ) -> Result<(Vec<f64>, Vec<f64>, f64, usize), NewtonFailure> {
+    ) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
         let t = Instant::now();
         let a = match kept.filter(|k| same_bits(&k.u, u)) {
             Some(k) => {
@@ -80,13 +79,12 @@ impl PathContext<'_, '_> {
                 .assemble(u, true)
                 .map_err(NewtonFailure::material)?,
         };
-        let latched = self.sys.latch_cracks();
+        self.sys.latch_cracks();
         self.timings.assembly_s += t.elapsed().as_secs_f64();
         Ok((
             a.f_int,
             a.k_values.expect("tangent requested"),
             a.force_scale,
-            latched,
         ))
     }
 
@@ -364,28 +362,17 @@ fn newton_controlled(
             mut k,
             mut rf,
             mut rel,
-            latched,
         } = controlled_residual(ctx, &u, f_ext, ctl, kept.take())?;
         if let Some(c) = last.take() {
             if overshot(rel, c.rel) {
                 // The correction overshot (a band of open cracks or yielded bars is nearly a
                 // mechanism: the linearised step closes cracks into compression at E): back
-                // along it to where the residual's work vanishes, or half-way. The search's
-                // first point, the full correction, is this iterate: its work is known when
-                // nothing was latched since this assembly (the search would assemble the
-                // same point from the same states again).
-                let full = (latched == 0).then(|| (&u[..], &rf[..]));
-                let (s, at) = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl, Some(full))?;
+                // along it to where the residual's work vanishes, or half-way.
+                let (s, at) = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl, true)?;
                 let s = s.unwrap_or(0.5);
                 u.copy_from_slice(&c.u);
                 ctx.add_free(&mut u, &c.du, s);
-                Residual {
-                    f_int,
-                    k,
-                    rf,
-                    rel,
-                    ..
-                } = controlled_residual(ctx, &u, f_ext, ctl, at)?;
+                Residual { f_int, k, rf, rel } = controlled_residual(ctx, &u, f_ext, ctl, at)?;
                 if controls.verbose {
                     eprintln!(
                         "    residual grew: back to {s:.3} of the last correction, relative residual {rel:.3e}"
@@ -451,7 +438,7 @@ fn newton_controlled(
             // correction, g(s) = δu·r(u + s δu), which has a zero in (0, 1] when the
             // correction overshoots a kink of the material response; fall back to the
             // plain halving when g does not change sign.
-            let (s, at) = line_search(ctx, &u, &du, &rf, f_ext, ctl, None)?;
+            let (s, at) = line_search(ctx, &u, &du, &rf, f_ext, ctl, false)?;
             kept = at;
             let s = s.unwrap_or(damp);
             du.iter_mut().for_each(|v| *v *= s);
@@ -497,9 +484,6 @@ struct Residual {
     rf: Vec<f64>,
     /// ‖rf‖ over the force scale [-].
     rel: f64,
-    /// Points latched after the assembly (0: the system's trial states and crack holds are
-    /// still those the assembly at this iterate made and read).
-    latched: usize,
 }
 
 /// Internal forces, tangent, free residual and relative residual norm at `u` (the line
@@ -511,7 +495,7 @@ fn controlled_residual(
     ctl: &[Controlled],
     kept: Option<Kept>,
 ) -> Result<Residual, NewtonFailure> {
-    let (f_int, k, scale, latched) = ctx.tangent_reusing(u, kept)?;
+    let (f_int, k, scale) = ctx.tangent_reusing(u, kept)?;
     let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
     let mut rf = ctx.sys.to_free(&r);
     for k in ctl {
@@ -522,13 +506,7 @@ fn controlled_residual(
             .max(norm(&f_int))
             .max(scale)
             .max(f64::MIN_POSITIVE);
-    Ok(Residual {
-        f_int,
-        k,
-        rf,
-        rel,
-        latched,
-    })
+    Ok(Residual { f_int, k, rf, rel })
 }
 
 /// Step length s ∈ (0, 1] along the correction `du` (free equations) from `u` where the
@@ -548,7 +526,7 @@ fn line_search(
     r0: &[f64],
     f_ext: &[f64],
     ctl: &[Controlled],
-    overshoot: Option<Option<(&[f64], &[f64])>>,
+    overshoot: bool,
 ) -> Result<Searched, NewtonFailure> {
     let g0 = dot(du, r0);
     if g0.is_nan() || g0 <= 0.0 {
@@ -562,10 +540,20 @@ fn line_search(
         let mut ut = u.to_vec();
         ctx.add_free(&mut ut, du, s);
         let t = Instant::now();
-        let a = ctx
-            .sys
-            .assemble(&ut, tangent)
-            .map_err(NewtonFailure::material)?;
+        // The full step after an overshoot is the iterate just assembled (and latched):
+        // only the elements of the latched points are computed again.
+        let again = if tangent {
+            None
+        } else {
+            ctx.sys.reassemble_after_latch(&ut)
+        };
+        let ls = &mut ctx.timings.line_searches;
+        ls.full_step_again += usize::from(again.is_some());
+        let a = match again {
+            Some(a) => a,
+            None => ctx.sys.assemble(&ut, tangent),
+        }
+        .map_err(NewtonFailure::material)?;
         let ls = &mut ctx.timings.line_searches;
         if tangent {
             ls.tangent_trials += 1;
@@ -586,22 +574,9 @@ fn line_search(
         Ok((dot(du, &rf), kept))
     };
     ctx.timings.line_searches.searches += 1;
-    ctx.timings.line_searches.after_overshoot += usize::from(overshoot.is_some());
-    // The full step's work from the iterate the overshoot was seen at, when that is u + du
-    // to the bit.
-    let known_g1 = overshoot.flatten().and_then(|(at, rf)| {
-        let mut ut = u.to_vec();
-        ctx.add_free(&mut ut, du, 1.0);
-        same_bits(&ut, at).then(|| dot(du, rf))
-    });
+    ctx.timings.line_searches.after_overshoot += usize::from(overshoot);
     let searched = (|| {
-        let g1 = match known_g1 {
-            Some(g) => {
-                ctx.timings.line_searches.full_step_known += 1;
-                g
-            }
-            None => g_at(1.0, false, ctx)?.0,
-        };
+        let (g1, _) = g_at(1.0, false, ctx)?;
         if g1 >= 0.0 {
             ctx.timings.line_searches.full_step += 1;
             return Ok((None, None));
@@ -882,9 +857,7 @@ fn arc_increment(
                 }
             }
         }
-        let Residual {
-            f_int, k, rf, rel, ..
-        } = eval?;
+        let Residual { f_int, k, rf, rel } = eval?;
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
@@ -1020,11 +993,5 @@ fn arc_residual(
             .max(norm(&f_int))
             .max(scale)
             .max(f64::MIN_POSITIVE);
-    Ok(Residual {
-        f_int,
-        k,
-        rf,
-        rel,
-        latched: 0,
-    })
+    Ok(Residual { f_int, k, rf, rel })
 }

@@ -109,13 +109,13 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                 );
                 let l = &t.line_searches;
                 outln!(
-                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), s = 1 known {} times, trial points {} without the tangent ({:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
+                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
                     "",
                     l.searches,
                     l.after_overshoot,
                     l.full_step,
-                    l.full_step_known,
                     l.residual_trials,
+                    l.full_step_again,
                     l.residual_s,
                     l.tangent_trials,
                     l.tangent_s,
@@ -175,13 +175,13 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
                 );
                 let l = &t.line_searches;
                 outln!(
-                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), s = 1 known {} times, trial points {} without the tangent ({:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
+                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
                     "",
                     l.searches,
                     l.after_overshoot,
                     l.full_step,
-                    l.full_step_known,
                     l.residual_trials,
+                    l.full_step_again,
                     l.residual_s,
                     l.tangent_trials,
                     l.tangent_s,
