@@ -734,7 +734,13 @@ impl SparseCholesky {
     ) -> Result<usize, SolverError> {
         self.prepare(pattern, values)?;
         let t = std::time::Instant::now();
-        let spare = match self.spare.take() {
+        // (Sized for this analysis: the kept-permuted one replaces the first only before the
+        // second factorisation, but a stale pair is not used in any case.)
+        let spare = match self
+            .spare
+            .take()
+            .filter(|s| s.0.len() == self.symbolic.len_val())
+        {
             Some(s) => s,
             None => {
                 let s = Storage::new(&self.symbolic)?;
