@@ -146,6 +146,9 @@ pub struct Timings {
     /// Element loops of the displacement driver's line searches (residual checks along a
     /// correction; not in `assembly_s`).
     pub line_search_s: f64,
+    /// What the line searches did (counts; empty in a run without any).
+    #[serde(skip_serializing_if = "LineSearchStats::is_empty")]
+    pub line_searches: LineSearchStats,
     /// Linear solver figures.
     pub solver: SolverStats,
     /// Observers (output writing).
@@ -169,6 +172,39 @@ pub struct Timings {
     /// control is off).
     #[serde(skip_serializing_if = "is_zero_f")]
     pub implex_max_error: f64,
+}
+
+/// Counts of the displacement driver's line searches ([`Timings::line_searches`]).
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct LineSearchStats {
+    /// Searches that evaluated a trial point (the work of the residual along the
+    /// correction positive at s = 0).
+    pub searches: usize,
+    /// Of these, those after an overshooting correction (the others on a stagnating
+    /// residual).
+    pub after_overshoot: usize,
+    /// Searches that stopped at s = 1 (the work kept its sign: no trial point inside).
+    pub full_step: usize,
+    /// Trial points assembled without the tangent (s = 1).
+    pub residual_trials: usize,
+    /// Of these, full steps that were the iterate just assembled (after an overshoot),
+    /// computed again only in the elements of the points latched since
+    /// (`System::reassemble_after_latch`).
+    pub full_step_again: usize,
+    /// Trial points assembled with the tangent (inside (0, 1)).
+    pub tangent_trials: usize,
+    /// Tangent trial assemblies the next Newton iteration took over.
+    pub reused: usize,
+    /// Element-loop time of the trial points without the tangent [s].
+    pub residual_s: f64,
+    /// Element-loop time of the trial points with the tangent [s].
+    pub tangent_s: f64,
+}
+
+impl LineSearchStats {
+    fn is_empty(&self) -> bool {
+        self.searches == 0
+    }
 }
 
 fn is_zero(v: &usize) -> bool {

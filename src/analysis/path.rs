@@ -70,7 +70,10 @@ impl PathContext<'_, '_> {
     ) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
         let t = Instant::now();
         let a = match kept.filter(|k| same_bits(&k.u, u)) {
-            Some(k) => k.assembled,
+            Some(k) => {
+                self.timings.line_searches.reused += 1;
+                k.assembled
+            }
             None => self
                 .sys
                 .assemble(u, true)
@@ -365,7 +368,7 @@ fn newton_controlled(
                 // The correction overshot (a band of open cracks or yielded bars is nearly a
                 // mechanism: the linearised step closes cracks into compression at E): back
                 // along it to where the residual's work vanishes, or half-way.
-                let (s, at) = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl)?;
+                let (s, at) = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl, true)?;
                 let s = s.unwrap_or(0.5);
                 u.copy_from_slice(&c.u);
                 ctx.add_free(&mut u, &c.du, s);
@@ -435,7 +438,7 @@ fn newton_controlled(
             // correction, g(s) = δu·r(u + s δu), which has a zero in (0, 1] when the
             // correction overshoots a kink of the material response; fall back to the
             // plain halving when g does not change sign.
-            let (s, at) = line_search(ctx, &u, &du, &rf, f_ext, ctl)?;
+            let (s, at) = line_search(ctx, &u, &du, &rf, f_ext, ctl, false)?;
             kept = at;
             let s = s.unwrap_or(damp);
             du.iter_mut().for_each(|v| *v *= s);
@@ -523,6 +526,7 @@ fn line_search(
     r0: &[f64],
     f_ext: &[f64],
     ctl: &[Controlled],
+    overshoot: bool,
 ) -> Result<Searched, NewtonFailure> {
     let g0 = dot(du, r0);
     if g0.is_nan() || g0 <= 0.0 {
@@ -535,10 +539,29 @@ fn line_search(
      -> Result<(f64, Option<Kept>), NewtonFailure> {
         let mut ut = u.to_vec();
         ctx.add_free(&mut ut, du, s);
-        let a = ctx
-            .sys
-            .assemble(&ut, tangent)
-            .map_err(NewtonFailure::material)?;
+        let t = Instant::now();
+        // The full step after an overshoot is the iterate just assembled (and latched):
+        // only the elements of the latched points are computed again.
+        let again = if tangent {
+            None
+        } else {
+            ctx.sys.reassemble_after_latch(&ut)
+        };
+        let ls = &mut ctx.timings.line_searches;
+        ls.full_step_again += usize::from(again.is_some());
+        let a = match again {
+            Some(a) => a,
+            None => ctx.sys.assemble(&ut, tangent),
+        }
+        .map_err(NewtonFailure::material)?;
+        let ls = &mut ctx.timings.line_searches;
+        if tangent {
+            ls.tangent_trials += 1;
+            ls.tangent_s += t.elapsed().as_secs_f64();
+        } else {
+            ls.residual_trials += 1;
+            ls.residual_s += t.elapsed().as_secs_f64();
+        }
         let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();
         let mut rf = ctx.sys.to_free(&r);
         for k in ctl {
@@ -550,9 +573,12 @@ fn line_search(
         });
         Ok((dot(du, &rf), kept))
     };
+    ctx.timings.line_searches.searches += 1;
+    ctx.timings.line_searches.after_overshoot += usize::from(overshoot);
     let searched = (|| {
         let (g1, _) = g_at(1.0, false, ctx)?;
         if g1 >= 0.0 {
+            ctx.timings.line_searches.full_step += 1;
             return Ok((None, None));
         }
         let (mut a, mut ga, mut b, mut gb) = (0.0, g0, 1.0, g1);

@@ -53,7 +53,21 @@ pub struct SolverStats {
     pub factor_nnz: usize,
     /// Numeric factorisations that fell back to LDLᵀ (indefinite tangent).
     pub ldlt_factorisations: usize,
+    /// LDLᵀ factorisations computed on the second core beside an LLᵀ attempt after an
+    /// indefinite tangent ([`SparseCholesky::factorize_indefinite`]); those the LLᵀ made
+    /// unnecessary are in neither count above.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub concurrent_ldlt: usize,
 }
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
+}
+
+/// Smallest factor [values] whose LDLᵀ is computed beside the LLᵀ attempt after an
+/// indefinite tangent: below it a factorisation takes about a millisecond or less, and the
+/// second buffer and the hand-over are not worth it.
+const CONCURRENT_LDLT_VALUES: usize = 1 << 20;
 
 /// Supernodal factorisation at every size. faer's automatic rule (supernodal above 40 flops
 /// per factor entry) chose the simplicial up-looking factorisation for the seed beam's
@@ -291,6 +305,14 @@ pub struct SparseCholesky {
     /// until it is joined, `symbolic` is a stand-in of order 1 and `stats` are empty.
     analysis: Option<std::thread::JoinHandle<Result<SparseCholesky, SolverError>>>,
     factor: Factor,
+    /// Whether the last [`SparseCholesky::factorize_indefinite`] ended in LDLᵀ: the next
+    /// one then computes LDLᵀ beside its LLᵀ attempt ([`SparseCholesky::factorize_both`]).
+    last_ldlt: bool,
+    /// Factor values and scratch of the LDLᵀ computed beside an LLᵀ (allocated at the first
+    /// such pair).
+    spare: Option<(Vec<f64>, MemBuffer)>,
+    /// Smallest factor [values] for that ([`CONCURRENT_LDLT_VALUES`]; lowered by tests).
+    concurrent_min: usize,
     /// Negative pivots of the last successful factorisation (0 after LLᵀ).
     pub negative_pivots: usize,
     /// Accumulated timings.
@@ -456,6 +478,9 @@ impl SparseCholesky {
             pending,
             analysis: None,
             factor: Factor::None,
+            last_ldlt: false,
+            spare: None,
+            concurrent_min: CONCURRENT_LDLT_VALUES,
             negative_pivots: 0,
             stats,
         })
@@ -512,18 +537,10 @@ impl SparseCholesky {
 
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
-        self.take_analysis()?;
-        if self.prepermute_due && self.stats.factorisations > 0 {
-            self.prepermute(pattern)?;
-        }
+        self.prepare(pattern, values)?;
         let t = std::time::Instant::now();
-        self.take_storage()?;
-        self.factor = Factor::None;
-        let a = match self.pre.as_mut() {
-            Some(p) => {
-                p.fill(values);
-                SparseColMatRef::new(p.pattern.as_ref(), &p.values)
-            }
+        let a = match self.pre.as_ref() {
+            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
             None => SparseColMatRef::new(symbolic(pattern), values),
         };
         let stack = MemStack::new(&mut self.mem);
@@ -538,6 +555,36 @@ impl SparseCholesky {
         );
         self.stats.numeric_s += t.elapsed().as_secs_f64();
         self.stats.factorisations += 1;
+        let res = res.map(|_| ());
+        self.finish_llt(pattern, values, res)
+    }
+
+    /// What every numeric factorisation starts with: the analysis and the factor storage
+    /// taken in, the matrix kept permuted from the second factorisation on and filled with
+    /// `values` (the time of the fill counts as factorisation time).
+    fn prepare(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
+        self.take_analysis()?;
+        if self.prepermute_due && self.stats.factorisations > 0 {
+            self.prepermute(pattern)?;
+        }
+        let t = std::time::Instant::now();
+        self.take_storage()?;
+        self.factor = Factor::None;
+        if let Some(p) = self.pre.as_mut() {
+            p.fill(values);
+        }
+        self.stats.numeric_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The outcome of an LLᵀ of `values` in `l_values`: a pivot that is round-off of its
+    /// diagonal entry or not positive is [`SolverError::NotPositiveDefinite`].
+    fn finish_llt(
+        &mut self,
+        pattern: &LowerPattern,
+        values: &[f64],
+        res: Result<(), faer::linalg::cholesky::llt::factor::LltError>,
+    ) -> Result<(), SolverError> {
         match res {
             Ok(_) => {
                 // A pivot that is round-off of its diagonal entry is a zero pivot (the
@@ -626,12 +673,20 @@ impl SparseCholesky {
         pattern: &LowerPattern,
         values: &[f64],
     ) -> Result<usize, SolverError> {
-        match self.factorize(pattern, values) {
-            Ok(()) => Ok(0),
-            // (A kept-permuted matrix was filled by the failed LLᵀ.)
-            Err(SolverError::NotPositiveDefinite { .. }) => self.factorize_ldlt(pattern, values),
-            Err(e) => Err(e),
-        }
+        let out = if self.last_ldlt && self.symbolic.len_val() >= self.concurrent_min {
+            self.factorize_both(pattern, values)
+        } else {
+            match self.factorize(pattern, values) {
+                Ok(()) => Ok(0),
+                // (A kept-permuted matrix was filled by the failed LLᵀ.)
+                Err(SolverError::NotPositiveDefinite { .. }) => {
+                    self.factorize_ldlt(pattern, values)
+                }
+                Err(e) => Err(e),
+            }
+        };
+        self.last_ldlt = self.factor == Factor::Ldlt;
+        out
     }
 
     /// LDLᵀ of the matrix (a kept-permuted matrix must already hold `values`); the number
@@ -649,19 +704,106 @@ impl SparseCholesky {
             None => SparseColMatRef::new(symbolic(pattern), values),
         };
         let stack = MemStack::new(&mut self.mem);
-        let res = self.symbolic.factorize_numeric_ldlt(
-            &mut self.l_values,
-            a,
-            Side::Lower,
-            LdltRegularization::default(),
-            Par::Seq,
-            stack,
-            Default::default(),
-        );
+        let ok = self
+            .symbolic
+            .factorize_numeric_ldlt(
+                &mut self.l_values,
+                a,
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .is_ok();
         self.stats.numeric_s += t.elapsed().as_secs_f64();
         self.stats.factorisations += 1;
         self.stats.ldlt_factorisations += 1;
-        if res.is_err() {
+        self.finish_ldlt(ok)
+    }
+
+    /// LLᵀ and LDLᵀ of the same matrix at once, one on each core (the next tangent after an
+    /// indefinite one is mostly indefinite too: its LLᵀ attempt, which fails at a late pivot,
+    /// then no longer delays the LDLᵀ). Each is the factorisation
+    /// [`SparseCholesky::factorize_indefinite`] would compute alone, in its own buffers, so the
+    /// factor kept (the LLᵀ if it succeeds, else the LDLᵀ) is the same to the bit.
+    fn factorize_both(
+        &mut self,
+        pattern: &LowerPattern,
+        values: &[f64],
+    ) -> Result<usize, SolverError> {
+        self.prepare(pattern, values)?;
+        let t = std::time::Instant::now();
+        // (Sized for this analysis: the kept-permuted one replaces the first only before the
+        // second factorisation, but a stale pair is not used in any case.)
+        let spare = match self
+            .spare
+            .take()
+            .filter(|s| s.0.len() == self.symbolic.len_val())
+        {
+            Some(s) => s,
+            None => {
+                let s = Storage::new(&self.symbolic)?;
+                (s.l_values, s.mem)
+            }
+        };
+        let (mut l2, mut mem2) = spare;
+        let a = match self.pre.as_ref() {
+            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
+            None => SparseColMatRef::new(symbolic(pattern), values),
+        };
+        let (symbolic, l1, mem1) = (&self.symbolic, &mut self.l_values, &mut self.mem);
+        let (llt, ldlt) = rayon::join(
+            || {
+                symbolic
+                    .factorize_numeric_llt(
+                        l1,
+                        a,
+                        Side::Lower,
+                        LltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(mem1),
+                        Default::default(),
+                    )
+                    .map(|_| ())
+            },
+            || {
+                symbolic
+                    .factorize_numeric_ldlt(
+                        &mut l2,
+                        a,
+                        Side::Lower,
+                        LdltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(&mut mem2),
+                        Default::default(),
+                    )
+                    .is_ok()
+            },
+        );
+        self.stats.numeric_s += t.elapsed().as_secs_f64();
+        self.stats.factorisations += 1;
+        self.stats.concurrent_ldlt += 1;
+        let out = match self.finish_llt(pattern, values, llt) {
+            Ok(()) => Ok(0),
+            Err(SolverError::NotPositiveDefinite { .. }) => {
+                // As if the LDLᵀ had run after the failed LLᵀ: counted so.
+                self.stats.factorisations += 1;
+                self.stats.ldlt_factorisations += 1;
+                std::mem::swap(&mut self.l_values, &mut l2);
+                std::mem::swap(&mut self.mem, &mut mem2);
+                self.finish_ldlt(ldlt)
+            }
+            Err(e) => Err(e),
+        };
+        self.spare = Some((l2, mem2));
+        out
+    }
+
+    /// The outcome of an LDLᵀ in `l_values` (`ok`: faer's factorisation succeeded): the
+    /// number of negative pivots, or [`SolverError::Singular`] for a zero or non-finite one.
+    fn finish_ldlt(&mut self, ok: bool) -> Result<usize, SolverError> {
+        if !ok {
             return Err(SolverError::Singular);
         }
         let d = self.ldlt_diagonal();
@@ -809,14 +951,10 @@ mod tests {
         assert_eq!(s.stats.ldlt_factorisations, 1);
     }
 
-    /// Supernodal LDLᵀ: the 9-point matrix 9I − T⊗T of an m×m grid (T = tridiag(1, 1, 1),
-    /// the stencil of a Q4 mesh) shifted by σ has exactly as many negative pivots as
-    /// eigenvalues 9 − (1 + 2cos jh)(1 + 2cos kh), h = π/(m+1), below σ (Sylvester).
-    #[test]
-    fn ldlt_inertia_of_shifted_laplacian() {
-        let m = 40;
+    /// The 9-point Laplacian of an m × m grid (8 on the diagonal, −1 to the 8 neighbours)
+    /// shifted by −σ: lower-triangle pattern and values.
+    fn shifted_laplacian(m: usize, sigma: f64) -> (LowerPattern, Vec<f64>) {
         let n = m * m;
-        let sigma = 0.37;
         let mut col_ptr = vec![0];
         let mut row_idx = vec![];
         let mut vals = vec![];
@@ -847,6 +985,59 @@ mod tests {
             col_ptr,
             row_idx,
         };
+        (p, vals)
+    }
+
+    /// After an indefinite tangent the LDLᵀ is computed beside the LLᵀ attempt: the factor
+    /// kept is the one the sequential fallback computes, to the bit (an indefinite matrix's
+    /// LDLᵀ, a positive-definite one's LLᵀ), with the same inertia.
+    #[test]
+    fn concurrent_ldlt_keeps_the_sequential_factor() {
+        let m = 30;
+        let (p, indefinite) = shifted_laplacian(m, 0.37);
+        let (_, definite) = shifted_laplacian(m, -0.5);
+        let b: Vec<f64> = (0..m * m).map(|i| (i as f64 * 0.1).sin()).collect();
+        let solve = |s: &mut SparseCholesky| {
+            let mut x = b.clone();
+            s.solve_in_place(&mut x);
+            x.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        };
+        let mut seq = SparseCholesky::new(&p).unwrap();
+        seq.concurrent_min = usize::MAX;
+        let mut both = SparseCholesky::new(&p).unwrap();
+        both.concurrent_min = 0;
+        for vals in [
+            &indefinite,
+            &indefinite,
+            &indefinite,
+            &definite,
+            &indefinite,
+        ] {
+            let a = seq.factorize_indefinite(&p, vals).unwrap();
+            let c = both.factorize_indefinite(&p, vals).unwrap();
+            assert_eq!(a, c);
+            assert_eq!(seq.factor, both.factor);
+            assert_eq!(solve(&mut seq), solve(&mut both));
+        }
+        // The 2nd, 3rd and 4th factorisations ran beside an LDLᵀ (after an indefinite one).
+        assert_eq!(both.stats.concurrent_ldlt, 3);
+        assert_eq!(seq.stats.concurrent_ldlt, 0);
+        assert_eq!(both.stats.factorisations, seq.stats.factorisations);
+        assert_eq!(
+            both.stats.ldlt_factorisations,
+            seq.stats.ldlt_factorisations
+        );
+    }
+
+    /// Supernodal LDLᵀ: the 9-point matrix 9I − T⊗T of an m×m grid (T = tridiag(1, 1, 1),
+    /// the stencil of a Q4 mesh) shifted by σ has exactly as many negative pivots as
+    /// eigenvalues 9 − (1 + 2cos jh)(1 + 2cos kh), h = π/(m+1), below σ (Sylvester).
+    #[test]
+    fn ldlt_inertia_of_shifted_laplacian() {
+        let m = 40;
+        let n = m * m;
+        let sigma = 0.37;
+        let (p, vals) = shifted_laplacian(m, sigma);
         let h = std::f64::consts::PI / (m + 1) as f64;
         let mut expected = 0;
         for j in 1..=m {

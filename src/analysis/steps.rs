@@ -3,7 +3,7 @@
 
 use super::driver::{check_stop, implex_retry, note_limit_point};
 pub use super::driver::{
-    AnalysisError, Observer, RunOptions, Snapshot, StepEnd, StopReason, Timings,
+    AnalysisError, LineSearchStats, Observer, RunOptions, Snapshot, StepEnd, StopReason, Timings,
 };
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::loads::load_vector;

@@ -96,6 +96,21 @@ pub struct System<'m> {
     /// The continuum elements' Gauss-point geometry, computed once for a nonlinear run
     /// (None for a linear one, which assembles twice: not worth the memory).
     geometry: Option<responses::GeometryCache>,
+    /// The last assembly's element forces, for [`System::reassemble_after_latch`].
+    last: LastAssembly,
+}
+
+/// What [`System::reassemble_after_latch`] needs of the last assembly: its displacements, the
+/// forces of every continuum element ([`responses::ND`] entries each) and the points
+/// latched since. Kept for nonlinear models without joints, external tendons or stages
+/// (`kept`); `valid` while the states are the assembly's, up to the latched points.
+#[derive(Default)]
+struct LastAssembly {
+    kept: bool,
+    valid: bool,
+    u: Vec<f64>,
+    forces: Vec<f64>,
+    latched: Vec<usize>,
 }
 
 /// Replace a square row-major matrix of order n by its symmetric part.
@@ -125,6 +140,13 @@ fn chunks<P>(pieces: Vec<P>) -> Vec<(usize, Vec<P>)> {
         start += n;
     }
     out
+}
+
+/// Copy the forces of the `n` continuum elements from `first` on out of their chunk buffer
+/// (slots of [`responses::ND`] entries) into `forces` (element e at e × ND).
+fn keep_forces(forces: &mut [f64], first: usize, n: usize, chunk: &[f64]) {
+    let nd = responses::ND;
+    forces[first * nd..(first + n) * nd].copy_from_slice(&chunk[..n * nd]);
 }
 
 /// Dofs of the largest of elements with these node counts.
@@ -424,6 +446,13 @@ impl<'m> System<'m> {
             stages: model.staging.is_staged().then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
             elem_buf2: (Vec::new(), Vec::new()),
+            last: LastAssembly {
+                kept: !linear
+                    && model.interfaces.is_empty()
+                    && model.tendons.is_empty()
+                    && !model.staging.is_staged(),
+                ..Default::default()
+            },
             blocks,
             geometry,
         }
@@ -467,6 +496,9 @@ impl<'m> System<'m> {
         }
         let new = new.into_iter().map(|(g, b, _)| (g, b));
         let n = new.len();
+        if self.last.valid {
+            self.last.latched.extend(new.clone().map(|x| x.0));
+        }
         if n > 0 {
             c.holds.latched.extend(new);
             c.holds.latched.sort_by_key(|x| x.0);
@@ -476,6 +508,7 @@ impl<'m> System<'m> {
 
     /// Forget latched cracks (the increment is thrown away).
     pub fn unlatch(&mut self) {
+        self.last.valid = false;
         let holds = &mut self.families.continuum.holds;
         holds.latched.clear();
         holds.frozen = false;
@@ -490,6 +523,7 @@ impl<'m> System<'m> {
         if c.holds.frozen {
             return 0;
         }
+        self.last.valid = false;
         c.holds.frozen = true;
         let latched = &mut c.holds.latched;
         let mut held = Vec::new();
@@ -524,6 +558,12 @@ impl<'m> System<'m> {
         tangent: bool,
     ) -> Result<Assembled, (usize, UpdateError)> {
         let model = self.model;
+        self.last.valid = false;
+        let keep = self.last.kept;
+        let mut forces = std::mem::take(&mut self.last.forces);
+        if keep {
+            forces.resize(model.elements.len() * responses::ND, 0.0);
+        }
         let mut sc = Scatter {
             asm: &self.asm,
             f_int: crate::fem::assembly::zeroed_values(u.len()),
@@ -577,6 +617,9 @@ impl<'m> System<'m> {
                 },
                 || match pending.take() {
                     Some((results, first)) => {
+                        if keep {
+                            keep_forces(&mut forces, first, results.len(), &other.0);
+                        }
                         sc.add_chunk(results, first, responses::ND, &mut other, of)
                     }
                     None => Ok(()),
@@ -590,6 +633,9 @@ impl<'m> System<'m> {
             start = end;
         }
         if let Some((results, first)) = pending {
+            if keep {
+                keep_forces(&mut forces, first, results.len(), &buf.0);
+            }
             if let Err(e) = sc.add_chunk(results, first, responses::ND, &mut buf, of) {
                 (self.elem_buf, self.elem_buf2) = (buf, other);
                 return Err(e);
@@ -660,11 +706,100 @@ impl<'m> System<'m> {
         }
         self.symmetrised = sc.symmetrised;
         let force_scale = sc.f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if keep {
+            let last = &mut self.last;
+            last.u.clear();
+            last.u.extend_from_slice(u);
+            last.latched.clear();
+            last.valid = true;
+        }
+        self.last.forces = forces;
         Ok(Assembled {
             f_int: sc.f_int,
             k_values: sc.k_values,
             force_scale,
         })
+    }
+
+    /// The internal forces (no tangent) at `u` when the last assembly was made at `u` to the
+    /// bit and since then only [`System::latch_cracks`] changed the states: the elements
+    /// holding the points it latched are computed again from their new base states (their
+    /// trial states with them), the others' forces are those of the last assembly, which the
+    /// same displacements and states would repeat to the bit, and all are summed in element
+    /// order as an assembly does. The same forces and trial states as `assemble(u, false)`.
+    /// None when that does not hold (or the model keeps no element forces: joints,
+    /// external tendons or stages); then assemble.
+    pub fn reassemble_after_latch(
+        &mut self,
+        u: &[f64],
+    ) -> Option<Result<Assembled, (usize, UpdateError)>> {
+        let last = &self.last;
+        if !(last.valid
+            && last.u.len() == u.len()
+            && last
+                .u
+                .iter()
+                .zip(u)
+                .all(|(a, b)| a.to_bits() == b.to_bits()))
+        {
+            return None;
+        }
+        let model = self.model;
+        let gp_offset = &self.gp_offset;
+        let mut elements: Vec<usize> = last
+            .latched
+            .iter()
+            .map(|&g| gp_offset.partition_point(|&o| o <= g) - 1)
+            .collect();
+        elements.sort_unstable();
+        elements.dedup();
+        let mut forces = std::mem::take(&mut self.last.forces);
+        let mut ke = vec![0.0; responses::ND * responses::ND];
+        let time = self.time;
+        for &e in &elements {
+            let (chunk, mut pieces) = responses::split_chunk(
+                model,
+                &mut self.families,
+                gp_offset,
+                &self.bar_gps,
+                &self.bar_offset,
+                &self.thermal,
+                u,
+                &time,
+                false,
+                (e, e + 1),
+                None,
+                &self.blocks,
+                self.geometry.as_ref(),
+            );
+            let piece = pieces.pop().expect("one element");
+            let fe = &mut forces[e * responses::ND..(e + 1) * responses::ND];
+            if let Err(err) = chunk.element(piece, fe, &mut ke) {
+                self.last.forces = forces;
+                self.last.valid = false;
+                return Some(Err((e, err)));
+            }
+        }
+        let mut f_int = crate::fem::assembly::zeroed_values(u.len());
+        let mut f_abs = crate::fem::assembly::zeroed_values(u.len());
+        for (e, el) in model.elements.iter().enumerate() {
+            let fe = &forces[e * responses::ND..];
+            for (a, &n) in el.nodes.iter().enumerate() {
+                f_int[2 * n] += fe[2 * a];
+                f_int[2 * n + 1] += fe[2 * a + 1];
+                f_abs[2 * n] += fe[2 * a].abs();
+                f_abs[2 * n + 1] += fe[2 * a + 1].abs();
+            }
+        }
+        self.last.forces = forces;
+        self.last.latched.clear();
+        self.symmetrised = false;
+        let force_scale = f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        Some(Ok(Assembled {
+            f_int,
+            k_values: None,
+            force_scale,
+        }))
     }
 
     /// Recompute the committed Gauss outputs of the linear elastic points at the committed
@@ -750,6 +885,7 @@ impl<'m> System<'m> {
     /// against the concrete as it stands); bonded post-tensioned tendons are locked off or
     /// grouted (their bond strain is measured from the current displacements on).
     pub fn stress_tendons(&mut self, step: usize) {
+        self.last.valid = false;
         self.stage_bonded_tendons(step);
         for (t, data) in self.model.tendons.iter().enumerate() {
             if data.stressed_in_step != step || self.tendons[t].is_some() {
@@ -889,6 +1025,7 @@ impl<'m> System<'m> {
 
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
+        self.last.valid = false;
         self.commit_time_dependent();
         std::mem::swap(&mut self.u, &mut self.u_prev);
         self.u.copy_from_slice(u);

@@ -107,6 +107,20 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                     s.factor_nnz,
                     s.solve_s
                 );
+                let l = &t.line_searches;
+                outln!(
+                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
+                    "",
+                    l.searches,
+                    l.after_overshoot,
+                    l.full_step,
+                    l.residual_trials,
+                    l.full_step_again,
+                    l.residual_s,
+                    l.tangent_trials,
+                    l.tangent_s,
+                    l.reused
+                );
             }
             Err(e) => {
                 eprintln!("error: {e}");
@@ -158,6 +172,20 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
                     1e3 * s.numeric_s / s.factorisations.max(1) as f64,
                     s.factor_nnz,
                     s.solve_s
+                );
+                let l = &t.line_searches;
+                outln!(
+                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
+                    "",
+                    l.searches,
+                    l.after_overshoot,
+                    l.full_step,
+                    l.residual_trials,
+                    l.full_step_again,
+                    l.residual_s,
+                    l.tangent_trials,
+                    l.tangent_s,
+                    l.reused
                 );
             }
             Err(e) => {

@@ -212,6 +212,11 @@ impl HardeningLaw {
         self.e0
     }
 
+    /// ε̄0 [-] and κ0 [-] at initial yield: [`initial_yield`] of the law's parameters.
+    pub fn initial_yield(&self) -> (f64, f64) {
+        (self.e0, self.k0)
+    }
+
     /// σ_c(ε̄) [Pa] and dσ_c/dε̄ [Pa] (see [`hardening_curve`]).
     pub fn curve(&self, ebar: f64) -> (f64, f64) {
         if let Some(eu) = self.crush_eu {

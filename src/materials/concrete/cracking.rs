@@ -293,8 +293,14 @@ struct DirHistory {
     reduction: (f64, f64),
 }
 
-/// Uniaxial law of one crack-axis direction at strain `e`.
-fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult {
+/// Uniaxial law of one crack-axis direction at strain `e` (`law`: the hardening law of `p`).
+fn direction(
+    p: &ConcreteParams,
+    law: &compression::HardeningLaw,
+    alpha: f64,
+    h: DirHistory,
+    e: f64,
+) -> DirResult {
     let DirHistory {
         cracked,
         emax,
@@ -305,7 +311,7 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
         reduction: (beta, dbeta),
     } = h;
     let e_el = e + plastic;
-    let ebar = ebar.max(compression::initial_yield(p).0);
+    let ebar = ebar.max(law.initial_yield().0);
     let mut r = DirResult {
         sigma: 0.0,
         k: 0.0,
@@ -360,16 +366,16 @@ fn direction(p: &ConcreteParams, alpha: f64, h: DirHistory, e: f64) -> DirResult
     // `compression`): σ_c(ε̄) = −E(e + p + Δp), Δp = κ(ε̄) − κ(ε̄_n) ⇒
     // ε̄ = −e − p + κ(ε̄_n) + κ0. With compression softening the curve is the one scaled by
     // β_d (κ0 scales with it).
-    let (h_n, ds_n, _) = super::reduction::scaled_hardening(p, beta, ebar);
+    let (h_n, ds_n, _) = super::reduction::scaled_hardening_with(p, law, beta, ebar);
     let s_tr = p.ec * e_el;
     if -s_tr <= h_n.sigma_c {
         r.sigma = s_tr;
         r.k = p.ec;
         return r;
     }
-    let (_, k0) = compression::initial_yield(p);
+    let (_, k0) = law.initial_yield();
     let eb = (-e - plastic + h_n.kappa + beta * k0).max(ebar);
-    let (h, ds, _) = super::reduction::scaled_hardening(p, beta, eb);
+    let (h, ds, _) = super::reduction::scaled_hardening_with(p, law, beta, eb);
     r.ebar = eb;
     r.plastic = plastic + (h.kappa - h_n.kappa).max(0.0);
     r.sigma = -h.sigma_c;
@@ -397,6 +403,7 @@ pub fn update_cracked(
         )));
     }
     let alpha = p.softening_alpha(char_length);
+    let law = compression::HardeningLaw::new(p);
     let t = strain_transform(committed.crack_angle);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let el: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * ee[j]).sum());
@@ -421,7 +428,7 @@ pub fn update_cracked(
             extrapolated: (p.implex && cracked).then(|| extrapolate(i)),
             reduction: red[i],
         };
-        direction(p, alpha, h, el[i])
+        direction(p, &law, alpha, h, el[i])
     };
     let r0 = eval(0, n_cracks, &crack_max);
     let mut r1 = eval(1, n_cracks, &crack_max);

@@ -56,15 +56,25 @@ pub fn lateral_strain(eps0: f64, lateral: f64, h: f64, spacing: f64) -> (f64, f6
 /// and dσ_c/dβ [Pa], dκ/dβ [-] at fixed ε̄. With β = 1 it is exactly
 /// [`compression::hardening`].
 pub fn scaled_hardening(p: &ConcreteParams, beta: f64, ebar: f64) -> (Hardening, f64, f64) {
+    scaled_hardening_with(p, &compression::HardeningLaw::new(p), beta, ebar)
+}
+
+/// [`scaled_hardening`] with the hardening law of `p` given (`law`, the same values).
+pub fn scaled_hardening_with(
+    p: &ConcreteParams,
+    law: &compression::HardeningLaw,
+    beta: f64,
+    ebar: f64,
+) -> (Hardening, f64, f64) {
     if beta == 1.0 {
-        let h = compression::hardening(p, ebar);
-        let (_, k0) = compression::initial_yield(p);
+        let h = law.at(ebar);
+        let (_, k0) = law.initial_yield();
         let ds = h.sigma_c - ebar * h.dsigma_c;
         return (h, ds, -ds / p.ec - k0);
     }
     let y = ebar / beta;
-    let (s0, ds0) = compression::hardening_curve(p, y);
-    let (_, k0) = compression::initial_yield(p);
+    let (s0, ds0) = law.curve(y);
+    let (_, k0) = law.initial_yield();
     let s = beta * s0;
     // ∂(β σ0(ε̄/β))/∂β = σ0(y) − y σ0'(y).
     let ds_db = s0 - y * ds0;
