@@ -436,9 +436,9 @@ impl<'m> Recorder<'m> {
             .chunks(2)
             .flat_map(|d| [d[0], d[1], 0.0])
             .collect();
-        let flat = |v: &[[f64; 3]]| -> Vec<f64> { v.iter().flatten().copied().collect() };
-        let ns = flat(&f.node_stress);
-        let ne = flat(&f.node_strain);
+        // The recovered fields' own memory, viewed flat (no copies: 24 MB at 5e5 dofs).
+        let ns = f.node_stress.as_flattened();
+        let ne = f.node_strain.as_flattened();
         let np: Vec<f64> = f
             .node_stress
             .iter()
@@ -447,8 +447,8 @@ impl<'m> Recorder<'m> {
                 [a, b]
             })
             .collect();
-        let cs = flat(&f.cell_stress);
-        let ce = flat(&f.cell_strain);
+        let cs = f.cell_stress.as_flattened();
+        let ce = f.cell_strain.as_flattened();
         let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
         let mut reaction = vec![0.0; 3 * model.nodes.len()];
         for s in &model.supports {
@@ -564,7 +564,7 @@ impl<'m> Recorder<'m> {
         );
         let tag = field_tag(model, snap.step);
         let name = format!("{tag}_inc{:04}.vtu", snap.increment);
-        let mut files = vec![(self.dir.join(&name), doc.into_bytes())];
+        let mut files = vec![(self.dir.join(&name), doc)];
         let t = self.rows.len() as f64;
         self.pvd.push((t, 0, name));
         if let Some(lines) = render_lines(snap, &disp) {
