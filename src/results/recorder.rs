@@ -486,12 +486,12 @@ impl<'m> Recorder<'m> {
             Array::F64 {
                 name: "stress",
                 components: 3,
-                values: &cs,
+                values: cs,
             },
             Array::F64 {
                 name: "strain",
                 components: 3,
-                values: &ce,
+                values: ce,
             },
         ];
         if let Some((st, crack_normal)) = &concrete {
@@ -547,7 +547,7 @@ impl<'m> Recorder<'m> {
                 Array::F64 {
                     name: "stress",
                     components: 3,
-                    values: &ns,
+                    values: ns,
                 },
                 Array::F64 {
                     name: "principal_stress",
@@ -557,7 +557,7 @@ impl<'m> Recorder<'m> {
                 Array::F64 {
                     name: "strain",
                     components: 3,
-                    values: &ne,
+                    values: ne,
                 },
             ],
             &cell_data,
