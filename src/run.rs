@@ -338,6 +338,10 @@ impl Observer for Progress<'_, '_> {
         self.rec.write_last_fields(system)
     }
 
+    fn idle_work(&mut self) -> Option<crate::analysis::steps::IdleWork> {
+        self.rec.idle_work()
+    }
+
     fn stop_requested(&self) -> Option<StopReason> {
         let sig = self.signal.as_ref().map_or(0, |s| s.load(Ordering::SeqCst));
         if sig != 0 {

@@ -62,7 +62,19 @@ pub trait Observer {
     fn stop_requested(&self) -> Option<StopReason> {
         None
     }
+
+    /// Asked before each increment: work that does not depend on the coming solution (e.g.
+    /// preparing the memory of the next field output), run on a thread of its own while
+    /// the next numeric factorisation runs, which is sequential and leaves the other cores
+    /// idle. It may never run (no factorisation follows); the observer must not wait for
+    /// it without a way to call it off. Default: none.
+    fn idle_work(&mut self) -> Option<IdleWork> {
+        None
+    }
 }
+
+/// Work for an idle core ([`Observer::idle_work`]).
+pub type IdleWork = Box<dyn FnOnce() + Send + Sync + 'static>;
 
 /// The state at a step end, as observers see it (for checkpoints).
 pub struct StepEnd<'a, 's> {

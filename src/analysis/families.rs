@@ -78,8 +78,8 @@ impl ContinuumBlock {
     /// Accept the trial states; the holds last one increment only, so the committed points
     /// end their increment ([`PointState::end_increment`]) when any was held.
     pub fn commit(&mut self) {
-        self.points.commit();
-        self.gauss.commit();
+        self.points.commit_parallel();
+        self.gauss.commit_parallel();
         self.holds.latched.clear();
         let frozen = std::mem::take(&mut self.holds.frozen);
         if std::mem::take(&mut self.holds.held_plastic) || frozen {

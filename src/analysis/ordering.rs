@@ -28,6 +28,8 @@
 //! threshold is kept where it is so that smaller systems, all the bundled examples among
 //! them, keep AMD and their results to the bit.
 
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
 /// Systems of Q4 elements with at least this many equations are ordered by nested
 /// dissection ([`nested_dissection`]).
 pub const ND_MIN_EQUATIONS: usize = 20_000;
@@ -79,13 +81,23 @@ fn median_split(items: &mut [u32], point: impl Fn(u32) -> [f64; 2]) -> (usize, u
     (if split == 0 { mid } else { split }, axis, v)
 }
 
+/// Subdomains from this many nodes have their two halves dissected in parallel (rayon).
+/// The halves read and write the labels of their own nodes only (a node of one half has
+/// no neighbour in the other: those are in the separator), and labels only need to be
+/// distinct, so the order is the same as a sequential dissection's.
+const PARALLEL_MIN_NODES: usize = 4096;
+
 struct Dissection<'a> {
     node_ptr: &'a [usize],
     node_adj: &'a [u32],
     coords: &'a [[f64; 2]],
-    /// Part label of each node: the subdomain currently holding it, or SEPARATOR.
-    part: Vec<u32>,
-    next_label: u32,
+    /// Part label of each node: the subdomain currently holding it, or SEPARATOR (atomic
+    /// with relaxed order, plain loads and stores on x86, for the parallel halves).
+    part: Vec<AtomicU32>,
+    next_label: AtomicU32,
+    /// Subdomains from this many nodes are split in parallel ([`PARALLEL_MIN_NODES`];
+    /// `usize::MAX` in the test that compares with the sequential order).
+    parallel_min: usize,
 }
 
 impl<'a> Dissection<'a> {
@@ -97,28 +109,45 @@ impl<'a> Dissection<'a> {
         coords: &'a [[f64; 2]],
         nodes: &[u32],
     ) -> Self {
-        let mut part = vec![0; coords.len()];
+        let part: Vec<AtomicU32> = (0..coords.len()).map(|_| AtomicU32::new(0)).collect();
         for &v in nodes {
-            part[v as usize] = 1;
+            part[v as usize].store(1, Relaxed);
         }
         Self {
             node_ptr,
             node_adj,
             coords,
             part,
-            next_label: 1,
+            next_label: AtomicU32::new(1),
+            parallel_min: PARALLEL_MIN_NODES,
         }
     }
 
-    fn label(&mut self) -> u32 {
-        self.next_label += 1;
-        self.next_label
+    /// A label no subdomain had.
+    fn label(&self) -> u32 {
+        self.next_label.fetch_add(1, Relaxed) + 1
     }
 
-    /// Append the elimination order of `nodes` (all labelled `id`) to `out`.
-    fn dissect(&mut self, nodes: &mut [u32], out: &mut Vec<u32>) {
+    /// Part label of node `v`.
+    fn part(&self, v: usize) -> u32 {
+        self.part[v].load(Relaxed)
+    }
+
+    fn set_part(&self, v: usize, label: u32) {
+        self.part[v].store(label, Relaxed);
+    }
+
+    /// Append the elimination order of `nodes` (all labelled alike) to `out`.
+    fn dissect_into(&self, nodes: &mut [u32], out: &mut Vec<u32>) {
+        let start = out.len();
+        out.resize(start + nodes.len(), 0);
+        self.dissect(nodes, &mut out[start..]);
+    }
+
+    /// Write the elimination order of `nodes` (all labelled alike) into `out` (as long).
+    fn dissect(&self, nodes: &mut [u32], out: &mut [u32]) {
         if nodes.len() <= LEAF_NODES {
-            out.extend_from_slice(nodes);
+            out.copy_from_slice(nodes);
             return;
         }
         // Nodes tied with the median go to the upper half, so that a grid line is never
@@ -128,7 +157,7 @@ impl<'a> Dissection<'a> {
         let (lower, upper) = nodes.split_at_mut(split);
         let up = self.label();
         for &v in upper.iter() {
-            self.part[v as usize] = up;
+            self.set_part(v as usize, up);
         }
         // Separator: nodes of the lower half with a neighbour in the upper half. Moved to
         // the end of `lower`; the rest keep their relative order.
@@ -137,7 +166,7 @@ impl<'a> Dissection<'a> {
             let v = lower[i] as usize;
             let touches = self.node_adj[self.node_ptr[v]..self.node_ptr[v + 1]]
                 .iter()
-                .any(|&w| self.part[w as usize] == up);
+                .any(|&w| self.part(w as usize) == up);
             if !touches {
                 lower.swap(i, kept);
                 kept += 1;
@@ -146,14 +175,24 @@ impl<'a> Dissection<'a> {
         let low = self.label();
         let (inner, sep) = lower.split_at_mut(kept);
         for &v in inner.iter() {
-            self.part[v as usize] = low;
+            self.set_part(v as usize, low);
         }
         for &v in sep.iter() {
-            self.part[v as usize] = SEPARATOR;
+            self.set_part(v as usize, SEPARATOR);
         }
-        self.dissect(inner, out);
-        self.dissect(upper, out);
-        out.extend_from_slice(sep);
+        // The order: the lower half's, the upper half's, the separator.
+        let (out_inner, rest) = out.split_at_mut(inner.len());
+        let (out_upper, out_sep) = rest.split_at_mut(upper.len());
+        out_sep.copy_from_slice(sep);
+        if inner.len() + upper.len() >= self.parallel_min {
+            rayon::join(
+                || self.dissect(inner, out_inner),
+                || self.dissect(upper, out_upper),
+            );
+        } else {
+            self.dissect(inner, out_inner);
+            self.dissect(upper, out_upper);
+        }
     }
 }
 
@@ -207,7 +246,7 @@ impl Dissection<'_> {
         }
         if elems.len() < 2 {
             // Nodes in no element (or one element's) left: split on their coordinates.
-            return self.dissect(nodes, out);
+            return self.dissect_into(nodes, out);
         }
         let (split_e, n_low, n_up) = self.split_elements(el, elems, nodes);
         let (low_e, up_e) = elems.split_at_mut(split_e);
@@ -254,25 +293,28 @@ impl Dissection<'_> {
         };
         let sides: Vec<u8> = nodes.iter().map(|&a| side(a)).collect();
         for (&a, &s) in nodes.iter().zip(&sides) {
-            self.part[a as usize] = match s {
-                1 => low,
-                2 => up,
-                _ => SEPARATOR,
-            };
+            self.set_part(
+                a as usize,
+                match s {
+                    1 => low,
+                    2 => up,
+                    _ => SEPARATOR,
+                },
+            );
         }
         // Lower nodes coupled to upper ones outside the elements join the separator.
         for &a in nodes.iter() {
             let a = a as usize;
-            if self.part[a] == low
+            if self.part(a) == low
                 && self.node_adj[self.node_ptr[a]..self.node_ptr[a + 1]]
                     .iter()
-                    .any(|&w| self.part[w as usize] == up)
+                    .any(|&w| self.part(w as usize) == up)
             {
-                self.part[a] = SEPARATOR;
+                self.set_part(a, SEPARATOR);
             }
         }
         // Nodes reordered: lower, upper, separator (each in its previous order).
-        let key = |a: &u32| match self.part[*a as usize] {
+        let key = |a: &u32| match self.part(*a as usize) {
             p if p == low => 0u8,
             p if p == up => 1,
             _ => 2,
@@ -324,8 +366,8 @@ pub fn nested_dissection(
 ) -> Vec<usize> {
     let n_nodes = coords.len();
     let mut nodes = free_nodes(eq, n_eq, n_nodes);
-    let mut d = Dissection::new(node_ptr, node_adj, coords, &nodes);
-    let mut order = Vec::with_capacity(nodes.len());
+    let d = Dissection::new(node_ptr, node_adj, coords, &nodes);
+    let mut order = vec![0; nodes.len()];
     d.dissect(&mut nodes, &mut order);
     node_order_to_equations(&order, eq, n_eq)
 }
@@ -379,6 +421,34 @@ mod tests {
             }
         }
         (ptr, adj, xy)
+    }
+
+    /// The halves dissected in parallel give the sequential order exactly (a grid of
+    /// 40,000 nodes: subdomains down to 4,096 nodes split in parallel, some 16 of them).
+    #[test]
+    fn parallel_dissection_is_the_sequential_one() {
+        let m = 200;
+        let (ptr, adj, xy) = grid(m);
+        let cons: Vec<(usize, f64)> = (0..m)
+            .flat_map(|j| [(2 * j * m, 0.0), (2 * j * m + 1, 0.0)])
+            .collect();
+        let dofs = DofMap::new(m * m, &cons);
+        let order = |parallel_min| {
+            let mut nodes = free_nodes(&dofs.eq, dofs.n_eq, m * m);
+            let mut d = Dissection::new(&ptr, &adj, &xy, &nodes);
+            d.parallel_min = parallel_min;
+            let mut out = vec![0; nodes.len()];
+            d.dissect(&mut nodes, &mut out);
+            out
+        };
+        let sequential = order(usize::MAX);
+        for _ in 0..3 {
+            assert_eq!(order(PARALLEL_MIN_NODES), sequential);
+        }
+        assert_eq!(
+            nested_dissection(&ptr, &adj, &xy, &dofs.eq, dofs.n_eq),
+            node_order_to_equations(&sequential, &dofs.eq, dofs.n_eq)
+        );
     }
 
     /// Every free equation appears exactly once, constrained ones never.

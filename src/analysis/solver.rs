@@ -204,6 +204,46 @@ pub const BACKGROUND_MIN_EQUATIONS: usize = 50_000;
 /// pages touched on a thread of their own while the caller assembles the matrix.
 const TOUCH_AHEAD_VALUES: usize = 4_000_000;
 
+/// Fault in every page of the `len` bytes at `ptr` for writing, their contents unchanged
+/// (Linux ≥ 5.14: `madvise(MADV_POPULATE_WRITE)`, the pages faulted in by the kernel in one
+/// call: 0.27–0.30 s for 454 MB on this project's VM against 0.37–0.40 s writing a byte of
+/// each page, docs/performance.md, session 16). False if the kernel cannot (the caller then
+/// touches the pages itself).
+#[cfg(target_os = "linux")]
+fn populate(ptr: *mut u8, len: usize) -> bool {
+    const MADV_POPULATE_WRITE: i32 = 23;
+    extern "C" {
+        fn madvise(addr: *mut u8, len: usize, advice: i32) -> i32;
+    }
+    let page = Storage::PAGE;
+    // madvise wants a page-aligned start: the pages wholly inside the range are populated,
+    // the partial ones at its ends written here (one byte each, its own value: unchanged).
+    let start = (ptr as usize).next_multiple_of(page);
+    let end = (ptr as usize + len) & !(page - 1);
+    if end <= start {
+        return false;
+    }
+    // SAFETY: [start, end) lies inside memory the caller owns exclusively; the advice
+    // changes no contents and no permissions.
+    if unsafe { madvise(start as *mut u8, end - start, MADV_POPULATE_WRITE) } != 0 {
+        return false;
+    }
+    // SAFETY: the first and last bytes of the range are the caller's, initialised or not:
+    // read and written back as raw bytes (MaybeUninit), no value is assumed.
+    unsafe {
+        for p in [ptr, ptr.add(len - 1)] {
+            let p = p.cast::<std::mem::MaybeUninit<u8>>();
+            std::ptr::write_volatile(p, std::ptr::read_volatile(p));
+        }
+    }
+    true
+}
+
+#[cfg(not(target_os = "linux"))]
+fn populate(_ptr: *mut u8, _len: usize) -> bool {
+    false
+}
+
 /// Factor values and the scratch of the numeric factorisation and solves.
 struct Storage {
     l_values: Vec<f64>,
@@ -230,6 +270,9 @@ impl Storage {
     /// first factorisation waits for the touching with the other core idle.
     fn touch(mut self) -> Self {
         fn touch_values(values: &mut [f64]) {
+            if populate(values.as_mut_ptr().cast(), std::mem::size_of_val(values)) {
+                return;
+            }
             for v in values.iter_mut().step_by(Storage::PAGE / 8) {
                 // Volatile: a plain store of zero into calloc'ed memory may be optimised
                 // away. SAFETY: `v` is a valid, aligned, exclusive reference.
@@ -245,8 +288,10 @@ impl Storage {
         std::thread::scope(|s| {
             s.spawn(|| touch_values(second));
             touch_values(first);
-            for b in mem.iter_mut().step_by(Self::PAGE) {
-                *b = std::mem::MaybeUninit::new(0);
+            if !populate(mem.as_mut_ptr().cast(), mem.len()) {
+                for b in mem.iter_mut().step_by(Self::PAGE) {
+                    *b = std::mem::MaybeUninit::new(0);
+                }
             }
         });
         self
@@ -304,6 +349,9 @@ pub struct SparseCholesky {
     /// The whole analysis running on another thread ([`SparseCholesky::in_background`]):
     /// until it is joined, `symbolic` is a stand-in of order 1 and `stats` are empty.
     analysis: Option<std::thread::JoinHandle<Result<SparseCholesky, SolverError>>>,
+    /// Work to start on a thread of its own when the next numeric factorisation starts
+    /// ([`SparseCholesky::beside_next_factorisation`]).
+    beside: Option<super::driver::IdleWork>,
     factor: Factor,
     /// Whether the last [`SparseCholesky::factorize_indefinite`] ended in LDLᵀ: the next
     /// one then computes LDLᵀ beside its LLᵀ attempt ([`SparseCholesky::factorize_both`]).
@@ -324,18 +372,44 @@ impl Drop for SparseCholesky {
     /// kernel took ~0.1–0.2 s at 5e5 equations, which the caller (writing results) need not
     /// wait for.
     fn drop(&mut self) {
-        if self.l_values.len() >= TOUCH_AHEAD_VALUES {
-            let l_values = std::mem::take(&mut self.l_values);
-            let mem = std::mem::replace(
-                &mut self.mem,
-                MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
-            );
-            std::thread::spawn(move || drop((l_values, mem)));
-        }
+        self.release();
     }
 }
 
 impl SparseCholesky {
+    /// Start `work` on a thread of its own when the next numeric factorisation starts (its
+    /// storage ready): faer's sequential factorisation leaves the other cores idle. Work
+    /// handed earlier and not started yet is dropped (never run).
+    pub fn beside_next_factorisation(&mut self, work: super::driver::IdleWork) {
+        self.beside = Some(work);
+    }
+
+    /// Give the factor's memory (values and scratch) back now, when no solve will follow
+    /// (the last increment of a run has converged): the field files and the checkpoint are
+    /// then written into the pages just freed. On a virtual machine whose balloon reports
+    /// free memory to its host (docs/running.md, "Huge pages"), pages freed long ago cost a
+    /// host fault at their first touch, recently freed ones do not: at 5e5 equations the
+    /// .vtu's 70 MB of page cache took 0.2–0.3 s to fill from cold pages. A large factor is
+    /// released on a thread of its own (0.1–0.2 s of the kernel's work at 5e5 equations).
+    /// The analysis stays; the next factorisation allocates the storage anew.
+    pub fn release(&mut self) {
+        self.factor = Factor::None;
+        let pending = self.pending.take();
+        // The spare LDLᵀ storage beside an LLᵀ attempt goes too (factor-sized).
+        let spare = self.spare.take();
+        let l_values = std::mem::take(&mut self.l_values);
+        let mem = std::mem::replace(
+            &mut self.mem,
+            MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+        );
+        if l_values.len() >= TOUCH_AHEAD_VALUES || pending.is_some() || spare.is_some() {
+            std::thread::spawn(move || {
+                drop((l_values, mem, spare));
+                drop(pending.map(|h| h.join()));
+            });
+        }
+    }
+
     /// Floating-point operations of one numeric LLᵀ with this analysis: Σ c² over the
     /// factor's columns, c the stored values of the column (diagonal included), as the
     /// supernodes store them. 0 for a simplicial analysis or before a background one is joined.
@@ -403,11 +477,13 @@ impl SparseCholesky {
                 .join()
                 .map_err(|_| SolverError::Internal("symbolic analysis thread panicked".into()))??;
             // What the caller set or added meanwhile (the ordering's time, the negative
-            // pivots of a restored run) is kept.
+            // pivots of a restored run, work to run beside the factorisation) is kept.
             let (before, negative_pivots) = (std::mem::take(&mut self.stats), self.negative_pivots);
+            let beside = self.beside.take();
             *self = a;
             self.stats.symbolic_s += before.symbolic_s;
             self.negative_pivots = negative_pivots;
+            self.beside = beside;
         }
         Ok(())
     }
@@ -477,6 +553,7 @@ impl SparseCholesky {
             mem,
             pending,
             analysis: None,
+            beside: None,
             factor: Factor::None,
             last_ldlt: false,
             spare: None,
@@ -492,6 +569,17 @@ impl SparseCholesky {
             let s = h
                 .join()
                 .map_err(|_| SolverError::Internal("factor storage thread panicked".into()))??;
+            (self.l_values, self.mem) = (s.l_values, s.mem);
+        }
+        Ok(())
+    }
+
+    /// The factor storage ready for a numeric factorisation: the one prepared on another
+    /// thread, or a new one after [`SparseCholesky::release`].
+    fn ready_storage(&mut self) -> Result<(), SolverError> {
+        self.take_storage()?;
+        if self.l_values.len() != self.symbolic.len_val() {
+            let s = Storage::new(&self.symbolic)?;
             (self.l_values, self.mem) = (s.l_values, s.mem);
         }
         Ok(())
@@ -543,6 +631,9 @@ impl SparseCholesky {
             Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
             None => SparseColMatRef::new(symbolic(pattern), values),
         };
+        if let Some(work) = self.beside.take() {
+            std::thread::spawn(work);
+        }
         let stack = MemStack::new(&mut self.mem);
         let res = self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
@@ -568,7 +659,7 @@ impl SparseCholesky {
             self.prepermute(pattern)?;
         }
         let t = std::time::Instant::now();
-        self.take_storage()?;
+        self.ready_storage()?;
         self.factor = Factor::None;
         if let Some(p) = self.pre.as_mut() {
             p.fill(values);
@@ -697,7 +788,7 @@ impl SparseCholesky {
         values: &[f64],
     ) -> Result<usize, SolverError> {
         let t = std::time::Instant::now();
-        self.take_storage()?;
+        self.ready_storage()?;
         self.factor = Factor::None;
         let a = match self.pre.as_ref() {
             Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
@@ -877,6 +968,54 @@ impl SparseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A released factor is rebuilt by the next factorisation; work beside it runs.
+    #[test]
+    fn released_factor_is_rebuilt_and_work_runs_beside() {
+        // The 1-D Laplacian of the test below: after `release` the next factorisation
+        // allocates the storage anew and gives the same solution to the last bit; work
+        // handed for the next factorisation runs once.
+        let n = 50;
+        let mut col_ptr = vec![0];
+        let (mut row_idx, mut vals) = (vec![], vec![]);
+        for j in 0..n {
+            row_idx.push(j);
+            vals.push(2.0);
+            if j + 1 < n {
+                row_idx.push(j + 1);
+                vals.push(-1.0);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let p = LowerPattern {
+            n,
+            col_ptr,
+            row_idx,
+        };
+        let b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+        let mut s = SparseCholesky::new(&p).unwrap();
+        let ran = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let r = ran.clone();
+        s.beside_next_factorisation(Box::new(move || {
+            r.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        }));
+        s.factorize(&p, &vals).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x);
+        s.release();
+        s.factorize(&p, &vals).unwrap();
+        let mut y = b.clone();
+        s.solve_in_place(&mut y);
+        assert_eq!(x, y);
+        // The work's thread is detached: wait for it (a few milliseconds at most).
+        for _ in 0..1000 {
+            if ran.load(std::sync::atomic::Ordering::SeqCst) > 0 {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        assert_eq!(ran.load(std::sync::atomic::Ordering::SeqCst), 1);
+    }
 
     /// 1-D Laplacian (tridiagonal 2, −1): solution of A x = e checked through the residual.
     #[test]

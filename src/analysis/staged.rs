@@ -38,6 +38,26 @@ impl<T: Clone> Staged<T> {
     }
 }
 
+/// Lists from this many items are committed on all cores ([`Staged::commit_parallel`]).
+const PARALLEL_COMMIT_MIN: usize = 65_536;
+
+impl<E: Clone + Send + Sync> Staged<Vec<E>> {
+    /// As [`Staged::commit`], a long list copied on all cores (at 5e5 dofs the material
+    /// points and Gauss outputs of a million points, ~0.05 s on one core after every
+    /// converged increment). The same values: item by item clones either way.
+    pub fn commit_parallel(&mut self) {
+        use rayon::prelude::*;
+        if self.trial.len() < PARALLEL_COMMIT_MIN || self.trial.len() != self.committed.len() {
+            return self.commit();
+        }
+        self.committed
+            .par_iter_mut()
+            .zip(self.trial.par_iter())
+            .with_min_len(PARALLEL_COMMIT_MIN / 4)
+            .for_each(|(c, t)| c.clone_from(t));
+    }
+}
+
 impl<T: Clone> From<T> for Staged<T> {
     fn from(value: T) -> Self {
         Self::new(value)
@@ -53,6 +73,20 @@ impl<T: Serialize> Serialize for Staged<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The parallel commit of a long list gives the trial list, as the plain commit.
+    #[test]
+    fn parallel_commit_takes_the_trial_list() {
+        let n = 3 * PARALLEL_COMMIT_MIN + 7;
+        let mut s = Staged::new(vec![0.0_f64; n]);
+        s.trial = (0..n).map(|i| (i as f64).sqrt()).collect();
+        s.commit_parallel();
+        assert_eq!(s.committed, s.trial);
+        let mut short = Staged::new(vec![1u8; 10]);
+        short.trial[3] = 7;
+        short.commit_parallel();
+        assert_eq!(short.committed, short.trial);
+    }
 
     /// Commit takes the trial value, revert restores the committed one, and neither copy
     /// aliases the other afterwards.

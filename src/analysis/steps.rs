@@ -3,7 +3,8 @@
 
 use super::driver::{check_stop, implex_retry, note_limit_point};
 pub use super::driver::{
-    AnalysisError, LineSearchStats, Observer, RunOptions, Snapshot, StepEnd, StopReason, Timings,
+    AnalysisError, IdleWork, LineSearchStats, Observer, RunOptions, Snapshot, StepEnd, StopReason,
+    Timings,
 };
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::loads::load_vector;
@@ -252,6 +253,9 @@ fn load_step(
         if let (true, false, true, Some(p)) = (extrapolating, retry, increment > 0, prev_size) {
             ctx.sys.extrapolate(ctx.u, (target - level) / p);
         }
+        if let Some(work) = obs.idle_work() {
+            ctx.solver.beside_next_factorisation(work);
+        }
         match newton(
             ctx.sys,
             ctx.solver,
@@ -348,6 +352,11 @@ fn load_step(
                     &step.name,
                     increment,
                 );
+                // The run's last increment: no solve follows, and its output is written
+                // into the factor's pages ([`SparseCholesky::release`]).
+                if end_of_step && si + 1 == model.steps.len() {
+                    ctx.solver.release();
+                }
                 let t = Instant::now();
                 obs.increment(&Snapshot {
                     system: ctx.sys,

@@ -6,6 +6,7 @@ pub mod fields;
 pub mod gauss_points;
 pub mod joints;
 pub mod plausibility;
+pub mod prepare;
 pub mod recorder;
 pub mod stages;
 pub mod sustained;

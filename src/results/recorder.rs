@@ -7,8 +7,9 @@
 use super::atomic::write_atomic;
 use super::fields::{principal, recover};
 use super::joints::summarise;
-use super::vtu::{render, render_pvd, Array, Grid};
-use crate::analysis::steps::{Observer, Snapshot};
+use super::prepare::{Prepared, TempFile, PREPARE_MIN_BYTES};
+use super::vtu::{render, render_into, render_pvd, Array, Grid};
+use crate::analysis::steps::{IdleWork, Observer, Snapshot};
 use crate::analysis::system::System;
 use crate::model::{Model, MonitorKind};
 use std::io::Write;
@@ -71,6 +72,9 @@ pub struct Recorder<'m> {
     /// The field files of the last increment and results.pvd, being written in that order
     /// on a thread of their own ([`FieldWrite`]).
     writing: Option<FieldWrite>,
+    /// The next continuum .vtu's memory being prepared on an idle core
+    /// ([`Recorder::idle_work`]).
+    prepared: Option<Arc<Prepared>>,
 }
 
 /// Field files being written on a thread of their own, in order, results.pvd last (so that
@@ -89,12 +93,16 @@ struct WriteState {
 }
 
 impl FieldWrite {
-    /// Write `files` (path, contents) in order on another thread.
-    fn start(files: Vec<(PathBuf, Vec<u8>)>) -> Self {
+    /// Write `files` (path, contents) in order on another thread, the first through
+    /// `first_into` if given (a temporary file prepared for it).
+    fn start(files: Vec<(PathBuf, Vec<u8>)>, mut first_into: Option<TempFile>) -> Self {
         let thread = std::thread::spawn(move || {
             files
                 .iter()
-                .try_for_each(|(path, bytes)| write_atomic(path, bytes))
+                .try_for_each(|(path, bytes)| match first_into.take() {
+                    Some(t) => t.write_as(path, bytes),
+                    None => write_atomic(path, bytes),
+                })
         });
         Self(Arc::new(Mutex::new(WriteState {
             thread: Some(thread),
@@ -148,6 +156,7 @@ impl<'m> Recorder<'m> {
             history: None,
             unwritten: None,
             writing: None,
+            prepared: None,
         })
     }
 
@@ -394,10 +403,26 @@ impl<'m> Recorder<'m> {
             .collect()
     }
 
+    /// Work preparing the next continuum .vtu's buffer and file beside the factorisation
+    /// ([`super::prepare`]), for large documents, one at a time.
+    pub fn idle_work(&mut self) -> Option<IdleWork> {
+        if !self.write_fields || self.prepared.is_some() {
+            return None;
+        }
+        let len = vtu_len(self.model);
+        (len >= PREPARE_MIN_BYTES).then(|| {
+            let (p, work) = Prepared::start(&self.dir, len);
+            self.prepared = Some(p);
+            work
+        })
+    }
+
     fn write_vtu(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         // One increment's files at a time, in order.
         self.wait_fields()?;
         let model = self.model;
+        let ready = self.prepared.take().and_then(|p| p.take());
+        let (buffer, file) = ready.map_or((Vec::new(), None), |r| (r.buffer, r.file));
         let f = recover(snap.system);
         let cells: Vec<&[usize]> = model.elements.iter().map(|e| e.nodes.as_slice()).collect();
         let types: Vec<u8> = model
@@ -411,9 +436,9 @@ impl<'m> Recorder<'m> {
             .chunks(2)
             .flat_map(|d| [d[0], d[1], 0.0])
             .collect();
-        let flat = |v: &[[f64; 3]]| -> Vec<f64> { v.iter().flatten().copied().collect() };
-        let ns = flat(&f.node_stress);
-        let ne = flat(&f.node_strain);
+        // The recovered fields' own memory, viewed flat (no copies: 24 MB at 5e5 dofs).
+        let ns = f.node_stress.as_flattened();
+        let ne = f.node_strain.as_flattened();
         let np: Vec<f64> = f
             .node_stress
             .iter()
@@ -422,8 +447,8 @@ impl<'m> Recorder<'m> {
                 [a, b]
             })
             .collect();
-        let cs = flat(&f.cell_stress);
-        let ce = flat(&f.cell_strain);
+        let cs = f.cell_stress.as_flattened();
+        let ce = f.cell_strain.as_flattened();
         let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
         let mut reaction = vec![0.0; 3 * model.nodes.len()];
         for s in &model.supports {
@@ -461,12 +486,12 @@ impl<'m> Recorder<'m> {
             Array::F64 {
                 name: "stress",
                 components: 3,
-                values: &cs,
+                values: cs,
             },
             Array::F64 {
                 name: "strain",
                 components: 3,
-                values: &ce,
+                values: ce,
             },
         ];
         if let Some((st, crack_normal)) = &concrete {
@@ -501,7 +526,8 @@ impl<'m> Recorder<'m> {
                 },
             ]);
         }
-        let doc = render(
+        let doc = render_into(
+            buffer,
             &Grid {
                 points: &model.nodes,
                 cells: &cells,
@@ -521,7 +547,7 @@ impl<'m> Recorder<'m> {
                 Array::F64 {
                     name: "stress",
                     components: 3,
-                    values: &ns,
+                    values: ns,
                 },
                 Array::F64 {
                     name: "principal_stress",
@@ -531,14 +557,14 @@ impl<'m> Recorder<'m> {
                 Array::F64 {
                     name: "strain",
                     components: 3,
-                    values: &ne,
+                    values: ne,
                 },
             ],
             &cell_data,
         );
         let tag = field_tag(model, snap.step);
         let name = format!("{tag}_inc{:04}.vtu", snap.increment);
-        let mut files = vec![(self.dir.join(&name), doc.into_bytes())];
+        let mut files = vec![(self.dir.join(&name), doc)];
         let t = self.rows.len() as f64;
         self.pvd.push((t, 0, name));
         if let Some(lines) = render_lines(snap, &disp) {
@@ -566,7 +592,7 @@ impl<'m> Recorder<'m> {
             self.dir.join("results.pvd"),
             render_pvd(&self.pvd).into_bytes(),
         ));
-        self.writing = Some(FieldWrite::start(files));
+        self.writing = Some(FieldWrite::start(files, file));
         Ok(())
     }
 }
@@ -576,6 +602,8 @@ impl Drop for Recorder<'_> {
     /// [`Recorder::wait_fields`] reports it).
     fn drop(&mut self) {
         let _ = self.wait_fields();
+        // A prepared file not used is removed (dropping it).
+        drop(self.prepared.take().and_then(|p| p.take()));
     }
 }
 
@@ -627,6 +655,28 @@ impl Observer for Recorder<'_> {
         }
         Ok(())
     }
+}
+
+/// Length of the continuum .vtu of `model` [bytes], about (the arrays of
+/// [`Recorder::write_vtu`] as base64 blocks, and a margin for the tags).
+fn vtu_len(model: &Model) -> usize {
+    let b64 = |bytes: usize| (4 + bytes).div_ceil(3) * 4 + 120;
+    let (n, e) = (model.nodes.len(), model.elements.len());
+    let conn: usize = model.elements.iter().map(|el| el.nodes.len()).sum();
+    let index = if n <= i32::MAX as usize && conn <= i32::MAX as usize {
+        4
+    } else {
+        8
+    };
+    let points = b64(24 * n) + b64(index * conn) + b64(index * e) + b64(e);
+    // displacement, reaction, stress, principal stress, strain.
+    let point_data = 4 * b64(24 * n) + b64(16 * n);
+    // region, stress, strain; the concrete state where written.
+    let mut cell_data = b64(4 * e) + 2 * b64(24 * e);
+    if super::gauss_points::wanted(model) {
+        cell_data += 2 * b64(4 * e) + 3 * b64(8 * e) + b64(24 * e);
+    }
+    points + point_data + cell_data + 1000
 }
 
 /// The step part of the field file names: `stepNNN`, and for a staged model
