@@ -969,13 +969,8 @@ impl SparseCholesky {
 mod tests {
     use super::*;
 
-    /// A released factor is rebuilt by the next factorisation; work beside it runs.
-    #[test]
-    fn released_factor_is_rebuilt_and_work_runs_beside() {
-        // The 1-D Laplacian of the test below: after `release` the next factorisation
-        // allocates the storage anew and gives the same solution to the last bit; work
-        // handed for the next factorisation runs once.
-        let n = 50;
+    /// Lower pattern and values of the 1-D Laplacian of order n (tridiagonal 2, −1).
+    fn laplacian_1d(n: usize) -> (LowerPattern, Vec<f64>) {
         let mut col_ptr = vec![0];
         let (mut row_idx, mut vals) = (vec![], vec![]);
         for j in 0..n {
@@ -987,11 +982,24 @@ mod tests {
             }
             col_ptr.push(row_idx.len());
         }
-        let p = LowerPattern {
-            n,
-            col_ptr,
-            row_idx,
-        };
+        (
+            LowerPattern {
+                n,
+                col_ptr,
+                row_idx,
+            },
+            vals,
+        )
+    }
+
+    /// A released factor is rebuilt by the next factorisation; work beside it runs.
+    #[test]
+    fn released_factor_is_rebuilt_and_work_runs_beside() {
+        // The 1-D Laplacian of the test below: after `release` the next factorisation
+        // allocates the storage anew and gives the same solution to the last bit; work
+        // handed for the next factorisation runs once.
+        let n = 50;
+        let (p, vals) = laplacian_1d(n);
         let b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
         let mut s = SparseCholesky::new(&p).unwrap();
         let ran = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
@@ -1021,23 +1029,7 @@ mod tests {
     #[test]
     fn solves_a_tridiagonal_system() {
         let n = 50;
-        let mut col_ptr = vec![0];
-        let mut row_idx = vec![];
-        let mut vals = vec![];
-        for j in 0..n {
-            row_idx.push(j);
-            vals.push(2.0);
-            if j + 1 < n {
-                row_idx.push(j + 1);
-                vals.push(-1.0);
-            }
-            col_ptr.push(row_idx.len());
-        }
-        let p = LowerPattern {
-            n,
-            col_ptr,
-            row_idx,
-        };
+        let (p, vals) = laplacian_1d(n);
         let mut s = SparseCholesky::new(&p).unwrap();
         s.factorize(&p, &vals).unwrap();
         let b: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();

@@ -107,20 +107,7 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                     s.factor_nnz,
                     s.solve_s
                 );
-                let l = &t.line_searches;
-                outln!(
-                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
-                    "",
-                    l.searches,
-                    l.after_overshoot,
-                    l.full_step,
-                    l.residual_trials,
-                    l.full_step_again,
-                    l.residual_s,
-                    l.tangent_trials,
-                    l.tangent_s,
-                    l.reused
-                );
+                print_line_searches(&t.line_searches);
             }
             Err(e) => {
                 eprintln!("error: {e}");
@@ -129,6 +116,23 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
         }
     }
     ExitCode::SUCCESS
+}
+
+/// The line-search counters of a run (summary.json `line_searches`), one line.
+fn print_line_searches(l: &segfem::analysis::steps::LineSearchStats) {
+    outln!(
+        "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
+        "",
+        l.searches,
+        l.after_overshoot,
+        l.full_step,
+        l.residual_trials,
+        l.full_step_again,
+        l.residual_s,
+        l.tangent_trials,
+        l.tangent_s,
+        l.reused
+    );
 }
 
 /// Print one row per refinement factor of a seed-beam benchmark `case`.
@@ -173,20 +177,7 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
                     s.factor_nnz,
                     s.solve_s
                 );
-                let l = &t.line_searches;
-                outln!(
-                    "{:>18} line searches: {} ({} after an overshoot, {} stopped at s = 1), trial points {} without the tangent ({} of them reassembled in part; {:.2} s) and {} with it ({:.2} s), {} of these taken over by the iteration",
-                    "",
-                    l.searches,
-                    l.after_overshoot,
-                    l.full_step,
-                    l.residual_trials,
-                    l.full_step_again,
-                    l.residual_s,
-                    l.tangent_trials,
-                    l.tangent_s,
-                    l.reused
-                );
+                print_line_searches(&t.line_searches);
             }
             Err(e) => {
                 eprintln!("error: {e}");
