@@ -20,6 +20,19 @@ fn symbolic(p: &LowerPattern) -> SymbolicSparseColMatRef<'_, usize> {
     SymbolicSparseColMatRef::new_checked(p.n, p.n, &p.col_ptr, None, &p.row_idx)
 }
 
+/// The matrix a numeric factorisation reads: the kept-permuted one (already holding the
+/// values) or the caller's pattern with `values`.
+fn matrix<'a>(
+    pre: &'a Option<Prepermuted>,
+    pattern: &'a LowerPattern,
+    values: &'a [f64],
+) -> SparseColMatRef<'a, usize, f64> {
+    match pre {
+        Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
+        None => SparseColMatRef::new(symbolic(pattern), values),
+    }
+}
+
 /// Why a factorisation or solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolverError {
@@ -627,10 +640,7 @@ impl SparseCholesky {
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
         self.prepare(pattern, values)?;
         let t = std::time::Instant::now();
-        let a = match self.pre.as_ref() {
-            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
-            None => SparseColMatRef::new(symbolic(pattern), values),
-        };
+        let a = matrix(&self.pre, pattern, values);
         if let Some(work) = self.beside.take() {
             std::thread::spawn(work);
         }
@@ -790,10 +800,7 @@ impl SparseCholesky {
         let t = std::time::Instant::now();
         self.ready_storage()?;
         self.factor = Factor::None;
-        let a = match self.pre.as_ref() {
-            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
-            None => SparseColMatRef::new(symbolic(pattern), values),
-        };
+        let a = matrix(&self.pre, pattern, values);
         let stack = MemStack::new(&mut self.mem);
         let ok = self
             .symbolic
@@ -839,10 +846,7 @@ impl SparseCholesky {
             }
         };
         let (mut l2, mut mem2) = spare;
-        let a = match self.pre.as_ref() {
-            Some(p) => SparseColMatRef::new(p.pattern.as_ref(), &p.values),
-            None => SparseColMatRef::new(symbolic(pattern), values),
-        };
+        let a = matrix(&self.pre, pattern, values);
         let (symbolic, l1, mem1) = (&self.symbolic, &mut self.l_values, &mut self.mem);
         let (llt, ldlt) = rayon::join(
             || {

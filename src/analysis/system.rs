@@ -780,23 +780,32 @@ impl<'m> System<'m> {
                 return Some(Err((e, err)));
             }
         }
-        let mut f_int = crate::fem::assembly::zeroed_values(u.len());
-        let mut f_abs = crate::fem::assembly::zeroed_values(u.len());
-        for (e, el) in model.elements.iter().enumerate() {
-            let fe = &forces[e * responses::ND..];
-            for (a, &n) in el.nodes.iter().enumerate() {
-                f_int[2 * n] += fe[2 * a];
-                f_int[2 * n + 1] += fe[2 * a + 1];
-                f_abs[2 * n] += fe[2 * a].abs();
-                f_abs[2 * n + 1] += fe[2 * a + 1].abs();
-            }
+        // Summed by the assembly's own scatter (no tangent), every element present.
+        let mut sc = Scatter {
+            asm: &self.asm,
+            f_int: crate::fem::assembly::zeroed_values(u.len()),
+            f_abs: crate::fem::assembly::zeroed_values(u.len()),
+            k_values: None,
+            symmetrised: false,
+        };
+        let numbers = &self.numbers;
+        let of = |e: usize| {
+            let nodes = &model.elements[e].nodes;
+            (nodes.as_slice(), numbers.number(Family::Continuum, e))
+        };
+        let mut buf = (forces, Vec::new());
+        let all_present = vec![Ok(Some(true)); model.elements.len()];
+        let summed = sc.add_chunk(all_present, 0, responses::ND, &mut buf, of);
+        self.last.forces = buf.0;
+        if let Err(e) = summed {
+            self.last.valid = false;
+            return Some(Err(e));
         }
-        self.last.forces = forces;
         self.last.latched.clear();
         self.symmetrised = false;
-        let force_scale = f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let force_scale = sc.f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
         Some(Ok(Assembled {
-            f_int,
+            f_int: sc.f_int,
             k_values: None,
             force_scale,
         }))
