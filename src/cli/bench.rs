@@ -464,9 +464,20 @@ struct Reach {
     tendon_stress: f64,
     max_opening: f64,
     crushed: usize,
+    /// The timings up to the last converged state of a run that stopped early.
+    stopped: Option<steps::Timings>,
 }
 
 impl Observer for Reach {
+    fn step_stopped(
+        &mut self,
+        _system: &segfem::analysis::system::System,
+        timings: &steps::Timings,
+    ) -> std::io::Result<()> {
+        self.stopped = Some(timings.clone());
+        Ok(())
+    }
+
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         let sys = snap.system;
         let m = sys.model;
@@ -557,7 +568,8 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         .watch
         .finish(&model, result.is_ok())
         .map_or_else(String::new, |u| u.mode);
-    let mut timings = steps::Timings::default();
+    // A run that stops early reports its timings up to there (not zeros).
+    let mut timings = obs.stopped.take().unwrap_or_default();
     let end = match result {
         Ok(t) => {
             timings = t;
@@ -699,9 +711,20 @@ struct RcWatch {
     iterations: usize,
     p_max: f64,
     deflection: f64,
+    /// The timings up to the last converged state of a run that stopped early.
+    stopped: Option<steps::Timings>,
 }
 
 impl Observer for RcWatch {
+    fn step_stopped(
+        &mut self,
+        _system: &segfem::analysis::system::System,
+        timings: &steps::Timings,
+    ) -> std::io::Result<()> {
+        self.stopped = Some(timings.clone());
+        Ok(())
+    }
+
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         self.equations = snap.system.dofs.n_eq;
         self.increments += 1;
@@ -735,8 +758,10 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = RcWatch::default();
-    let mut timings = steps::Timings::default();
-    let end = match steps::run(&model, &mut obs) {
+    let result = steps::run(&model, &mut obs);
+    // A run that stops early reports its timings up to there (not zeros).
+    let mut timings = obs.stopped.take().unwrap_or_default();
+    let end = match result {
         Ok(t) => {
             timings = t;
             "completed".to_string()
