@@ -13,6 +13,8 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
+use super::split::{SplitCholesky, SplitOutcome};
+
 pub use crate::fem::pattern::LowerPattern;
 
 /// faer's view of a lower-triangle pattern.
@@ -107,7 +109,13 @@ enum Factor {
     None,
     Llt,
     Ldlt,
+    /// LLᵀ of the two halves and the separator ([`SplitCholesky`]).
+    Split,
 }
+
+/// Systems from this many equations on, ordered by segfem's nested dissection, have their
+/// LLᵀ factorised as two halves at once and then the separator ([`SplitCholesky`]).
+pub const SPLIT_MIN_EQUATIONS: usize = 20_000;
 
 /// The matrix permuted once into the elimination order, so that faer factorises it as it
 /// stands (identity ordering) instead of permuting it at every numeric factorisation.
@@ -131,7 +139,10 @@ const PREPERMUTE_MAX_NNZ: usize = 2_000_000;
 
 /// Compressed columns of an n × n pattern from (column, row, source) triples: column
 /// pointers, row indices sorted within each column, and the source of each entry.
-fn compress(n: usize, triples: &[(usize, usize, usize)]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+pub(crate) fn compress(
+    n: usize,
+    triples: &[(usize, usize, usize)],
+) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let mut col_ptr = vec![0usize; n + 1];
     for &(c, _, _) in triples {
         col_ptr[c + 1] += 1;
@@ -374,6 +385,9 @@ pub struct SparseCholesky {
     spare: Option<(Vec<f64>, MemBuffer)>,
     /// Smallest factor [values] for that ([`CONCURRENT_LDLT_VALUES`]; lowered by tests).
     concurrent_min: usize,
+    /// The LLᵀ factorised as two halves at once and the separator (large systems ordered by
+    /// nested dissection); LDLᵀ and a failed split LLᵀ go the whole-matrix way.
+    split: Option<SplitCholesky>,
     /// Negative pivots of the last successful factorisation (0 after LLᵀ).
     pub negative_pivots: usize,
     /// Accumulated timings.
@@ -410,14 +424,19 @@ impl SparseCholesky {
         let pending = self.pending.take();
         // The spare LDLᵀ storage beside an LLᵀ attempt goes too (factor-sized).
         let spare = self.spare.take();
+        let halves = self.split.as_mut().map(SplitCholesky::release);
         let l_values = std::mem::take(&mut self.l_values);
         let mem = std::mem::replace(
             &mut self.mem,
             MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
         );
-        if l_values.len() >= TOUCH_AHEAD_VALUES || pending.is_some() || spare.is_some() {
+        let split_len: usize = halves.iter().flatten().map(Vec::len).sum();
+        if l_values.len().max(split_len) >= TOUCH_AHEAD_VALUES
+            || pending.is_some()
+            || spare.is_some()
+        {
             std::thread::spawn(move || {
-                drop((l_values, mem, spare));
+                drop((l_values, mem, spare, halves));
                 drop(pending.map(|h| h.join()));
             });
         }
@@ -452,7 +471,19 @@ impl SparseCholesky {
         pattern: &LowerPattern,
         order: Option<&[usize]>,
     ) -> Result<Self, SolverError> {
-        Self::build(pattern, FACTOR_KIND, order)
+        Self::build(pattern, FACTOR_KIND, order, SPLIT_MIN_EQUATIONS)
+    }
+
+    /// Drop the factorisation by halves ([`SplitCholesky`]): every LLᵀ goes the whole-matrix
+    /// way on one core (benchmarks compare both on the same matrix).
+    pub fn without_split(mut self) -> Self {
+        self.split = None;
+        self
+    }
+
+    /// Whether LLᵀ factorisations go by halves ([`SplitCholesky`]).
+    pub fn is_split(&self) -> bool {
+        self.split.is_some()
     }
 
     /// As [`SparseCholesky::with_ordering`], the analysis of a large system (from
@@ -470,14 +501,15 @@ impl SparseCholesky {
         // The pattern shared, not copied (a copy was 36 MB of fresh pages at 5e5 equations,
         // on the caller's thread before the assembly).
         let (pattern, order) = (pattern.clone(), order.map(<[usize]>::to_vec));
-        let handle =
-            std::thread::spawn(move || Self::build(&pattern, FACTOR_KIND, order.as_deref()));
+        let handle = std::thread::spawn(move || {
+            Self::build(&pattern, FACTOR_KIND, order.as_deref(), SPLIT_MIN_EQUATIONS)
+        });
         let stand_in = LowerPattern {
             n: 1,
             col_ptr: vec![0, 1],
             row_idx: vec![0],
         };
-        let mut s = Self::build(&stand_in, FACTOR_KIND, None)?;
+        let mut s = Self::build(&stand_in, FACTOR_KIND, None, usize::MAX)?;
         s.stats = SolverStats::default();
         s.analysis = Some(handle);
         Ok(s)
@@ -507,13 +539,16 @@ impl SparseCholesky {
         pattern: &LowerPattern,
         threshold: SupernodalThreshold,
     ) -> Result<Self, SolverError> {
-        Self::build(pattern, threshold, None)
+        Self::build(pattern, threshold, None, usize::MAX)
     }
 
+    /// `split_min`: the smallest system factorised by halves ([`SPLIT_MIN_EQUATIONS`]; lowered
+    /// by tests).
     fn build(
         pattern: &LowerPattern,
         threshold: SupernodalThreshold,
         order: Option<&[usize]>,
+        split_min: usize,
     ) -> Result<Self, SolverError> {
         let t = std::time::Instant::now();
         let inverse: Vec<usize> = match order {
@@ -552,7 +587,21 @@ impl SparseCholesky {
         let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
         let prepermute_due =
             supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && symbolic.perm().is_some();
-        let (l_values, mem, pending) = Storage::start(&symbolic)?;
+        let split = match order {
+            Some(fwd) if supernodal && pattern.n >= split_min => {
+                SplitCholesky::new(pattern, fwd, &inverse).map_err(SolverError::Internal)?
+            }
+            _ => None,
+        };
+        // With the split, the whole-matrix storage is allocated only if an LDLᵀ needs it.
+        let (l_values, mem, pending) = match split {
+            Some(_) => (
+                Vec::new(),
+                MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+                None,
+            ),
+            None => Storage::start(&symbolic)?,
+        };
         let stats = SolverStats {
             symbolic_s: t.elapsed().as_secs_f64(),
             factor_nnz: symbolic.len_val(),
@@ -571,6 +620,7 @@ impl SparseCholesky {
             last_ldlt: false,
             spare: None,
             concurrent_min: CONCURRENT_LDLT_VALUES,
+            split,
             negative_pivots: 0,
             stats,
         })
@@ -638,6 +688,49 @@ impl SparseCholesky {
 
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
+        match self.factorize_split(values)? {
+            // Not positive definite by the split: the whole matrix's LLᵀ gives the verdict
+            // (and the equation) the sequential factorisation gives.
+            Some(Ok(())) => return Ok(()),
+            Some(Err(_)) | None => {}
+        }
+        self.factorize_whole(pattern, values)
+    }
+
+    /// The LLᵀ by halves ([`SplitCholesky`]), if this analysis has one: None if not, else
+    /// whether the matrix was positive definite (Err: the equation of a failed pivot).
+    fn factorize_split(
+        &mut self,
+        values: &[f64],
+    ) -> Result<Option<Result<(), usize>>, SolverError> {
+        self.take_analysis()?;
+        let Some(split) = self.split.as_mut() else {
+            return Ok(None);
+        };
+        let t = std::time::Instant::now();
+        self.factor = Factor::None;
+        if let Some(work) = self.beside.take() {
+            std::thread::spawn(work);
+        }
+        let out = split.factorize(values, TINY_PIVOT);
+        self.stats.numeric_s += t.elapsed().as_secs_f64();
+        self.stats.factorisations += 1;
+        Ok(Some(match out {
+            SplitOutcome::Ok => {
+                self.factor = Factor::Split;
+                self.negative_pivots = 0;
+                Ok(())
+            }
+            SplitOutcome::NotPositiveDefinite(k) => Err(split.order()[k]),
+        }))
+    }
+
+    /// The whole matrix's LLᵀ by faer on one core.
+    fn factorize_whole(
+        &mut self,
+        pattern: &LowerPattern,
+        values: &[f64],
+    ) -> Result<(), SolverError> {
         self.prepare(pattern, values)?;
         let t = std::time::Instant::now();
         let a = matrix(&self.pre, pattern, values);
@@ -728,6 +821,13 @@ impl SparseCholesky {
             "solve called without a valid factorisation"
         );
         let t = std::time::Instant::now();
+        if self.factor == Factor::Split {
+            if let Some(split) = self.split.as_mut() {
+                split.solve_in_place(b);
+            }
+            self.stats.solve_s += t.elapsed().as_secs_f64();
+            return;
+        }
         let n = b.len();
         let stack = MemStack::new(&mut self.mem);
         // A kept-permuted matrix: solve for P x from P b.
@@ -774,8 +874,19 @@ impl SparseCholesky {
         pattern: &LowerPattern,
         values: &[f64],
     ) -> Result<usize, SolverError> {
+        self.take_analysis()?;
         let out = if self.last_ldlt && self.symbolic.len_val() >= self.concurrent_min {
             self.factorize_both(pattern, values)
+        } else if let Some(split) = self.factorize_split(values)? {
+            // A failed split LLᵀ: straight to the whole matrix's LDLᵀ (the matrix is
+            // filled there).
+            match split {
+                Ok(()) => Ok(0),
+                Err(_) => {
+                    self.prepare(pattern, values)?;
+                    self.factorize_ldlt(pattern, values)
+                }
+            }
         } else {
             match self.factorize(pattern, values) {
                 Ok(()) => Ok(0),
@@ -1209,6 +1320,106 @@ mod tests {
                 .fold(0.0, f64::max);
             // Indefinite, condition ~1e3–1e4 near σ: 1e-9 leaves room for round-off growth.
             assert!(err < 1e-9, "residual {err}");
+        }
+    }
+
+    /// Nested dissection of an m × m grid numbered row by row (x fastest): each rectangle
+    /// split across its longer side by a grid line, which separates the 9-point stencil's
+    /// halves; rectangles of up to 4 nodes numbered as they come.
+    fn grid_dissection(m: usize) -> Vec<usize> {
+        fn nd(m: usize, x: (usize, usize), y: (usize, usize), out: &mut Vec<usize>) {
+            let (w, h) = (x.1 - x.0, y.1 - y.0);
+            if w == 0 || h == 0 {
+                return;
+            }
+            if w * h <= 4 {
+                for j in y.0..y.1 {
+                    for i in x.0..x.1 {
+                        out.push(i + j * m);
+                    }
+                }
+                return;
+            }
+            if w >= h {
+                let c = x.0 + w / 2;
+                nd(m, (x.0, c), y, out);
+                nd(m, (c + 1, x.1), y, out);
+                nd(m, (c, c + 1), y, out);
+            } else {
+                let c = y.0 + h / 2;
+                nd(m, x, (y.0, c), out);
+                nd(m, x, (c + 1, y.1), out);
+                nd(m, x, (c, c + 1), out);
+            }
+        }
+        let mut out = Vec::with_capacity(m * m);
+        nd(m, (0, m), (0, m), &mut out);
+        out
+    }
+
+    /// The LLᵀ by halves of a positive-definite matrix solves as the whole-matrix one does,
+    /// to round-off; an indefinite one falls back to LDLᵀ with the same inertia; a
+    /// mechanism is reported.
+    #[test]
+    fn split_factorisation_matches_the_whole_one() {
+        let m = 41;
+        let n = m * m;
+        let order = grid_dissection(m);
+        let (p, definite) = shifted_laplacian(m, -0.5);
+        let (_, indefinite) = shifted_laplacian(m, 0.37);
+        let mut split = SparseCholesky::build(&p, FACTOR_KIND, Some(&order), 0).unwrap();
+        assert!(split.is_split());
+        let sp = split.split.as_ref().unwrap().split;
+        // The top separator is the middle grid line.
+        assert_eq!((sp.n1, sp.n2, sp.s), (20 * m, 20 * m, m));
+        let mut whole = SparseCholesky::with_ordering(&p, Some(&order)).unwrap();
+        assert!(!whole.is_split());
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        for _ in 0..2 {
+            split.factorize(&p, &definite).unwrap();
+            whole.factorize(&p, &definite).unwrap();
+            assert_eq!(split.factor, Factor::Split);
+            let (mut x, mut y) = (b.clone(), b.clone());
+            split.solve_in_place(&mut x);
+            whole.solve_in_place(&mut y);
+            // Condition number ≤ 17/0.5: the two round-off paths agree to ~1e-15; 1e-12
+            // leaves room.
+            let norm = y.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            for (a, c) in x.iter().zip(&y) {
+                assert!((a - c).abs() <= 1e-12 * norm, "{a} against {c}");
+            }
+        }
+        // Indefinite: LDLᵀ, the whole matrix's, the same negative pivots as without the split.
+        let a = split.factorize_indefinite(&p, &indefinite).unwrap();
+        let c = whole.factorize_indefinite(&p, &indefinite).unwrap();
+        assert!(a > 5);
+        assert_eq!(a, c);
+        assert_eq!(split.factor, Factor::Ldlt);
+        let (mut x, mut y) = (b.clone(), b.clone());
+        split.solve_in_place(&mut x);
+        whole.solve_in_place(&mut y);
+        assert_eq!(x, y);
+        // And back to a definite matrix: by halves again (after the concurrent LDLᵀ/LLᵀ
+        // pair, which needs the last factorisation indefinite).
+        assert_eq!(split.factorize_indefinite(&p, &definite).unwrap(), 0);
+        assert_eq!(split.factorize_indefinite(&p, &definite).unwrap(), 0);
+        assert_eq!(split.factor, Factor::Split);
+        // A zero row in half 2, in half 1 and in the separator: the equation of the
+        // whole-matrix factorisation.
+        for eq in [order[sp.n1 + 3], order[5], order[n - 2]] {
+            let mut v = definite.clone();
+            for j in 0..n {
+                for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                    if j == eq || p.row_idx[q] == eq {
+                        v[q] = 0.0;
+                    }
+                }
+            }
+            v[p.position(eq, eq).unwrap()] = 0.0;
+            let e1 = split.factorize(&p, &v).unwrap_err();
+            let e2 = whole.factorize(&p, &v).unwrap_err();
+            assert_eq!(e1, e2);
+            assert_eq!(e1, SolverError::NotPositiveDefinite { equation: eq });
         }
     }
 
