@@ -226,7 +226,7 @@ pub const BACKGROUND_MIN_EQUATIONS: usize = 50_000;
 
 /// Factor values from this many on (≈ 1e5 equations of a plane mesh) are allocated and their
 /// pages touched on a thread of their own while the caller assembles the matrix.
-const TOUCH_AHEAD_VALUES: usize = 4_000_000;
+pub(crate) const TOUCH_AHEAD_VALUES: usize = 4_000_000;
 
 /// Fault in every page of the `len` bytes at `ptr` for writing, their contents unchanged
 /// (Linux ≥ 5.14: `madvise(MADV_POPULATE_WRITE)`, the pages faulted in by the kernel in one
@@ -234,7 +234,7 @@ const TOUCH_AHEAD_VALUES: usize = 4_000_000;
 /// each page, docs/performance.md, session 16). False if the kernel cannot (the caller then
 /// touches the pages itself).
 #[cfg(target_os = "linux")]
-fn populate(ptr: *mut u8, len: usize) -> bool {
+pub(crate) fn populate(ptr: *mut u8, len: usize) -> bool {
     const MADV_POPULATE_WRITE: i32 = 23;
     extern "C" {
         fn madvise(addr: *mut u8, len: usize, advice: i32) -> i32;
@@ -264,7 +264,7 @@ fn populate(ptr: *mut u8, len: usize) -> bool {
 }
 
 #[cfg(not(target_os = "linux"))]
-fn populate(_ptr: *mut u8, _len: usize) -> bool {
+pub(crate) fn populate(_ptr: *mut u8, _len: usize) -> bool {
     false
 }
 
@@ -361,6 +361,9 @@ impl Storage {
 /// Sparse symmetric positive-definite solver with a reusable symbolic factorisation.
 pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
+    /// `symbolic` is a stand-in: the whole matrix's analysis is left for when it is needed
+    /// ([`SparseCholesky::whole`]; a solver by halves).
+    whole_due: bool,
     /// Set when the matrix is kept in the elimination order (then `symbolic` has none).
     pre: Option<Prepermuted>,
     /// The matrix is to be kept permuted from the next factorisation on.
@@ -476,9 +479,12 @@ impl SparseCholesky {
 
     /// Drop the factorisation by halves ([`SplitCholesky`]): every LLᵀ goes the whole-matrix
     /// way on one core (benchmarks compare both on the same matrix).
-    pub fn without_split(mut self) -> Self {
+    pub fn without_split(mut self, pattern: &LowerPattern) -> Result<Self, SolverError> {
+        self.take_analysis()?;
+        self.whole(pattern)?;
         self.split = None;
-        self
+        self.stats.factor_nnz = self.symbolic.len_val();
+        Ok(self)
     }
 
     /// Whether LLᵀ factorisations go by halves ([`SplitCholesky`]).
@@ -504,12 +510,7 @@ impl SparseCholesky {
         let handle = std::thread::spawn(move || {
             Self::build(&pattern, FACTOR_KIND, order.as_deref(), SPLIT_MIN_EQUATIONS)
         });
-        let stand_in = LowerPattern {
-            n: 1,
-            col_ptr: vec![0, 1],
-            row_idx: vec![0],
-        };
-        let mut s = Self::build(&stand_in, FACTOR_KIND, None, usize::MAX)?;
+        let mut s = Self::build(&LowerPattern::stand_in(), FACTOR_KIND, None, usize::MAX)?;
         s.stats = SolverStats::default();
         s.analysis = Some(handle);
         Ok(s)
@@ -568,46 +569,38 @@ impl SparseCholesky {
             }
             None => Vec::new(),
         };
-        let ordering = match order {
-            Some(fwd) => SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(
-                fwd, &inverse, pattern.n,
-            )),
-            None => SymmetricOrdering::Amd,
-        };
-        let symbolic = factorize_symbolic_cholesky(
-            symbolic(pattern),
-            Side::Lower,
-            ordering,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: threshold,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
-        let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
-        let prepermute_due =
-            supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && symbolic.perm().is_some();
+        // By halves: the whole matrix's analysis only when an LDLᵀ (or a failed LLᵀ by halves)
+        // needs it ([`SparseCholesky::whole`]), its storage then too.
         let split = match order {
-            Some(fwd) if supernodal && pattern.n >= split_min => {
+            Some(fwd) if threshold.0 == 0.0 && pattern.n >= split_min => {
                 SplitCholesky::new(pattern, fwd, &inverse).map_err(SolverError::Internal)?
             }
             _ => None,
         };
-        // With the split, the whole-matrix storage is allocated only if an LDLᵀ needs it.
-        let (l_values, mem, pending) = match split {
-            Some(_) => (
+        let (symbolic, prepermute_due, l_values, mem, pending, factor_nnz) = match &split {
+            Some(sp) => (
+                Self::analyse(&LowerPattern::stand_in(), threshold, None, &[])?.0,
+                false,
                 Vec::new(),
                 MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
                 None,
+                sp.factor_len(),
             ),
-            None => Storage::start(&symbolic)?,
+            None => {
+                let (symbolic, prepermute_due) =
+                    Self::analyse(pattern, threshold, order, &inverse)?;
+                let (l_values, mem, pending) = Storage::start(&symbolic)?;
+                let nnz = symbolic.len_val();
+                (symbolic, prepermute_due, l_values, mem, pending, nnz)
+            }
         };
         let stats = SolverStats {
             symbolic_s: t.elapsed().as_secs_f64(),
-            factor_nnz: symbolic.len_val(),
+            factor_nnz,
             ..Default::default()
         };
         Ok(Self {
+            whole_due: split.is_some(),
             symbolic,
             pre: None,
             prepermute_due,
@@ -624,6 +617,55 @@ impl SparseCholesky {
             negative_pivots: 0,
             stats,
         })
+    }
+
+    /// faer's symbolic analysis of the whole matrix in the order `order` (AMD if None;
+    /// `inverse`: the order's inverse), and whether the matrix is to be kept permuted.
+    fn analyse(
+        pattern: &LowerPattern,
+        threshold: SupernodalThreshold,
+        order: Option<&[usize]>,
+        inverse: &[usize],
+    ) -> Result<(SymbolicCholesky<usize>, bool), SolverError> {
+        let ordering = match order {
+            Some(fwd) => {
+                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inverse, pattern.n))
+            }
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic = factorize_symbolic_cholesky(
+            symbolic(pattern),
+            Side::Lower,
+            ordering,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: threshold,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
+        let supernodal = matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_));
+        let prepermute_due =
+            supernodal && pattern.nnz() <= PREPERMUTE_MAX_NNZ && symbolic.perm().is_some();
+        Ok((symbolic, prepermute_due))
+    }
+
+    /// The whole matrix's analysis, if it was left for when it is needed (a solver by
+    /// halves meeting an indefinite matrix).
+    fn whole(&mut self, pattern: &LowerPattern) -> Result<(), SolverError> {
+        if !self.whole_due {
+            return Ok(());
+        }
+        let t = std::time::Instant::now();
+        let order = self.split.as_ref().map(|s| s.order().to_vec());
+        let mut inverse = vec![0; pattern.n];
+        for (k, &i) in order.iter().flatten().enumerate() {
+            inverse[i] = k;
+        }
+        (self.symbolic, self.prepermute_due) =
+            Self::analyse(pattern, FACTOR_KIND, order.as_deref(), &inverse)?;
+        self.whole_due = false;
+        self.stats.symbolic_s += t.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// Wait for the factor storage being prepared on another thread, if any.
@@ -758,6 +800,7 @@ impl SparseCholesky {
     /// `values` (the time of the fill counts as factorisation time).
     fn prepare(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
         self.take_analysis()?;
+        self.whole(pattern)?;
         if self.prepermute_due && self.stats.factorisations > 0 {
             self.prepermute(pattern)?;
         }
@@ -875,6 +918,9 @@ impl SparseCholesky {
         values: &[f64],
     ) -> Result<usize, SolverError> {
         self.take_analysis()?;
+        if self.last_ldlt {
+            self.whole(pattern)?;
+        }
         let out = if self.last_ldlt && self.symbolic.len_val() >= self.concurrent_min {
             self.factorize_both(pattern, values)
         } else if let Some(split) = self.factorize_split(values)? {

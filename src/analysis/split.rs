@@ -32,7 +32,22 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, MatMut, MatRef, Par, Side};
 
-use super::solver::{compress, LowerPattern};
+use super::solver::{populate, LowerPattern, TOUCH_AHEAD_VALUES};
+
+/// Fault in every page of the `len` bytes at `ptr` for writing, contents unchanged.
+fn prefault(ptr: *mut u8, len: usize) {
+    if len == 0 || populate(ptr, len) {
+        return;
+    }
+    for off in (0..len).step_by(4096) {
+        // SAFETY: `ptr + off` lies inside the caller's exclusive buffer; the byte is read
+        // and written back unchanged (as raw, possibly uninitialised memory).
+        unsafe {
+            let p = ptr.add(off).cast::<std::mem::MaybeUninit<u8>>();
+            std::ptr::write_volatile(p, std::ptr::read_volatile(p));
+        }
+    }
+}
 
 const NONE: usize = usize::MAX;
 
@@ -51,7 +66,7 @@ pub struct TopSplit {
 /// separator, and the subtrees below it are shared out between the two halves (the
 /// prefix of them, in postorder, that balances the halves' columns best). None when the
 /// tree does not split (a chain, a forest, an order that is not postordered).
-pub fn top_split(n: usize, up_ptr: &[usize], up_idx: &[usize]) -> Option<TopSplit> {
+pub fn top_split(n: usize, up_ptr: &[usize], up_idx: &[u32]) -> Option<TopSplit> {
     if n < 3 {
         return None;
     }
@@ -60,6 +75,7 @@ pub fn top_split(n: usize, up_ptr: &[usize], up_idx: &[usize]) -> Option<TopSpli
     let mut ancestor = vec![NONE; n];
     for i in 0..n {
         for &k in &up_idx[up_ptr[i]..up_ptr[i + 1]] {
+            let k = k as usize;
             if k >= i {
                 continue;
             }
@@ -188,47 +204,115 @@ impl SplitCholesky {
         inverse: &[usize],
     ) -> Result<Option<Self>, String> {
         let n = pattern.n;
-        // The upper triangle of P A Pᵀ: its elimination tree.
-        let mut triples = Vec::with_capacity(pattern.nnz());
+        if n >= u32::MAX as usize {
+            return Ok(None);
+        }
+        let dbg = std::env::var_os("SPLIT_DEBUG").is_some();
+        let t0 = std::time::Instant::now();
+        // Each stored entry's (row, column) in P A Pᵀ, lower triangle.
+        let at = |j: usize, p: usize| {
+            let (a, b) = (inverse[pattern.row_idx[p]], inverse[j]);
+            (a.max(b), a.min(b))
+        };
+        // The upper triangle of P A Pᵀ (column r holds the rows c ≤ r, unsorted): its
+        // elimination tree.
+        let mut up_ptr = vec![0usize; n + 1];
         for j in 0..n {
             for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                let (a, b) = (inverse[pattern.row_idx[p]], inverse[j]);
-                // (column, row, source) of the upper triangle: column max, row min.
-                triples.push((a.max(b), a.min(b), p));
+                up_ptr[at(j, p).0 + 1] += 1;
             }
         }
-        let (up_ptr, up_idx, _) = compress(n, &triples);
+        for r in 0..n {
+            up_ptr[r + 1] += up_ptr[r];
+        }
+        let mut next = up_ptr[..n].to_vec();
+        let mut up_idx = vec![0u32; pattern.nnz()];
+        for j in 0..n {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let (r, c) = at(j, p);
+                up_idx[next[r]] = c as u32;
+                next[r] += 1;
+            }
+        }
+        drop(next);
+        if dbg {
+            eprintln!("upper {:?}", t0.elapsed());
+        }
         let Some(split) = top_split(n, &up_ptr, &up_idx) else {
             return Ok(None);
         };
         drop((up_ptr, up_idx));
+        if dbg {
+            eprintln!("split {:?} {:?}", split, t0.elapsed());
+        }
         let TopSplit { n1, n2, s } = split;
         let sep0 = n1 + n2;
-        // Lower triples (column, row, source) of B1 and B2 in their own numbering.
-        let (mut t1, mut t2, mut a33) = (Vec::new(), Vec::new(), Vec::new());
-        for &(r, c, p) in &triples {
-            if r < n1 {
-                t1.push((c, r, p));
-            } else if c < n1 {
-                if r < sep0 {
-                    return Err("top split: halves coupled".into());
-                }
-                t1.push((c, r - n2, p));
-            } else if c < sep0 {
-                t2.push((c - n1, r - n1, p));
-            } else {
-                t1.push((c - n2, r - n2, p));
-                t2.push((c - n1, r - n1, p));
-                a33.push(((r - sep0) + (c - sep0) * s, p));
+        // Half i's border matrix in its own numbering: the half's columns first, the
+        // separator's after (None: an entry of the other half).
+        let local = |half: usize, g: usize| -> Option<usize> {
+            match half {
+                0 if g < n1 => Some(g),
+                0 if g >= sep0 => Some(g - n2),
+                1 if g >= n1 => Some(g - n1),
+                _ => None,
             }
-        }
-        drop(triples);
-        let half = |m: usize, t: &mut Vec<(usize, usize, usize)>| -> Result<Half, String> {
+        };
+        let half = |h: usize, m: usize| -> Result<Half, String> {
             let nb = m + s;
-            // faer analyses the upper triangle when given no ordering.
-            let up: Vec<_> = t.iter().map(|&(c, r, p)| (r, c, p)).collect();
-            let (up_ptr, up_idx, _) = compress(nb, &up);
-            drop(up);
+            let mut col_ptr = vec![0usize; nb + 1];
+            let mut coupled = false;
+            for j in 0..n {
+                for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                    let (r, c) = at(j, p);
+                    match (local(h, c), local(h, r)) {
+                        (Some(c), Some(_)) => col_ptr[c + 1] += 1,
+                        (Some(_), None) => coupled = true,
+                        _ => {}
+                    }
+                }
+            }
+            if coupled {
+                return Err("top split: the halves are coupled".into());
+            }
+            for c in 0..nb {
+                col_ptr[c + 1] += col_ptr[c];
+            }
+            let mut next = col_ptr[..nb].to_vec();
+            let nnz = col_ptr[nb];
+            let mut entries = vec![(0usize, 0usize); nnz];
+            for j in 0..n {
+                for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                    let (r, c) = at(j, p);
+                    if let (Some(c), Some(r)) = (local(h, c), local(h, r)) {
+                        entries[next[c]] = (r, p);
+                        next[c] += 1;
+                    }
+                }
+            }
+            drop(next);
+            for c in 0..nb {
+                entries[col_ptr[c]..col_ptr[c + 1]].sort_unstable();
+            }
+            let (row_idx, source): (Vec<usize>, Vec<usize>) = entries.into_iter().unzip();
+            // faer analyses the upper triangle when given no ordering: the transpose (its
+            // columns' rows come sorted, in column order).
+            let mut up_ptr = vec![0usize; nb + 1];
+            for &r in &row_idx {
+                up_ptr[r + 1] += 1;
+            }
+            for r in 0..nb {
+                up_ptr[r + 1] += up_ptr[r];
+            }
+            let mut next = up_ptr[..nb].to_vec();
+            let mut up_idx = vec![0usize; nnz];
+            for c in 0..nb {
+                for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                    up_idx[next[r]] = c;
+                    next[r] += 1;
+                }
+            }
+            drop(next);
+            let pattern = SymbolicSparseColMat::new_checked(nb, nb, col_ptr, None, row_idx);
             let upper = SymbolicSparseColMatRef::new_checked(nb, nb, &up_ptr, None, &up_idx);
             let symbolic = factorize_symbolic_cholesky(
                 upper,
@@ -240,18 +324,22 @@ impl SplitCholesky {
                 },
             )
             .map_err(|e| format!("{e:?}"))?;
-            let (col_ptr, row_idx, source) = compress(nb, t);
-            t.clear();
-            t.shrink_to_fit();
-            let nnz = row_idx.len();
             let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+            let mut l_values = vec![0.0; symbolic.len_val()];
+            let mut mem = MemBuffer::try_new(req).map_err(|e| format!("{e:?}"))?;
+            if l_values.len() >= TOUCH_AHEAD_VALUES / 2 {
+                // The factor's pages faulted in now (an analysis of a large system runs
+                // beside the assembly), not in the first factorisation.
+                prefault(l_values.as_mut_ptr().cast(), l_values.len() * 8);
+                prefault(mem.as_mut_ptr().cast(), mem.len());
+            }
             Ok(Half {
                 m,
-                pattern: SymbolicSparseColMat::new_checked(nb, nb, col_ptr, None, row_idx),
+                pattern,
                 source,
                 values: vec![0.0; nnz],
-                l_values: Vec::new(),
-                mem: MemBuffer::try_new(req).map_err(|e| format!("{e:?}"))?,
+                l_values,
+                mem,
                 symbolic,
                 m33: vec![0.0; s * s],
                 schur: vec![0.0; s * s],
@@ -259,7 +347,20 @@ impl SplitCholesky {
                 work: Vec::new(),
             })
         };
-        let (h1, h2) = rayon::join(|| half(n1, &mut t1), || half(n2, &mut t2));
+        let (h1, h2) = rayon::join(|| half(0, n1), || half(1, n2));
+        if dbg {
+            eprintln!("halves {:?}", t0.elapsed());
+        }
+        // The separator block A33 (dense positions).
+        let mut a33 = Vec::new();
+        for &i in &order[sep0..] {
+            for p in pattern.col_ptr[i]..pattern.col_ptr[i + 1] {
+                let (r, c) = at(i, p);
+                if c >= sep0 {
+                    a33.push(((r - sep0) + (c - sep0) * s, p));
+                }
+            }
+        }
         let req = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
             s,
             Par::Seq,
@@ -302,7 +403,24 @@ impl SplitCholesky {
     pub fn factorize(&mut self, values: &[f64], tiny: f64) -> SplitOutcome {
         let TopSplit { n1, n2, s } = self.split;
         let [h1, h2] = &mut self.halves;
-        let (r1, r2) = rayon::join(|| h1.factorize(values, tiny), || h2.factorize(values, tiny));
+        let t0 = std::time::Instant::now();
+        let (r1, r2) = rayon::join(
+            || {
+                let t = std::time::Instant::now();
+                let r = h1.factorize(values, tiny);
+                (r, t.elapsed())
+            },
+            || {
+                let t = std::time::Instant::now();
+                let r = h2.factorize(values, tiny);
+                (r, t.elapsed())
+            },
+        );
+        let dbg = std::env::var_os("SPLIT_DEBUG").is_some();
+        if dbg {
+            eprintln!("halves {:?} {:?} join {:?}", r1.1, r2.1, t0.elapsed());
+        }
+        let (r1, r2) = (r1.0, r2.0);
         // Positions in the elimination order of a failed pivot (local to the half).
         let global = |k: usize, m: usize, off: usize| {
             if k < m {
@@ -340,6 +458,9 @@ impl SplitCholesky {
         if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = res
         {
             return SplitOutcome::NotPositiveDefinite(n1 + n2 + index.min(s - 1));
+        }
+        if dbg {
+            eprintln!("dense {:?}", t0.elapsed());
         }
         // A separator pivot at round-off of its diagonal entry a_jj of A33.
         let mut a_diag = vec![0.0; s];
