@@ -730,11 +730,10 @@ impl SparseCholesky {
 
     /// Numeric factorisation of the matrix with the analysed pattern and these values.
     pub fn factorize(&mut self, pattern: &LowerPattern, values: &[f64]) -> Result<(), SolverError> {
-        match self.factorize_split(values)? {
-            // Not positive definite by the split: the whole matrix's LLᵀ gives the verdict
-            // (and the equation) the sequential factorisation gives.
-            Some(Ok(())) => return Ok(()),
-            Some(Err(_)) | None => {}
+        // Not positive definite by halves: the whole matrix's LLᵀ gives the verdict (and the
+        // equation) the sequential factorisation gives.
+        if let Some(Ok(())) = self.factorize_split(values)? {
+            return Ok(());
         }
         self.factorize_whole(pattern, values)
     }

@@ -207,8 +207,6 @@ impl SplitCholesky {
         if n >= u32::MAX as usize {
             return Ok(None);
         }
-        let dbg = std::env::var_os("SPLIT_DEBUG").is_some();
-        let t0 = std::time::Instant::now();
         // Each stored entry's (row, column) in P A Pᵀ, lower triangle.
         let at = |j: usize, p: usize| {
             let (a, b) = (inverse[pattern.row_idx[p]], inverse[j]);
@@ -235,16 +233,10 @@ impl SplitCholesky {
             }
         }
         drop(next);
-        if dbg {
-            eprintln!("upper {:?}", t0.elapsed());
-        }
         let Some(split) = top_split(n, &up_ptr, &up_idx) else {
             return Ok(None);
         };
         drop((up_ptr, up_idx));
-        if dbg {
-            eprintln!("split {:?} {:?}", split, t0.elapsed());
-        }
         let TopSplit { n1, n2, s } = split;
         let sep0 = n1 + n2;
         // Half i's border matrix in its own numbering: the half's columns first, the
@@ -348,9 +340,6 @@ impl SplitCholesky {
             })
         };
         let (h1, h2) = rayon::join(|| half(0, n1), || half(1, n2));
-        if dbg {
-            eprintln!("halves {:?}", t0.elapsed());
-        }
         // The separator block A33 (dense positions).
         let mut a33 = Vec::new();
         for &i in &order[sep0..] {
@@ -403,24 +392,7 @@ impl SplitCholesky {
     pub fn factorize(&mut self, values: &[f64], tiny: f64) -> SplitOutcome {
         let TopSplit { n1, n2, s } = self.split;
         let [h1, h2] = &mut self.halves;
-        let t0 = std::time::Instant::now();
-        let (r1, r2) = rayon::join(
-            || {
-                let t = std::time::Instant::now();
-                let r = h1.factorize(values, tiny);
-                (r, t.elapsed())
-            },
-            || {
-                let t = std::time::Instant::now();
-                let r = h2.factorize(values, tiny);
-                (r, t.elapsed())
-            },
-        );
-        let dbg = std::env::var_os("SPLIT_DEBUG").is_some();
-        if dbg {
-            eprintln!("halves {:?} {:?} join {:?}", r1.1, r2.1, t0.elapsed());
-        }
-        let (r1, r2) = (r1.0, r2.0);
+        let (r1, r2) = rayon::join(|| h1.factorize(values, tiny), || h2.factorize(values, tiny));
         // Positions in the elimination order of a failed pivot (local to the half).
         let global = |k: usize, m: usize, off: usize| {
             if k < m {
@@ -458,9 +430,6 @@ impl SplitCholesky {
         if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = res
         {
             return SplitOutcome::NotPositiveDefinite(n1 + n2 + index.min(s - 1));
-        }
-        if dbg {
-            eprintln!("dense {:?}", t0.elapsed());
         }
         // A separator pivot at round-off of its diagonal entry a_jj of A33.
         let mut a_diag = vec![0.0; s];
