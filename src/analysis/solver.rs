@@ -1,6 +1,8 @@
 //! The one linear-solver interface of segfem: a symmetric sparse matrix in compressed-column
 //! form (lower triangle), symbolic analysis (AMD ordering) once per pattern, numeric
-//! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work.
+//! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work;
+//! the LLᵀ of a large system ordered by nested dissection goes by halves on two cores
+//! ([`super::split`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
