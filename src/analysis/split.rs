@@ -204,7 +204,7 @@ impl SplitCholesky {
         inverse: &[usize],
     ) -> Result<Option<Self>, String> {
         let n = pattern.n;
-        if n >= u32::MAX as usize {
+        if n.max(pattern.nnz()) >= u32::MAX as usize {
             return Ok(None);
         }
         // Each stored entry's (row, column) in P A Pᵀ, lower triangle.
@@ -223,12 +223,16 @@ impl SplitCholesky {
         for r in 0..n {
             up_ptr[r + 1] += up_ptr[r];
         }
+        // Each entry's row and its position in the caller's values (32 bits: the pattern
+        // is read once here, the halves are built from this transpose).
         let mut next = up_ptr[..n].to_vec();
         let mut up_idx = vec![0u32; pattern.nnz()];
+        let mut up_src = vec![0u32; pattern.nnz()];
         for j in 0..n {
             for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
                 let (r, c) = at(j, p);
                 up_idx[next[r]] = c as u32;
+                up_src[next[r]] = p as u32;
                 next[r] += 1;
             }
         }
@@ -236,7 +240,6 @@ impl SplitCholesky {
         let Some(split) = top_split(n, &up_ptr, &up_idx) else {
             return Ok(None);
         };
-        drop((up_ptr, up_idx));
         let TopSplit { n1, n2, s } = split;
         let sep0 = n1 + n2;
         // Half i's border matrix in its own numbering: the half's columns first, the
@@ -249,43 +252,47 @@ impl SplitCholesky {
                 _ => None,
             }
         };
+        let (up_ptr, up_idx, up_src) = (&up_ptr, &up_idx, &up_src);
         let half = |h: usize, m: usize| -> Result<Half, String> {
             let nb = m + s;
+            // The half's columns of the upper triangle, in increasing order (the local
+            // numbering keeps the order).
+            let columns = || {
+                let own = if h == 0 { 0..n1 } else { n1..sep0 };
+                own.chain(sep0..n).map(|r| (r, up_ptr[r]..up_ptr[r + 1]))
+            };
+            // The lower triangle of Bᵢ: column c holds its rows r in increasing order,
+            // as the upper columns r come.
             let mut col_ptr = vec![0usize; nb + 1];
-            let mut coupled = false;
-            for j in 0..n {
-                for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                    let (r, c) = at(j, p);
-                    match (local(h, c), local(h, r)) {
-                        (Some(c), Some(_)) => col_ptr[c + 1] += 1,
-                        (Some(_), None) => coupled = true,
-                        _ => {}
+            for (r, range) in columns() {
+                for &c in &up_idx[range] {
+                    match local(h, c as usize) {
+                        Some(c) => col_ptr[c + 1] += 1,
+                        // A column of half 2 with a row of half 1 (the elimination tree
+                        // rules it out).
+                        None if r < sep0 => return Err("top split: the halves are coupled".into()),
+                        None => {}
                     }
                 }
-            }
-            if coupled {
-                return Err("top split: the halves are coupled".into());
             }
             for c in 0..nb {
                 col_ptr[c + 1] += col_ptr[c];
             }
             let mut next = col_ptr[..nb].to_vec();
             let nnz = col_ptr[nb];
-            let mut entries = vec![(0usize, 0usize); nnz];
-            for j in 0..n {
-                for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                    let (r, c) = at(j, p);
-                    if let (Some(c), Some(r)) = (local(h, c), local(h, r)) {
-                        entries[next[c]] = (r, p);
+            let mut row_idx = vec![0usize; nnz];
+            let mut source = vec![0usize; nnz];
+            for (r, range) in columns() {
+                let rl = local(h, r).expect("the half's own column");
+                for q in range {
+                    if let Some(c) = local(h, up_idx[q] as usize) {
+                        row_idx[next[c]] = rl;
+                        source[next[c]] = up_src[q] as usize;
                         next[c] += 1;
                     }
                 }
             }
             drop(next);
-            for c in 0..nb {
-                entries[col_ptr[c]..col_ptr[c + 1]].sort_unstable();
-            }
-            let (row_idx, source): (Vec<usize>, Vec<usize>) = entries.into_iter().unzip();
             // faer analyses the upper triangle when given no ordering: the transpose (its
             // columns' rows come sorted, in column order).
             let mut up_ptr = vec![0usize; nb + 1];
