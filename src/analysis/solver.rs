@@ -141,10 +141,7 @@ const PREPERMUTE_MAX_NNZ: usize = 2_000_000;
 
 /// Compressed columns of an n × n pattern from (column, row, source) triples: column
 /// pointers, row indices sorted within each column, and the source of each entry.
-pub(crate) fn compress(
-    n: usize,
-    triples: &[(usize, usize, usize)],
-) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+fn compress(n: usize, triples: &[(usize, usize, usize)]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let mut col_ptr = vec![0usize; n + 1];
     for &(c, _, _) in triples {
         col_ptr[c + 1] += 1;
