@@ -10,6 +10,7 @@ pub mod ordering;
 pub mod path;
 mod responses;
 pub mod solver;
+mod split;
 pub mod staged;
 pub mod stages;
 pub mod state;

@@ -632,7 +632,22 @@ pub struct BareRow {
     pub own_factor_nnz: usize,
     /// Floating-point operations of one numeric LLᵀ after segfem's ordering.
     pub own_factor_flops: f64,
+    /// Whether segfem's ordering factorises the LLᵀ by halves on two threads (large systems
+    /// ordered by nested dissection, [`segfem::analysis::solver::SPLIT_MIN_EQUATIONS`]).
+    pub own_split: bool,
+    /// Medians of [`BARE_ROUNDS`] numeric LLᵀ (and solves of one right-hand side) after
+    /// segfem's ordering, the whole matrix on one core and by halves, alternated [s] (both
+    /// the whole matrix's when not split).
+    pub own_numeric_whole_s: f64,
+    pub own_numeric_split_s: f64,
+    pub own_solve_whole_s: f64,
+    pub own_solve_split_s: f64,
+    /// Largest difference of the two solutions of K x = K·1 relative to the largest entry.
+    pub split_rel_diff: f64,
 }
+
+/// Rounds of [`BareRow::own_numeric_whole_s`] and [`BareRow::own_numeric_split_s`].
+const BARE_ROUNDS: usize = 5;
 
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
 /// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
@@ -663,8 +678,44 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         ))
     };
     let (amd_symbolic_s, amd_numeric_s, amd_factor_nnz, amd_factor_flops) = time(None, 0.0)?;
-    let (own_symbolic_s, own_numeric_s, own_factor_nnz, own_factor_flops) =
-        time(sys.ordering.as_deref(), sys.ordering_s)?;
+    let (own_symbolic_s, own_numeric_s, _, _) = time(sys.ordering.as_deref(), sys.ordering_s)?;
+    // The whole-matrix and the split factorisation of the same matrix, alternated.
+    let order = sys.ordering.as_deref();
+    let mut split = SparseCholesky::with_ordering(pattern, order).map_err(|e| e.to_string())?;
+    let own_split = split.is_split();
+    let mut whole = SparseCholesky::with_ordering(pattern, order)
+        .map_err(|e| e.to_string())?
+        .without_split(pattern)
+        .map_err(|e| e.to_string())?;
+    let ones = vec![1.0; pattern.n];
+    let mut b = vec![0.0; pattern.n];
+    pattern.sym_mul(&k, &ones, &mut b);
+    let (mut tw, mut ts, mut sw, mut ss) = (vec![], vec![], vec![], vec![]);
+    let (mut xw, mut xs) = (b.clone(), b.clone());
+    for _ in 0..BARE_ROUNDS {
+        for (s, tf, tsol, x) in [
+            (&mut whole, &mut tw, &mut sw, &mut xw),
+            (&mut split, &mut ts, &mut ss, &mut xs),
+        ] {
+            let t = Instant::now();
+            s.factorize(pattern, &k).map_err(|e| e.to_string())?;
+            tf.push(t.elapsed().as_secs_f64());
+            x.copy_from_slice(&b);
+            let t = Instant::now();
+            s.solve_in_place(x);
+            tsol.push(t.elapsed().as_secs_f64());
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let scale = xw.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let split_rel_diff = xw
+        .iter()
+        .zip(&xs)
+        .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()))
+        / scale;
     Ok(BareRow {
         equations: pattern.n,
         amd_symbolic_s,
@@ -673,8 +724,14 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         amd_factor_flops,
         own_symbolic_s,
         own_numeric_s,
-        own_factor_nnz,
-        own_factor_flops,
+        own_factor_nnz: whole.stats.factor_nnz,
+        own_factor_flops: whole.factor_flops(),
+        own_split,
+        own_numeric_whole_s: median(&mut tw),
+        own_numeric_split_s: median(&mut ts),
+        own_solve_whole_s: median(&mut sw),
+        own_solve_split_s: median(&mut ss),
+        split_rel_diff,
     })
 }
 

@@ -13,6 +13,15 @@ pub struct LowerPattern {
 }
 
 impl LowerPattern {
+    /// The pattern of a 1 × 1 matrix (a stand-in for an analysis not done yet).
+    pub fn stand_in() -> Self {
+        Self {
+            n: 1,
+            col_ptr: vec![0, 1],
+            row_idx: vec![0],
+        }
+    }
+
     /// Number of stored entries.
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
