@@ -139,6 +139,23 @@ struct Prepermuted {
 /// permutes per factorisation, which then costs little against the factorisation itself.
 const PREPERMUTE_MAX_NNZ: usize = 2_000_000;
 
+/// faer's supernodal analysis of a matrix already in its elimination order, given by its
+/// upper triangle (the identity ordering: no permutation at each numeric factorisation).
+pub(crate) fn supernodal_in_order(
+    upper: SymbolicSparseColMatRef<'_, usize>,
+) -> Result<SymbolicCholesky<usize>, String> {
+    factorize_symbolic_cholesky(
+        upper,
+        Side::Upper,
+        SymmetricOrdering::Identity,
+        CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| format!("{e:?}"))
+}
+
 /// Compressed columns of an n × n pattern from (column, row, source) triples: column
 /// pointers, row indices sorted within each column, and the source of each entry.
 fn compress(n: usize, triples: &[(usize, usize, usize)]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
@@ -182,16 +199,7 @@ impl Prepermuted {
         }
         let (up_ptr, up_idx, _) = compress(n, &triples);
         let upper = SymbolicSparseColMatRef::new_checked(n, n, &up_ptr, None, &up_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            upper,
-            Side::Upper,
-            SymmetricOrdering::Identity,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| SolverError::Internal(format!("{e:?}")))?;
+        let symbolic = supernodal_in_order(upper).map_err(SolverError::Internal)?;
         for t in triples.iter_mut() {
             *t = (t.1, t.0, t.2);
         }

@@ -24,15 +24,11 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::matmul::triangular::BlockStructure;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
-};
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, MatMut, MatRef, Par, Side};
 
-use super::solver::{populate, LowerPattern, TOUCH_AHEAD_VALUES};
+use super::solver::{populate, supernodal_in_order, LowerPattern, TOUCH_AHEAD_VALUES};
 
 /// Fault in every page of the `len` bytes at `ptr` for writing, contents unchanged.
 fn prefault(ptr: *mut u8, len: usize) {
@@ -313,16 +309,7 @@ impl SplitCholesky {
             drop(next);
             let pattern = SymbolicSparseColMat::new_checked(nb, nb, col_ptr, None, row_idx);
             let upper = SymbolicSparseColMatRef::new_checked(nb, nb, &up_ptr, None, &up_idx);
-            let symbolic = factorize_symbolic_cholesky(
-                upper,
-                Side::Upper,
-                SymmetricOrdering::Identity,
-                CholeskySymbolicParams {
-                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                    ..Default::default()
-                },
-            )
-            .map_err(|e| format!("{e:?}"))?;
+            let symbolic = supernodal_in_order(upper)?;
             let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
             let mut l_values = vec![0.0; symbolic.len_val()];
             let mut mem = MemBuffer::try_new(req).map_err(|e| format!("{e:?}"))?;
