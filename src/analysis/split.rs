@@ -45,6 +45,36 @@ fn prefault(ptr: *mut u8, len: usize) {
     }
 }
 
+/// One supernode of a half's factor: its first column `b`, its `ncols` columns, the rows
+/// below them (`pat`) and its values `blk`, column-major with `ncols + pat.len()` rows.
+struct Supernode<'a> {
+    b: usize,
+    ncols: usize,
+    pat: &'a [usize],
+    blk: &'a [f64],
+}
+
+/// The supernodes of a half's factor, in elimination order.
+fn supernodes<'a>(
+    symbolic: &'a SymbolicCholesky<usize>,
+    l_values: &'a [f64],
+) -> impl DoubleEndedIterator<Item = Supernode<'a>> + 'a {
+    let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else {
+        unreachable!("the halves are analysed supernodal");
+    };
+    let (begin, end, cpv) = (
+        sn.supernode_begin(),
+        sn.supernode_end(),
+        sn.col_ptr_for_val(),
+    );
+    (0..sn.n_supernodes()).map(move |k| Supernode {
+        b: begin[k],
+        ncols: end[k] - begin[k],
+        pat: sn.supernode(k).pattern(),
+        blk: &l_values[cpv[k]..cpv[k + 1]],
+    })
+}
+
 const NONE: usize = usize::MAX;
 
 /// The top-level split of an elimination order: half 1 is `[0, n1)`, half 2 `[n1, n1 + n2)`,
@@ -513,24 +543,12 @@ impl Half {
         {
             return Err(index);
         }
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("the halves are analysed supernodal");
-        };
         let (m, nb) = (self.m, self.pattern.nrows());
         let s = nb - m;
-        let (begin, end, cpv) = (
-            sn.supernode_begin(),
-            sn.supernode_end(),
-            sn.col_ptr_for_val(),
-        );
         let (cp, ri) = (self.pattern.col_ptr(), self.pattern.row_idx());
         self.m33.fill(0.0);
-        for k in 0..sn.n_supernodes() {
-            let (b, e) = (begin[k], end[k]);
-            let ncols = e - b;
-            let pat = sn.supernode(k).pattern();
+        for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values) {
             let nrows = ncols + pat.len();
-            let blk = &self.l_values[cpv[k]..cpv[k + 1]];
             for c in 0..ncols {
                 let j = b + c;
                 let d = blk[c + c * nrows];
@@ -574,26 +592,14 @@ impl Half {
     /// Forward substitution through the half's own columns: x[..m] ← L_ii⁻¹ x[..m], and
     /// x[m..] −= L₃ᵢ x[..m] (the supernodes straddling the boundary processed up to it).
     fn forward(&mut self) {
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("the halves are analysed supernodal");
-        };
         let m = self.m;
-        let (begin, end, cpv) = (
-            sn.supernode_begin(),
-            sn.supernode_end(),
-            sn.col_ptr_for_val(),
-        );
         let (x, w) = (&mut self.x, &mut self.work);
-        for k in 0..sn.n_supernodes() {
-            let b = begin[k];
+        for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values) {
             if b >= m {
                 break;
             }
-            let ncols = end[k] - b;
             let kc = ncols.min(m - b);
-            let pat = sn.supernode(k).pattern();
             let nrows = ncols + pat.len();
-            let blk = &self.l_values[cpv[k]..cpv[k + 1]];
             w.clear();
             w.resize(pat.len(), 0.0);
             for c in 0..kc {
@@ -616,26 +622,14 @@ impl Half {
     /// Back substitution through the half's own columns, the separator's unknowns in
     /// x[m..]: x[..m] ← L_ii⁻ᵀ (x[..m] − L₃ᵢᵀ x[m..]).
     fn backward(&mut self) {
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("the halves are analysed supernodal");
-        };
         let m = self.m;
-        let (begin, end, cpv) = (
-            sn.supernode_begin(),
-            sn.supernode_end(),
-            sn.col_ptr_for_val(),
-        );
         let (x, w) = (&mut self.x, &mut self.work);
-        for k in (0..sn.n_supernodes()).rev() {
-            let b = begin[k];
+        for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values).rev() {
             if b >= m {
                 continue;
             }
-            let ncols = end[k] - b;
             let kc = ncols.min(m - b);
-            let pat = sn.supernode(k).pattern();
             let nrows = ncols + pat.len();
-            let blk = &self.l_values[cpv[k]..cpv[k + 1]];
             w.clear();
             w.extend(pat.iter().map(|&r| x[r]));
             for c in (0..kc).rev() {
