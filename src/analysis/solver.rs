@@ -275,6 +275,23 @@ pub(crate) fn populate(_ptr: *mut u8, _len: usize) -> bool {
     false
 }
 
+/// Fault in every page of the `len` bytes at `ptr` for writing, their contents unchanged:
+/// by [`populate`] where the kernel can, else by reading and writing back one byte of each
+/// page.
+pub(crate) fn fault_in(ptr: *mut u8, len: usize) {
+    if len == 0 || populate(ptr, len) {
+        return;
+    }
+    for off in (0..len).step_by(Storage::PAGE) {
+        // SAFETY: `ptr + off` lies inside the caller's exclusive buffer; the byte is read
+        // and written back unchanged (as raw, possibly uninitialised memory).
+        unsafe {
+            let p = ptr.add(off).cast::<std::mem::MaybeUninit<u8>>();
+            std::ptr::write_volatile(p, std::ptr::read_volatile(p));
+        }
+    }
+}
+
 /// Factor values and the scratch of the numeric factorisation and solves.
 struct Storage {
     l_values: Vec<f64>,
@@ -300,16 +317,6 @@ impl Storage {
     /// values): the analysis that started this ends about when the assembly does, so the
     /// first factorisation waits for the touching with the other core idle.
     fn touch(mut self) -> Self {
-        fn touch_values(values: &mut [f64]) {
-            if populate(values.as_mut_ptr().cast(), std::mem::size_of_val(values)) {
-                return;
-            }
-            for v in values.iter_mut().step_by(Storage::PAGE / 8) {
-                // Volatile: a plain store of zero into calloc'ed memory may be optimised
-                // away. SAFETY: `v` is a valid, aligned, exclusive reference.
-                unsafe { std::ptr::write_volatile(v, 0.0) };
-            }
-        }
         // The split on a page boundary of the values (any boundary is correct: the halves
         // are disjoint).
         let n = self.l_values.len();
@@ -317,13 +324,9 @@ impl Storage {
         let (first, second) = self.l_values.split_at_mut(half);
         let mem = &mut self.mem;
         std::thread::scope(|s| {
-            s.spawn(|| touch_values(second));
-            touch_values(first);
-            if !populate(mem.as_mut_ptr().cast(), mem.len()) {
-                for b in mem.iter_mut().step_by(Self::PAGE) {
-                    *b = std::mem::MaybeUninit::new(0);
-                }
-            }
+            s.spawn(|| fault_in(second.as_mut_ptr().cast(), std::mem::size_of_val(second)));
+            fault_in(first.as_mut_ptr().cast(), std::mem::size_of_val(first));
+            fault_in(mem.as_mut_ptr().cast(), mem.len());
         });
         self
     }

@@ -28,22 +28,7 @@ use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, MatMut, MatRef, Par, Side};
 
-use super::solver::{populate, supernodal_in_order, LowerPattern, TOUCH_AHEAD_VALUES};
-
-/// Fault in every page of the `len` bytes at `ptr` for writing, contents unchanged.
-fn prefault(ptr: *mut u8, len: usize) {
-    if len == 0 || populate(ptr, len) {
-        return;
-    }
-    for off in (0..len).step_by(4096) {
-        // SAFETY: `ptr + off` lies inside the caller's exclusive buffer; the byte is read
-        // and written back unchanged (as raw, possibly uninitialised memory).
-        unsafe {
-            let p = ptr.add(off).cast::<std::mem::MaybeUninit<u8>>();
-            std::ptr::write_volatile(p, std::ptr::read_volatile(p));
-        }
-    }
-}
+use super::solver::{fault_in, supernodal_in_order, LowerPattern, TOUCH_AHEAD_VALUES};
 
 /// One supernode of a half's factor: its first column `b`, its `ncols` columns, the rows
 /// below them (`pat`) and its values `blk`, column-major with `ncols + pat.len()` rows.
@@ -346,8 +331,8 @@ impl SplitCholesky {
             if l_values.len() >= TOUCH_AHEAD_VALUES / 2 {
                 // The factor's pages faulted in now (an analysis of a large system runs
                 // beside the assembly), not in the first factorisation.
-                prefault(l_values.as_mut_ptr().cast(), l_values.len() * 8);
-                prefault(mem.as_mut_ptr().cast(), mem.len());
+                fault_in(l_values.as_mut_ptr().cast(), l_values.len() * 8);
+                fault_in(mem.as_mut_ptr().cast(), mem.len());
             }
             Ok(Half {
                 m,
@@ -455,16 +440,11 @@ impl SplitCholesky {
         {
             return SplitOutcome::NotPositiveDefinite(n1 + n2 + index.min(s - 1));
         }
-        // A separator pivot at round-off of its diagonal entry a_jj of A33.
-        let mut a_diag = vec![0.0; s];
+        // A separator pivot at round-off of its diagonal entry a_jj of A33 (the diagonal
+        // entries come in `a33` in the order of j; a pivot without one is not zero here).
         for &(q, p) in &self.a33 {
-            if q % s == q / s {
-                a_diag[q % s] = values[p];
-            }
-        }
-        for (j, a) in a_diag.iter().enumerate() {
-            let d = self.l33[j + j * s];
-            if d * d <= tiny * a.abs() {
+            let j = q % s;
+            if q / s == j && self.l33[q] * self.l33[q] <= tiny * values[p].abs() {
                 return SplitOutcome::NotPositiveDefinite(n1 + n2 + j);
             }
         }

@@ -449,11 +449,46 @@ pub struct FailureRow {
     pub end: String,
     /// The first failure met (see [`segfem::results::ultimate`]).
     pub mode: String,
-    /// Solver and assembly figures (zero when the run ended without converging).
+    /// Solver and assembly figures (up to the last converged increment when the run stopped early).
     pub timings: steps::Timings,
 }
 
 /// Records what a failure run reaches.
+/// Run `model` reporting to `obs`; besides the result, the timings of the run, up to the
+/// last converged state if it stopped early (not zeros: `Observer::step_stopped`).
+fn run_keeping_timings(
+    model: &segfem::model::Model,
+    obs: &mut dyn Observer,
+) -> (Result<steps::Timings, steps::AnalysisError>, steps::Timings) {
+    struct KeepTimings<'a> {
+        inner: &'a mut dyn Observer,
+        stopped: steps::Timings,
+    }
+    impl Observer for KeepTimings<'_> {
+        fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+            self.inner.increment(snap)
+        }
+        fn step_stopped(
+            &mut self,
+            system: &segfem::analysis::system::System,
+            timings: &steps::Timings,
+        ) -> std::io::Result<()> {
+            self.stopped = timings.clone();
+            self.inner.step_stopped(system, timings)
+        }
+    }
+    let mut keep = KeepTimings {
+        inner: obs,
+        stopped: steps::Timings::default(),
+    };
+    let result = steps::run(model, &mut keep);
+    let timings = match &result {
+        Ok(t) => t.clone(),
+        Err(_) => keep.stopped,
+    };
+    (result, timings)
+}
+
 #[derive(Default)]
 struct Reach {
     watch: segfem::results::ultimate::UltimateWatch,
@@ -464,20 +499,9 @@ struct Reach {
     tendon_stress: f64,
     max_opening: f64,
     crushed: usize,
-    /// The timings up to the last converged state of a run that stopped early.
-    stopped: Option<steps::Timings>,
 }
 
 impl Observer for Reach {
-    fn step_stopped(
-        &mut self,
-        _system: &segfem::analysis::system::System,
-        timings: &steps::Timings,
-    ) -> std::io::Result<()> {
-        self.stopped = Some(timings.clone());
-        Ok(())
-    }
-
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         let sys = snap.system;
         let m = sys.model;
@@ -563,16 +587,13 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Reach::default();
-    let result = steps::run(&model, &mut obs);
+    let (result, timings) = run_keeping_timings(&model, &mut obs);
     let mode = obs
         .watch
         .finish(&model, result.is_ok())
         .map_or_else(String::new, |u| u.mode);
-    // A run that stops early reports its timings up to there (not zeros).
-    let mut timings = obs.stopped.take().unwrap_or_default();
     let end = match result {
-        Ok(t) => {
-            timings = t;
+        Ok(_) => {
             if obs.deflection <= -0.12 + 1e-9 {
                 "deflection L/60 reached".to_string()
             } else {
@@ -756,7 +777,7 @@ pub struct RcRow {
     pub deflection: f64,
     /// How the run ended ("completed" or the first line of the error).
     pub end: String,
-    /// Solver and assembly figures (zero when the run ended without converging).
+    /// Solver and assembly figures (up to the last converged increment when the run stopped early).
     pub timings: steps::Timings,
 }
 
@@ -768,20 +789,9 @@ struct RcWatch {
     iterations: usize,
     p_max: f64,
     deflection: f64,
-    /// The timings up to the last converged state of a run that stopped early.
-    stopped: Option<steps::Timings>,
 }
 
 impl Observer for RcWatch {
-    fn step_stopped(
-        &mut self,
-        _system: &segfem::analysis::system::System,
-        timings: &steps::Timings,
-    ) -> std::io::Result<()> {
-        self.stopped = Some(timings.clone());
-        Ok(())
-    }
-
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         self.equations = snap.system.dofs.n_eq;
         self.increments += 1;
@@ -815,14 +825,9 @@ pub fn rc_case(refine: usize) -> Result<RcRow, String> {
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = RcWatch::default();
-    let result = steps::run(&model, &mut obs);
-    // A run that stops early reports its timings up to there (not zeros).
-    let mut timings = obs.stopped.take().unwrap_or_default();
+    let (result, timings) = run_keeping_timings(&model, &mut obs);
     let end = match result {
-        Ok(t) => {
-            timings = t;
-            "completed".to_string()
-        }
+        Ok(_) => "completed".to_string(),
         Err(e) => e.to_string().lines().next().unwrap_or("").to_string(),
     };
     // From the run itself, not from a second system built inside the timed span (pattern,
