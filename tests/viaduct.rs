@@ -476,3 +476,45 @@ jacking_stress = 1300e6
     assert_eq!(m.steps.len(), 9);
     assert_eq!(m.steps[8].name, "span 3 creeps");
 }
+
+/// The example's traffic case is EN 1991-2 Load Model 1 (Table 4.2, α factors 1) on its
+/// 11 m carriageway (three notional lanes of 3 m and 2 m of remaining area, 4.2.3): the
+/// tandems of lanes 1–3 (axle loads 300, 200 and 100 kN, two axles each) give 1200 kN in
+/// all, and the UDL 9 kN/m² on lane 1 and 2.5 kN/m² on the other 8 m gives 47 kN/m over
+/// both end spans (2 × 40 m). Totals exact to round-off.
+#[test]
+fn traffic_case_is_lm1_of_en_1991_2() {
+    let text = include_str!("../examples/viaduct.toml");
+    let model = segfem::input::parse(text, "viaduct.toml")
+        .expect("the example is valid")
+        .model;
+    let lc = model
+        .load_cases
+        .iter()
+        .find(|c| c.name == "traffic")
+        .expect("a traffic case");
+    // Table 4.2: Q_ik per axle [N] of lanes 1, 2, 3; q_ik [N/m²] of lane 1 and the rest.
+    let (q_axle, q1, q_rest) = ([300e3, 200e3, 100e3], 9e3, 2.5e3);
+    let (w, lane): (f64, f64) = (11.0, 3.0);
+    let n_lanes = (w / lane).floor();
+    assert_eq!(n_lanes, 3.0);
+    let tandems: f64 = 2.0 * q_axle.iter().sum::<f64>();
+    let udl = q1 * lane + q_rest * (w - lane);
+    let fy: f64 = lc.point_forces.iter().map(|(_, f)| f[1]).sum();
+    assert!((fy + tandems).abs() < 1e-9 * tandems, "tandems {fy} N");
+    assert!(lc.point_forces.iter().all(|(_, f)| f[0] == 0.0));
+    let udl_total: f64 = lc
+        .edge_loads
+        .iter()
+        .map(|e| {
+            let (a, b) = (model.nodes[e.nodes[0]], model.nodes[e.nodes[1]]);
+            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            e.q[1] * len * (e.range[1] - e.range[0]) / 2.0
+        })
+        .sum();
+    let expected = udl * 2.0 * 40.0;
+    assert!(
+        (udl_total + expected).abs() < 1e-9 * expected,
+        "UDL {udl_total} N against {expected} N"
+    );
+}
