@@ -41,6 +41,20 @@ pub struct NamedMaterial {
     pub name: String,
     /// The law and its parameters.
     pub law: Material,
+    /// A concrete strength the law itself does not model (elastic and elastic_creep
+    /// materials): every run checks the stresses of the material's regions and the contact
+    /// stresses of the joints beside them against it (`results::strength`). None for laws
+    /// that crack and crush, and for elastic materials given no strength.
+    pub strength: Option<Strength>,
+}
+
+/// Strength of a concrete modelled as elastic, to check its stresses against.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Strength {
+    /// Mean compressive strength f_cm [Pa] (positive).
+    pub fcm: f64,
+    /// Mean tensile strength f_tm [Pa] (positive).
+    pub ftm: f64,
 }
 
 /// Direction of a degree of freedom.

@@ -151,6 +151,10 @@ pub struct Summary {
     /// through open joints' residual stiffness, displacements beyond a tenth of the model
     /// size (docs/running.md, "Implausible results").
     pub plausibility: Vec<String>,
+    /// Stresses of concrete modelled as elastic past its strength (f_cm, f_tm, joint
+    /// contact), first met first (docs/running.md, "Concrete past its strength"); each also
+    /// in `warnings`.
+    pub strength_exceeded: Vec<crate::results::strength::StrengthFinding>,
     /// Warnings met in the input and in the results.
     pub warnings: Vec<String>,
 }
@@ -581,8 +585,10 @@ pub fn run_file_opts(
         &model,
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
+    let strength_exceeded = watch.strength_findings(&model);
     let mut warnings = built.warnings;
     warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
+    warnings.extend(strength_exceeded.iter().map(|f| f.text.clone()));
     warnings.extend(sustained);
     if error.is_some() || !failures.is_empty() {
         // A failed or stopped run says why it failed; the findings still go with it.
@@ -607,6 +613,7 @@ pub fn run_file_opts(
         stages,
         ultimate,
         plausibility,
+        strength_exceeded,
         warnings,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

@@ -72,6 +72,7 @@ fn model_from_mesh(
                 nu,
                 density: 0.0,
             },
+            strength: None,
         }],
         interfaces: vec![],
         joints: vec![],

@@ -78,6 +78,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
                 nu: 0.2,
                 density: 2500.0,
             },
+            strength: None,
         }],
         interfaces: vec![],
         joints: vec![],

@@ -9,6 +9,7 @@ pub mod plausibility;
 pub mod prepare;
 pub mod recorder;
 pub mod stages;
+pub mod strength;
 pub mod sustained;
 pub mod ultimate;
 pub mod vtu;

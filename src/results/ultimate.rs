@@ -9,6 +9,7 @@
 //! pass over the tendons, bars, concrete points and joints per increment); the limit point
 //! is found at the end, from the whole load history.
 
+use super::strength::{fmt_measure, StrengthFinding, StrengthWatch};
 use crate::analysis::steps::Snapshot;
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
@@ -62,10 +63,26 @@ pub struct Ultimate {
     /// plateau); empty otherwise.
     #[serde(default)]
     pub reached: String,
+    /// When concrete modelled as elastic passed its compressive strength at or before the
+    /// failure (the peak, if none was reached): what, where and from which load, and the
+    /// verdict's loads are upper bounds (`results::strength`); empty otherwise.
+    #[serde(default)]
+    pub upper_bound: String,
 }
 
 impl fmt::Display for Ultimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.verdict(f)?;
+        if !self.upper_bound.is_empty() {
+            write!(f, "; upper bound: {}", self.upper_bound)?;
+        }
+        Ok(())
+    }
+}
+
+impl Ultimate {
+    /// The verdict without its upper-bound note.
+    fn verdict(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let value = |v: f64| {
             if self.load_case == CONTROL_FORCE {
                 format!("{:.4} kN", v / 1e3)
@@ -147,6 +164,8 @@ pub struct UltimateWatch {
     arc_start: Option<f64>,
     /// Arc-length steps that used up their increments before their stop_displacement.
     unfinished: Vec<String>,
+    /// Stresses of elastic concrete past its strength.
+    strength: StrengthWatch,
 }
 
 /// Relative drop of the load below its peak at the end of the same step, taken as a limit
@@ -214,6 +233,7 @@ impl UltimateWatch {
             }
         }
         self.arc_length_end(snap);
+        self.strength.increment(snap, k);
         if self.crushing.is_none() || self.joint_crushing.is_none() {
             for e in crushing(model, snap, k) {
                 let slot = if e.mode == "concrete crushing" {
@@ -384,6 +404,18 @@ impl UltimateWatch {
         })
     }
 
+    /// Stresses of elastic concrete past its strength, first met first; their load is the
+    /// verdict's load measure in runs to failure.
+    pub fn strength_findings(&self, model: &Model) -> Vec<StrengthFinding> {
+        let failures = [&self.tendon_yield, &self.joint_crushing, &self.crushing];
+        let to_failure = self.rows.iter().any(|r| r.path) || failures.iter().any(|e| e.is_some());
+        if self.rows.is_empty() || !to_failure {
+            return self.strength.findings(model, None);
+        }
+        let (name, v) = self.measure(model);
+        self.strength.findings(model, Some((&name, &v)))
+    }
+
     /// The verdict, for runs that go to failure: those with a displacement or arc-length
     /// step, or any run in which a failure event was met. `converged`: the run ended
     /// without a failed increment.
@@ -434,8 +466,23 @@ impl UltimateWatch {
             (Some(y), true) => after_yield(y, &v, &load_case),
             _ => String::new(),
         };
+        // Elastic concrete past f_cm at or before the failure (or the peak): the verdict's
+        // loads are upper bounds.
+        let upper_bound = match self.strength.first_crushing() {
+            Some((kind, h)) if h.k <= modes.first().map_or(peak, |e| e.at) => format!(
+                "concrete {} {:.1} MPa > fcm {:.1} MPa at {} from {} = {}",
+                kind.words(),
+                h.value / 1e6,
+                h.limit / 1e6,
+                h.place,
+                load_case,
+                fmt_measure(&load_case, v[h.k])
+            ),
+            _ => String::new(),
+        };
         Some(Ultimate {
             reached,
+            upper_bound,
             mode,
             detail,
             load_case,

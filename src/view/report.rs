@@ -255,6 +255,23 @@ pub fn headline(dir: &Path, h: &Table) -> String {
     if let Ok(u) = ultimate {
         let _ = writeln!(s, "<p id=\"ultimate\"><b>{}</b></p>", esc(&u.to_string()));
     }
+    // Elastic concrete past its strength: flagged under the verdict, never only in the
+    // warnings table.
+    let findings = serde_json::from_value::<Vec<crate::results::strength::StrengthFinding>>(
+        v["strength_exceeded"].clone(),
+    )
+    .unwrap_or_default();
+    if !findings.is_empty() {
+        let _ = writeln!(
+            s,
+            "<div id=\"strength\" class=\"bad\"><p><b>Concrete past its strength ({} checks failed): the concrete is modelled as elastic.</b></p><ul>",
+            findings.len()
+        );
+        for f in &findings {
+            let _ = writeln!(s, "<li>{}</li>", esc(&f.text));
+        }
+        s.push_str("</ul></div>\n");
+    }
     s
 }
 

@@ -12,7 +12,7 @@ use crate::materials::concrete::{
 use crate::materials::mc90::{self, TensileRef};
 use crate::materials::point::Material;
 use crate::materials::steel::SteelParams;
-use crate::model::NamedMaterial;
+use crate::model::{NamedMaterial, Strength};
 use serde::{Deserialize, Serialize};
 
 /// `viscoplastic = { ... }` of a concrete material (Owen–Hinton option).
@@ -44,6 +44,7 @@ pub struct MaterialIn {
     // concrete
     pub fcm: Option<f64>,
     pub ftm: Option<f64>,
+    pub class: Option<String>,
     #[serde(rename = "C")]
     pub c: Option<f64>,
     pub tensile_reference: Option<String>,
@@ -139,7 +140,15 @@ impl MaterialKind {
     /// listed here for a kind is an error in a table of that kind.
     pub fn keys(self) -> &'static [&'static str] {
         match self {
-            MaterialKind::Elastic => &["E", "nu", "density", "thermal_expansion"],
+            MaterialKind::Elastic => &[
+                "E",
+                "nu",
+                "density",
+                "fcm",
+                "ftm",
+                "class",
+                "thermal_expansion",
+            ],
             MaterialKind::ElasticCreep => &[
                 "fcm",
                 "nu",
@@ -238,6 +247,98 @@ fn elastic_law(ctx: &Ctx, i: usize, m: &MaterialIn, warnings: &mut Vec<String>) 
     Ok(Material::Elastic { e, nu, density })
 }
 
+/// EN 1992-1-1 Table 3.1 strength classes `C{fck}/{fck,cube}` (normal-weight concrete) [MPa].
+const EN_CLASSES: [(u32, u32); 14] = [
+    (12, 15),
+    (16, 20),
+    (20, 25),
+    (25, 30),
+    (30, 37),
+    (35, 45),
+    (40, 50),
+    (45, 55),
+    (50, 60),
+    (55, 67),
+    (60, 75),
+    (70, 85),
+    (80, 95),
+    (90, 105),
+];
+
+/// The strength an elastic material is checked against: `class` (EN 1992-1-1 Table 3.1:
+/// f_cm = f_ck + 8 MPa, f_ctm = 0.30 f_ck^(2/3) up to C50/60, 2.12 ln(1 + f_cm/10) above), or
+/// `fcm` with `ftm` (default: the `concrete` kind's f_tm of the same f_cm, so that switching
+/// the kind keeps the strengths). None when neither is given.
+fn elastic_strength(
+    ctx: &Ctx,
+    i: usize,
+    m: &MaterialIn,
+    warnings: &mut Vec<String>,
+) -> R<Option<Strength>> {
+    let k = |f: &str| format!("materials[{i}].{f}");
+    if let Some(c) = &m.class {
+        if m.fcm.is_some() {
+            return Err(ctx.err(k("fcm"), "give class or fcm, not both"));
+        }
+        let known = || {
+            EN_CLASSES
+                .iter()
+                .map(|(a, b)| format!("C{a}/{b}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let fck = EN_CLASSES
+            .iter()
+            .find(|(a, b)| *c == format!("C{a}/{b}"))
+            .map(|(a, _)| f64::from(*a))
+            .ok_or_else(|| {
+                ctx.err(
+                    k("class"),
+                    format!(
+                        "unknown strength class '{c}' (EN 1992-1-1 Table 3.1: {})",
+                        known()
+                    ),
+                )
+            })?;
+        let fcm = fck + 8.0;
+        let fctm = if fck <= 50.0 {
+            0.30 * fck.powf(2.0 / 3.0)
+        } else {
+            2.12 * (1.0 + fcm / 10.0).ln()
+        };
+        let ftm = match m.ftm {
+            Some(f) => positive(ctx, &k("ftm"), f)?,
+            None => fctm * 1e6,
+        };
+        return Ok(Some(Strength {
+            fcm: fcm * 1e6,
+            ftm,
+        }));
+    }
+    match (m.fcm, m.ftm) {
+        (None, None) => Ok(None),
+        (None, Some(_)) => Err(ctx.err(
+            k("ftm"),
+            "needs fcm or class (the compressive strength to check against)",
+        )),
+        (Some(fcm), ftm) => {
+            let fcm = positive(ctx, &k("fcm"), fcm)?;
+            if fcm < 1e6 {
+                warnings.push(format!(
+                    "{}: {}: fcm = {fcm} Pa looks like MPa; segfem works in Pa",
+                    ctx.file,
+                    k("fcm")
+                ));
+            }
+            let ftm = match ftm {
+                Some(f) => positive(ctx, &k("ftm"), f)?,
+                None => mc90::f_tm(fcm, mc90::C_MEAN, TensileRef::Fcm),
+            };
+            Ok(Some(Strength { fcm, ftm }))
+        }
+    }
+}
+
 /// The `[[materials]]`: the continuum laws (for regions), and the steels (`rebar`,
 /// `prestressing_steel`) by name for bars and bar layers.
 #[allow(clippy::type_complexity)]
@@ -251,10 +352,21 @@ pub(super) fn build(
     let mut steels: Vec<(String, SteelParams)> = Vec::new();
     for (i, m) in list.iter().enumerate() {
         let kind = MaterialKind::parse(ctx, i, &m.kind)?;
-        let law = match kind {
-            MaterialKind::Elastic => elastic_law(ctx, i, m, warnings)?,
-            MaterialKind::ElasticCreep => creep_material(ctx, i, m, warnings)?,
-            MaterialKind::Concrete => concrete_law(ctx, i, m, warnings)?,
+        let (law, strength) = match kind {
+            MaterialKind::Elastic => (
+                elastic_law(ctx, i, m, warnings)?,
+                elastic_strength(ctx, i, m, warnings)?,
+            ),
+            MaterialKind::ElasticCreep => {
+                let law = creep_material(ctx, i, m, warnings)?;
+                // Its f_cm is given (the creep functions need it): checked like an elastic
+                // material's, with the concrete kind's default f_tm.
+                let fcm = m.fcm.unwrap_or(0.0);
+                let ftm = mc90::f_tm(fcm, mc90::C_MEAN, TensileRef::Fcm);
+                (law, Some(Strength { fcm, ftm }))
+            }
+            // Cracking and crushing are the law's own.
+            MaterialKind::Concrete => (concrete_law(ctx, i, m, warnings)?, None),
             MaterialKind::Rebar | MaterialKind::PrestressingSteel => {
                 steels.push((m.name.clone(), steel_law(ctx, i, m, kind, warnings)?));
                 continue;
@@ -263,6 +375,7 @@ pub(super) fn build(
         materials.push(NamedMaterial {
             name: m.name.clone(),
             law,
+            strength,
         });
     }
     Ok((materials, steels))
