@@ -68,7 +68,7 @@ fn at(rows: &[(f64, f64, f64, f64, bool)], q: f64) -> (f64, f64, f64, f64, bool)
 fn seed_beam_behaves_as_the_seed_reports() {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/examples/seed-beam.toml"
+        "/examples/seed-beam-elastic.toml"
     ))
     .unwrap();
     let model = segfem::input::parse(&text, "seed-beam.toml").unwrap().model;
@@ -277,7 +277,7 @@ fn seed_beam_example_fails_by_tendon_yield_at_the_statics_load() {
     let tmp = TempDir::new("seed-failure");
     let o = segfem(
         tmp.path(),
-        &["example", "seed-beam", "-o", "seed-beam.toml"],
+        &["example", "seed-beam-elastic", "-o", "seed-beam.toml"],
     );
     assert_eq!(code(&o), 0);
     let o = segfem(tmp.path(), &["run", "seed-beam.toml", "-o", "seed"]);
@@ -405,7 +405,7 @@ fn deflections(text: &str) -> (Vec<Row>, Vec<f64>) {
 fn example_text() -> String {
     std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/examples/seed-beam.toml"
+        "/examples/seed-beam-elastic.toml"
     ))
     .unwrap()
 }

@@ -709,6 +709,8 @@ fn tendon(
         stressed_in_step: None,
         relaxation_class: None,
         thermal_expansion: None,
+        anchor_plate: None,
+        local_zone: None,
     }
 }
 
