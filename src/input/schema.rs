@@ -162,6 +162,8 @@ pub struct SupportIn {
     pub group: Option<String>,
     pub ux: Option<f64>,
     pub uy: Option<f64>,
+    pub bearing: Option<f64>,
+    pub local_zone: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

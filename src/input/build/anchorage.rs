@@ -38,7 +38,7 @@ pub struct Spread {
 
 /// The unit vector of the element edge through `node` that is most nearly perpendicular to
 /// `axis` (the line a plate bearing along `axis` lies on), or None if no edge has the node.
-fn plate_line(model: &Model, node: usize, axis: [f64; 2]) -> Option<[f64; 2]> {
+pub fn plate_line(model: &Model, node: usize, axis: [f64; 2]) -> Option<[f64; 2]> {
     let mut best: Option<([f64; 2], f64)> = None;
     for e in &model.elements {
         if !e.nodes.contains(&node) {
@@ -203,5 +203,37 @@ pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[
             };
             model.elements[e].region = target;
         }
+    }
+}
+
+/// The local zone of a support over a bearing of length `bearing` [m] at `node` that holds
+/// the direction `held` (unit): the bearing lies along the element edge through the node
+/// most nearly perpendicular to `held`, and the zone reaches into the concrete on the side
+/// of the elements at the node.
+pub fn support_zone(model: &Model, node: usize, held: [f64; 2], bearing: f64) -> LocalZone {
+    let c = model.nodes[node];
+    let t = plate_line(model, node, held).unwrap_or([-held[1], held[0]]);
+    let normal = [-t[1], t[0]];
+    let side: f64 = model
+        .elements
+        .iter()
+        .filter(|e| e.nodes.contains(&node))
+        .map(|e| {
+            let k = e.nodes.len().min(4) as f64;
+            let m = e.nodes.iter().take(4).fold([0.0, 0.0], |a, &n| {
+                [a[0] + model.nodes[n][0] / k, a[1] + model.nodes[n][1] / k]
+            });
+            (m[0] - c[0]) * normal[0] + (m[1] - c[1]) * normal[1]
+        })
+        .sum();
+    let axis = if side >= 0.0 {
+        normal
+    } else {
+        [-normal[0], -normal[1]]
+    };
+    LocalZone {
+        centre: c,
+        axis,
+        plate: bearing,
     }
 }

@@ -325,6 +325,8 @@ fn post_tensioned_tendon(
             ("initial_stress", t.initial_stress.is_some()),
             ("deviators", t.deviators.is_some()),
             ("deviator_friction", t.deviator_friction.is_some()),
+            ("anchor_plate", t.anchor_plate.is_some()),
+            ("local_zone", t.local_zone.is_some()),
         ],
         "not a key of a bonded post-tensioned tendon (stressed with jacking_stress or jacking_force; a pre-tensioned tendon is kind = \"pretensioned\" with initial_stress)",
     )?;
@@ -438,6 +440,8 @@ pub(super) fn pretensioned_tendon(
             ("deviator_friction", t.deviator_friction.is_some()),
             ("stressed_in_step", t.stressed_in_step.is_some()),
             ("grouted_in_step", t.grouted_in_step.is_some()),
+            ("anchor_plate", t.anchor_plate.is_some()),
+            ("local_zone", t.local_zone.is_some()),
         ],
         "not a key of a pre-tensioned tendon (bonded from the start with initial_stress, the stress before release)",
     )?;

@@ -101,7 +101,7 @@ pub(super) fn build(
 /// `point_loads[j].bearing`: the load spread as a uniform pressure over a bearing of that
 /// length [m] centred on node `n`, along the element edge through the node most nearly
 /// perpendicular to the force (nodes and shares of the force, summing to 1), and its local
-/// zone (unless `local_zone = false`); None without a bearing.
+/// zone if `local_zone = true`; None without a bearing.
 fn bearing(
     ctx: &Ctx,
     key: &str,
@@ -143,7 +143,10 @@ fn bearing(
             ),
         ));
     }
-    if p.local_zone != Some(false) {
+    // Opt-in: a load bearing's pressure is usually far below f_cm (EN 1992-1-1 6.7 checks
+    // it), and an elastic block in a member's compression zone would attract the bending
+    // compression that plain concrete carries there.
+    if p.local_zone == Some(true) {
         zones.push(LocalZone {
             centre: model.nodes[n],
             axis,

@@ -92,9 +92,10 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         joints::add(ctx, mesh, &mut model, &joints, &joint_materials)?;
     }
     let used = mesh::used_nodes(ctx, &model, w);
-    supports::build(ctx, &file.supports, &groups, &mut model, &used)?;
-    // The steps tendons are stressed in are resolved once the steps are known (below).
+    // Local zones behind anchor plates and under bearings, made elastic at the end.
     let mut zones = Vec::new();
+    supports::build(ctx, &file.supports, &groups, &mut model, &used, &mut zones)?;
+    // The steps tendons are stressed in are resolved once the steps are known (below).
     let external_of =
         tendons::build_external(ctx, &file.tendons, &mut model, &used, &mut zones, w)?;
     supports::hold_unused(&mut model, &used);
