@@ -138,8 +138,8 @@ fn bearing(
         return Err(ctx.err(
             format!("{key}.bearing"),
             format!(
-                "the {b} m bearing centred on {:?} runs off the element edges (it lies on them over {:.4} m): shorten it or move the load",
-                model.nodes[n], s.covered
+                "the {b} m bearing centred on ({:.3}, {:.3}) runs off the element edges (it lies on them over {:.4} m): shorten it or move the load",
+                model.nodes[n][0], model.nodes[n][1], s.covered
             ),
         ));
     }

@@ -538,8 +538,8 @@ fn anchor_ties(
         let s = anchorage::spread(model, nodes[p], axis, plate);
         if s.covered < (1.0 - 1e-6) * plate {
             warnings.push(format!(
-                "{}: {key}.anchor_plate: the {plate:.3} m plate at {a:?} lies on element edges over {:.3} m only (the mesh ends): the force is spread over that part",
-                ctx.file, s.covered
+                "{}: {key}.anchor_plate: the {plate:.3} m plate at ({:.3}, {:.3}) lies on element edges over {:.3} m only (the mesh ends): the force is spread over that part",
+                ctx.file, a[0], a[1], s.covered
             ));
         }
         ties[p] = s.weights;
