@@ -343,3 +343,61 @@ loads = {{ F = 1.0 }}
         assert!((r[1] - f * x / l).abs() < 1e-6 * f, "{r:?}");
     }
 }
+
+/// A bonded post-tensioned tendon (the `pt-beam` example, its concrete made MC90): the
+/// local zones behind both anchors are the elements whose centroid lies in the box as wide
+/// and as deep as the default plate (1500 mm² = 11 strands of 140 mm²: 0.085 √11 =
+/// 0.282 m), along the parabola's end tangent (slope ∓4 × 0.25/12 at the ends, from the
+/// parabola y = 0.4 − 4 s x (L − x)/L² with sag s = 0.25 m, L = 12 m), counted here from the
+/// geometry.
+#[test]
+fn bonded_tendon_anchors_get_local_zones_along_the_end_tangent() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/pt-beam.toml"
+    ))
+    .unwrap();
+    let concrete = text.replacen(
+        "kind = \"elastic\"\nE = 35e9",
+        "kind = \"concrete\"\nfcm = 45e6",
+        1,
+    );
+    assert_ne!(concrete, text, "pt-beam.toml changed");
+    let model = segfem::input::parse(&concrete, "pt.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let a = 0.085 * 11f64.sqrt();
+    let slope: f64 = 4.0 * 0.25 / 12.0;
+    let n = (1.0 + slope * slope).sqrt();
+    // Anchor, unit direction into the member.
+    let ends = [
+        ([0.0, 0.4], [1.0 / n, -slope / n]),
+        ([12.0, 0.4], [-1.0 / n, -slope / n]),
+    ];
+    let inside = |c: [f64; 2]| {
+        ends.iter().any(|(p, d)| {
+            let (dx, dy) = (c[0] - p[0], c[1] - p[1]);
+            let s = dx * d[0] + dy * d[1];
+            let t = -dx * d[1] + dy * d[0];
+            (-1e-9..=a + 1e-9).contains(&s) && t.abs() <= 0.5 * a + 1e-9
+        })
+    };
+    let mut zone = [0, 0];
+    for e in &model.elements {
+        let c = e.nodes.iter().take(4).fold([0.0, 0.0], |s, &k| {
+            [
+                s[0] + model.nodes[k][0] / 4.0,
+                s[1] + model.nodes[k][1] / 4.0,
+            ]
+        });
+        let elastic = model.materials[model.regions[e.region].material]
+            .law
+            .is_linear();
+        assert_eq!(elastic, inside(c), "element at {c:?}");
+        if elastic {
+            zone[usize::from(c[0] > 6.0)] += 1;
+        }
+    }
+    // Both anchors have a zone, mirror images of each other.
+    assert!(zone[0] > 0 && zone[0] == zone[1], "{zone:?}");
+}

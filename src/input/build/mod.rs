@@ -109,7 +109,14 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         &mut zones,
     )?;
     // Embedded bars before the monitors, which can name them.
-    bars::build(ctx, &file.bars, &file.tendons, &steels, &mut model)?;
+    bars::build(
+        ctx,
+        &file.bars,
+        &file.tendons,
+        &steels,
+        &mut model,
+        &mut zones,
+    )?;
     super::bar_layers::build(ctx, &file.bar_layers, &steels, &mut model)?;
     monitors::build(ctx, &file, &mut model, &used)?;
     controls::geometry(ctx, file.analysis.as_ref(), &mut model)?;
