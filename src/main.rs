@@ -65,8 +65,13 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
     ),
     (
         "seed-beam",
-        "the seed's 7.2 m dry-jointed box beam with an external tendon, to failure (docs/validation.md)",
+        "the seed's 7.2 m dry-jointed box beam with an external tendon, MC90 concrete, to failure (docs/validation.md)",
         include_str!("../examples/seed-beam.toml"),
+    ),
+    (
+        "seed-beam-elastic",
+        "the seed beam on elastic concrete (the seed's elastic comparison, the README's figures)",
+        include_str!("../examples/seed-beam-elastic.toml"),
     ),
     (
         "creep-beam",

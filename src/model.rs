@@ -517,6 +517,10 @@ pub struct TendonEl {
     pub name: String,
     /// Concrete nodes the tendon is tied to (anchor, deviators…, anchor).
     pub nodes: Vec<usize>,
+    /// Per tendon point, the nodes it is tied to and their weights (summing to 1): the nodes
+    /// under an anchor plate, or the point's own node with weight 1. The point moves as the
+    /// weighted mean of its nodes and its force is shared out by the same weights.
+    pub ties: Vec<Vec<(usize, f64)>>,
     /// Steel area A_p [m²].
     pub area: f64,
     /// Modulus E_p [Pa].
@@ -537,6 +541,38 @@ pub struct TendonEl {
     pub stressed_in_step: usize,
     /// Relaxation class of the steel (None = no relaxation).
     pub relaxation: Option<RelaxationClass>,
+}
+
+impl TendonEl {
+    /// The distinct nodes of the tendon's ties, in the order of first appearance: the
+    /// assembler's node list of the tendon element.
+    pub fn tie_nodes(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = Vec::new();
+        for tie in &self.ties {
+            for &(n, _) in tie {
+                if !out.contains(&n) {
+                    out.push(n);
+                }
+            }
+        }
+        out
+    }
+
+    /// True if every point is tied to its own node alone (no anchor plate).
+    pub fn untied(&self) -> bool {
+        self.ties.iter().all(|t| t.len() == 1)
+    }
+
+    /// Position of point `p` as the weighted mean of `x(node)` over its ties.
+    pub fn at_point(&self, p: usize, x: impl Fn(usize) -> [f64; 2]) -> [f64; 2] {
+        match self.ties[p].as_slice() {
+            [(n, _)] => x(*n),
+            tie => tie.iter().fold([0.0, 0.0], |a, &(n, w)| {
+                let v = x(n);
+                [a[0] + w * v[0], a[1] + w * v[1]]
+            }),
+        }
+    }
 }
 
 /// The complete validated model.

@@ -727,7 +727,7 @@ fn opened_joint_beam(tendon: Option<f64>, p: f64) -> String {
     let data = "fcm = 45e6\nnu = 0.2\ncement = \"N\"\nrh = 0.70\nh0 = 0.15\nshrinkage = true\ndrying_start = 7.0\n";
     let prestress = match tendon {
         Some(s) => format!(
-            "[[tendons]]\nname = \"T\"\nkind = \"external\"\npoints = [[0.0, 0.1], [6.0, 0.1]]\n\
+            "[[tendons]]\nname = \"T\"\nkind = \"external\"\nanchor_plate = 0.0\npoints = [[0.0, 0.1], [6.0, 0.1]]\n\
              area = 560e-6\nEp = 195e9\nfptk = 1860e6\ninitial_stress = {s}\n\n\
              [[load_cases]]\nname = \"P\"\npoint_loads = []\n"
         ),

@@ -135,7 +135,7 @@ fn every_documented_error_and_warning_is_given() {
     let md = std::fs::read_to_string(root().join("docs/errors.md")).unwrap();
     let (mut bases, entries) = parse(&md);
     for ex in [
-        "seed-beam",
+        "seed-beam-elastic",
         "rc-beam",
         "creep-beam",
         "gmsh-tapered",

@@ -647,6 +647,7 @@ fn stressing_a_second_tendon_shortens_the_first_external() {
 [[tendons]]
 name = "A"
 kind = "external"
+anchor_plate = 0.0
 points = [[0.0, {ya}], [{l}, {ya}]]
 area = {AP}
 Ep = {EP}

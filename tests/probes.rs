@@ -521,7 +521,7 @@ fn too_many_rows_names_rows_and_counts_are_whole_numbers() {
 fn tendon_prestress_in_mpa_warns() {
     let tmp = TempDir::new("probe-prestress-unit");
     let text = edit(
-        &example("seed-beam"),
+        &example("seed-beam-elastic"),
         "initial_stress = 876e6",
         "initial_stress = 876.0",
     );

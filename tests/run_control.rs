@@ -34,7 +34,7 @@ fn with_steps(text: &str, steps: &str) -> String {
 /// The seed beam (elastic concrete, dry joints that open, a held external tendon) with
 /// fewer increments and a shorter ultimate step that still opens the joints.
 fn seed_beam_short() -> String {
-    let full = example("seed-beam");
+    let full = example("seed-beam-elastic");
     let to_140 = full.split("[[steps]]\nname = \"failure\"").next().unwrap();
     let t = edit(
         to_140,

@@ -26,6 +26,7 @@ bands = [{{ region = "r", depth = 0.6, rows = 6 }}]
 [[tendons]]
 name = "T"
 kind = "external"
+anchor_plate = 0.0      # a point anchor, as the closed forms
 points = {points}
 area = 1e-3
 Ep = 195e9
@@ -225,6 +226,7 @@ bands = [{{ region = "r", depth = 0.6, rows = 6 }}]
 [[tendons]]
 name = "T"
 kind = "external"
+anchor_plate = 0.0      # a point anchor, as the closed forms
 points = {points}
 area = 1e-3
 Ep = 195e9
@@ -418,6 +420,7 @@ bands = [{{ region = "r", depth = {h}, rows = 4 }}]
 [[tendons]]
 name = "T"
 kind = "external"
+anchor_plate = 0.0      # a point anchor, as the closed forms
 points = [[0.0, 0.25], [{l}, 0.25]]
 area = 2e-3
 Ep = {EP}

@@ -503,14 +503,14 @@ tendon = "P"
 const SEED_BANDS: [(f64, f64, f64); 3] = [(0.0, 0.1, 0.7), (0.1, 0.5, 0.2), (0.5, 0.6, 1.2)];
 const SEED_E: f64 = 35.5e9;
 
-/// The seed beam (examples/seed-beam.toml) with concrete α = 10e-6 and a thermal case `T`:
+/// The seed beam (examples/seed-beam-elastic.toml) with concrete α = 10e-6 and a thermal case `T`:
 /// the EN 1991-1-5 Fig. 6.2c cooling profile (h = 0.6 m: T1 = −6.5, T2 = −1.8, T3 = −1.5,
 /// T4 = −5.0 K; h1 = 0.12, h2 = 0.15 m), raised after the prestress step (and Q held at
 /// `q` kN) to 3 × the code's values in 60 increments. Returns the rows of history.csv (T
 /// factor, tendon stress and largest joint opening) and the header.
 fn seed_cooling(name: &str, q: f64) -> Vec<Vec<f64>> {
     let seed = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam-elastic.toml"),
     )
     .unwrap();
     let cut = seed.find("[[steps]]").unwrap();

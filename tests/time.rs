@@ -440,11 +440,11 @@ fn tendon_relaxation_at_constant_strain_follows_mc90() {
     assert!(last > 0.05 * s0 && last < 0.09 * s0, "{last}");
 }
 
-/// The seed beam (examples/seed-beam.toml) with its elastic concrete replaced by the MC90
+/// The seed beam (examples/seed-beam-elastic.toml) with its elastic concrete replaced by the MC90
 /// creep material (fcm 45 MPa as the seed's E = 35.5 GPa implies, RH 70 %, h0 0.2 m),
 /// prestressed with self weight on day 28 and held for 1e4 days.
 fn seed_beam_creep(substeps: &str) -> String {
-    let seed = include_str!("../examples/seed-beam.toml");
+    let seed = include_str!("../examples/seed-beam-elastic.toml");
     let head = &seed[..seed.find("[[steps]]").unwrap()];
     let text = head
         .replace(
@@ -871,7 +871,7 @@ duration = 1e4
 /// seed-beam.toml's steps to failure (service, ultimate, arc length to L/60).
 fn seed_beam_life(long_term: bool) -> String {
     let creep = include_str!("../examples/creep-beam.toml");
-    let seed = include_str!("../examples/seed-beam.toml");
+    let seed = include_str!("../examples/seed-beam-elastic.toml");
     let model = &creep[..creep.find("[[steps]]").unwrap()];
     let analysis = &seed[seed.find("[analysis]").unwrap()..seed.find("[[steps]]").unwrap()];
     let prestress = &creep[creep.find("[[steps]]\nname = \"prestress\"").unwrap()

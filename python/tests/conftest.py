@@ -32,7 +32,7 @@ def cli() -> str:
 @pytest.fixture
 def seed_beam(tmp_path: Path) -> Path:
     p = tmp_path / "seed-beam.toml"
-    shutil.copy(EXAMPLES / "seed-beam.toml", p)
+    shutil.copy(EXAMPLES / "seed-beam-elastic.toml", p)
     return p
 
 

@@ -149,6 +149,63 @@ fn keep_forces(forces: &mut [f64], first: usize, n: usize, chunk: &[f64]) {
     forces[first * nd..(first + n) * nd].copy_from_slice(&chunk[..n * nd]);
 }
 
+/// The forces `fp` and tangent `kp` of a tendon's points carried to the nodes of its ties
+/// (`nodes`, the tendon's assembler node list): f = Tᵀ f_p, K = Tᵀ K_p T with
+/// T[2p+c][2m+c] = w(p, m), into the slot buffers `fe` and `ke` (2 × nodes.len() dofs).
+fn tie_transform(
+    ties: &[Vec<(usize, f64)>],
+    nodes: &[usize],
+    fp: &[f64],
+    kp: &[f64],
+    fe: &mut [f64],
+    ke: &mut [f64],
+    tangent: bool,
+) {
+    let nd = 2 * nodes.len();
+    let np = 2 * ties.len();
+    let col = |n: usize| nodes.iter().position(|&m| m == n).expect("tie node listed");
+    // Point p's ties as (local node index, weight).
+    let local: Vec<Vec<(usize, f64)>> = ties
+        .iter()
+        .map(|t| t.iter().map(|&(n, w)| (col(n), w)).collect())
+        .collect();
+    fe[..nd].iter_mut().for_each(|v| *v = 0.0);
+    for (p, tie) in local.iter().enumerate() {
+        for &(a, w) in tie {
+            fe[2 * a] += w * fp[2 * p];
+            fe[2 * a + 1] += w * fp[2 * p + 1];
+        }
+    }
+    if !tangent {
+        return;
+    }
+    // K_p T first (np × nd), then Tᵀ (K_p T).
+    let mut kt = vec![0.0; np * nd];
+    for i in 0..np {
+        for (q, tie) in local.iter().enumerate() {
+            for c in 0..2 {
+                let k = kp[i * np + 2 * q + c];
+                if k == 0.0 {
+                    continue;
+                }
+                for &(b, w) in tie {
+                    kt[i * nd + 2 * b + c] += k * w;
+                }
+            }
+        }
+    }
+    ke[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
+    for (p, tie) in local.iter().enumerate() {
+        for c in 0..2 {
+            let row = &kt[(2 * p + c) * nd..(2 * p + c + 1) * nd];
+            for &(a, w) in tie {
+                let out = &mut ke[(2 * a + c) * nd..(2 * a + c + 1) * nd];
+                out.iter_mut().zip(row).for_each(|(o, r)| *o += w * r);
+            }
+        }
+    }
+}
+
 /// Dofs of the largest of elements with these node counts.
 fn max_dofs(nodes: impl Iterator<Item = usize>) -> usize {
     2 * nodes.max().unwrap_or(0)
@@ -278,7 +335,7 @@ impl<'m> System<'m> {
                 match f {
                     Family::Continuum => Box::new(model.elements.iter().map(|e| e.nodes.clone())),
                     Family::Joint => Box::new(model.interfaces.iter().map(|i| i.nodes.clone())),
-                    Family::Tendon => Box::new(model.tendons.iter().map(|t| t.nodes.clone())),
+                    Family::Tendon => Box::new(model.tendons.iter().map(|t| t.tie_nodes())),
                 }
             })
             .collect();
@@ -676,9 +733,12 @@ impl<'m> System<'m> {
                 (nodes, numbers.number(Family::Joint, i))
             })?;
         }
-        // External tendons (corotational: their forces follow the deformed geometry).
+        // External tendons (corotational: their forces follow the deformed geometry). A
+        // point tied to the nodes under an anchor plate moves as their weighted mean and
+        // shares its force out by the same weights (f = Tᵀ f_p, K = Tᵀ K_p T).
         let tb = &mut self.families.tendons;
-        let nd = max_dofs(model.tendons.iter().map(|t| t.nodes.len()));
+        let tie_nodes: Vec<Vec<usize>> = model.tendons.iter().map(|t| t.tie_nodes()).collect();
+        let nd = max_dofs(tie_nodes.iter().map(|n| n.len()));
         let pieces: Vec<_> = tb.states.trial.iter_mut().enumerate().collect();
         for (start, pieces) in chunks(pieces) {
             let results = compute_chunk(pieces, nd, &mut buf, |(t, trial), fe, ke| {
@@ -686,18 +746,31 @@ impl<'m> System<'m> {
                 else {
                     return Ok(None);
                 };
-                let ut: Vec<f64> = model.tendons[t]
-                    .nodes
-                    .iter()
+                let data = &model.tendons[t];
+                let ut: Vec<f64> = (0..data.nodes.len())
                     .zip(&tb.u0[t])
-                    .flat_map(|(&n, u0)| [u[2 * n] - u0[0], u[2 * n + 1] - u0[1]])
+                    .flat_map(|(p, u0)| {
+                        let up = data.at_point(p, |n| [u[2 * n], u[2 * n + 1]]);
+                        [up[0] - u0[0], up[1] - u0[1]]
+                    })
                     .collect();
-                let into = slot(fe, ke, ut.len(), tangent);
-                ElementResponse::response(el, &ut, committed, trial, into).map(Some)
+                if data.untied() {
+                    let into = slot(fe, ke, ut.len(), tangent);
+                    return ElementResponse::response(el, &ut, committed, trial, into).map(Some);
+                }
+                let np = ut.len();
+                let mut fp = vec![0.0; np];
+                let mut kp = vec![0.0; if tangent { np * np } else { 0 }];
+                let into = Response {
+                    f: &mut fp,
+                    k: tangent.then_some(&mut kp[..]),
+                };
+                let sym = ElementResponse::response(el, &ut, committed, trial, into)?;
+                tie_transform(&data.ties, &tie_nodes[t], &fp, &kp, fe, ke, tangent);
+                Ok(Some(sym))
             });
             sc.add_chunk(results, start, nd, &mut buf, |t| {
-                let nodes = &model.tendons[t].nodes;
-                (nodes, numbers.number(Family::Tendon, t))
+                (&tie_nodes[t][..], numbers.number(Family::Tendon, t))
             })?;
         }
         self.elem_buf = buf;
@@ -900,10 +973,8 @@ impl<'m> System<'m> {
             if data.stressed_in_step != step || self.tendons[t].is_some() {
                 continue;
             }
-            let u0: Vec<[f64; 2]> = data
-                .nodes
-                .iter()
-                .map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+            let u0: Vec<[f64; 2]> = (0..data.nodes.len())
+                .map(|p| data.at_point(p, |n| [self.u[2 * n], self.u[2 * n + 1]]))
                 .collect();
             let el = self.build_tendon(t, &u0);
             let tb = &mut self.families.tendons;
@@ -969,11 +1040,12 @@ impl<'m> System<'m> {
     /// Tendon `t` stressed on the geometry displaced by `u0` (one entry per tendon node) [m].
     pub(crate) fn build_tendon(&self, t: usize, u0: &[[f64; 2]]) -> ExternalTendon {
         let data = &self.model.tendons[t];
-        let x: Vec<[f64; 2]> = data
-            .nodes
-            .iter()
+        let x: Vec<[f64; 2]> = (0..data.nodes.len())
             .zip(u0)
-            .map(|(&n, d)| [self.model.nodes[n][0] + d[0], self.model.nodes[n][1] + d[1]])
+            .map(|(p, d)| {
+                let x0 = data.at_point(p, |n| self.model.nodes[n]);
+                [x0[0] + d[0], x0[1] + d[1]]
+            })
             .collect();
         ExternalTendon::new(
             &x,

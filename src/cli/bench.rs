@@ -297,7 +297,10 @@ fn seed_text(refine: usize) -> String {
 
 /// The bundled seed beam, refined as in [`seed_text`], with its last step on to failure.
 fn seed_text_to_failure(refine: usize) -> String {
-    refine_seed_mesh(include_str!("../../examples/seed-beam.toml"), refine.max(1))
+    refine_seed_mesh(
+        include_str!("../../examples/seed-beam-elastic.toml"),
+        refine.max(1),
+    )
 }
 
 /// The seed beam (bundled example) with its mesh refined `refine` times in both directions
@@ -535,53 +538,27 @@ impl Observer for Reach {
     }
 }
 
-/// The seed beam taken to failure: the bundled example (self weight, prestress, Q to 140 kN,
+/// The seed beam taken to failure: a bundled example (self weight, prestress, Q to 140 kN,
 /// then its arc-length step on Q until the midspan deflection reaches 0.12 m, L/60) refined
 /// `refine` times; the run ends there, where Newton gives up (the furthest point the model
-/// reaches), or after 400 increments. `concrete`: the elastic concrete replaced by the MC90/Ottosen concrete of
-/// the same strength (fcm = 45 MPa, docs/validation.md "The seed beam", IMPL-EX cracking) with
-/// elastic end blocks of 0.3 m at the anchors, each Q (1 kN per unit factor) spread uniformly
-/// over a 0.2 m loading plate centred on its load point, and the solver settings of the RC
-/// beam example.
+/// reaches), or after 400 increments. `concrete`: the `seed-beam` example (MC90/Ottosen
+/// concrete, fcm = 45 MPa, IMPL-EX cracking, anchor plates and loading bearings with their
+/// local zones, docs/validation.md "The seed beam"); else `seed-beam-elastic`.
 pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, String> {
     let r = refine.max(1);
-    let mut text = seed_text(r);
-    if concrete {
-        // MC90 concrete with IMPL-EX cracking; elastic end blocks (0.3 m, like anchor
-        // diaphragms) so that the single-node anchor forces do not crush the concrete.
-        text = text
-            .replace(
-                "kind = \"elastic\"\nE = 35.5e9",
-                "kind = \"concrete\"\nfcm = 45e6\ncrack_integration = \"implex\"\nE = 35.5e9",
-            )
-            .replace(
-                "[[joint_materials]]",
-                "[[materials]]\nname = \"block\"\nkind = \"elastic\"\nE = 35.5e9\nnu = 0.2\ndensity = 2548.4\n\n\
-                 [[regions]]\nname = \"end_blocks\"\nmaterial = \"block\"\nthickness = 0.70\n\
-                 boxes = [[[0.0, 0.0], [0.3, 0.6]], [[6.9, 0.0], [7.2, 0.6]]]\n\n[[joint_materials]]",
-            );
-        // The loads through 0.2 m loading plates (uniform pressure over the plate, as the
-        // test's jacks bear on steel plates; the seed gives no plate size, 0.2 m is the RC
-        // example's): a point load on a continuum has an unbounded stress under it, so
-        // with a concrete strength no mesh converges — refined 4× the top fibre under a
-        // single-node load crushed at 165 kN (docs/performance.md).
-        let point = "point_loads = [\n  { point = [2.4, 0.6], force = [0.0, -1e3] },\n  { point = [4.8, 0.6], force = [0.0, -1e3] },\n]";
-        let plates = "line_loads = [\n  { line = [[2.3, 0.6], [2.5, 0.6]], q = [0.0, -5e3] },\n  { line = [[4.7, 0.6], [4.9, 0.6]], q = [0.0, -5e3] },\n]";
-        let with_plates = text.replace(point, plates);
-        if !text.contains("implex") || !text.contains("end_blocks") || with_plates == text {
-            return Err("seed-beam.toml changed: cannot build the concrete case".into());
-        }
-        text = with_plates;
-        text.push_str("\n[solver]\nforce_tolerance = 1e-4\nmax_iterations = 30\nmax_cuts = 8\n");
+    let text = if concrete {
+        // The bundled `seed-beam` example as it stands: MC90 concrete with IMPL-EX
+        // cracking, the tendon's anchors on their default anchor plates and local zones,
+        // the loads on 0.2 m bearings (docs/theory-prestress.md, "Anchor plates, bearings
+        // and local zones"), program solver defaults; its own step on to failure.
+        refine_seed_mesh(include_str!("../../examples/seed-beam.toml"), r)
+    } else {
+        // The elastic example's own step on to failure (arc length to L/60).
+        seed_text_to_failure(r)
+    };
+    if !text.contains("[[steps]]\nname = \"failure\"") {
+        return Err("seed-beam.toml has no failure step".into());
     }
-    // The example's own step on to failure (arc length to L/60); a TOML array of tables
-    // may go on after the [solver] table.
-    let failure = seed_text_to_failure(r);
-    let step = &failure[failure
-        .find("[[steps]]\nname = \"failure\"")
-        .ok_or("seed-beam.toml has no failure step")?..];
-    text.push('\n');
-    text.push_str(step);
     let t0 = Instant::now();
     let cpu0 = process_cpu_s();
     let model = segfem::input::parse(&text, "seed-beam.toml")

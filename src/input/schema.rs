@@ -131,6 +131,8 @@ pub struct TendonIn {
     pub stressed_in_step: Option<String>,
     pub relaxation_class: Option<i64>,
     pub thermal_expansion: Option<f64>,
+    pub anchor_plate: Option<f64>,
+    pub local_zone: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -160,6 +162,8 @@ pub struct SupportIn {
     pub group: Option<String>,
     pub ux: Option<f64>,
     pub uy: Option<f64>,
+    pub bearing: Option<f64>,
+    pub local_zone: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -195,6 +199,8 @@ pub struct PointLoadIn {
     pub node: Option<i64>,
     pub point: Option<[f64; 2]>,
     pub force: [f64; 2],
+    pub bearing: Option<f64>,
+    pub local_zone: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

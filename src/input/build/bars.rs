@@ -1,6 +1,7 @@
 //! `[[bars]]` and bonded (post- and pre-tensioned) `[[tendons]]`: paths cut through the mesh
 //! into integration points of embedded bars; lock-off stresses of post-tensioned tendons.
 
+use super::anchorage::LocalZone;
 use super::fields::{positive, unique_names};
 use super::tendons::{
     friction_of, is_bonded_kind, jacking_stress_of, relaxation_of, tendon_law, tendon_steel,
@@ -144,6 +145,7 @@ pub(super) fn build(
     tendons: &[TendonIn],
     steels: &[(String, SteelParams)],
     model: &mut Model,
+    zones: &mut Vec<LocalZone>,
 ) -> R<()> {
     if bars.is_empty() && !tendons.iter().any(|t| is_bonded_kind(&t.kind)) {
         return Ok(());
@@ -173,9 +175,11 @@ pub(super) fn build(
             "pretensioned" => out.push(pretensioned_tendon(
                 ctx, i, t, bars, &embedder, model, &coords,
             )?),
-            "bonded" => out.push(post_tensioned_tendon(
-                ctx, i, t, bars, &embedder, model, &coords,
-            )?),
+            "bonded" => {
+                let bar = post_tensioned_tendon(ctx, i, t, bars, &embedder, model, &coords)?;
+                bonded_anchor_zones(ctx, i, t, &bar, zones)?;
+                out.push(bar);
+            }
             _ => {}
         }
     }
@@ -404,6 +408,48 @@ fn post_tensioned_tendon(
     })
 }
 
+/// The local zones behind the two anchors of bonded tendon `t` (`tendons[i]`) unless
+/// `local_zone = false`: each anchor is the path's end, found from the integration point
+/// nearest it (its position less its arc length along its direction), the zone as wide and
+/// as deep as the anchor plate. The anchorage force itself enters through the host element
+/// of the tendon's end (the bar's equivalent forces), not over plate nodes.
+fn bonded_anchor_zones(
+    ctx: &Ctx,
+    i: usize,
+    t: &TendonIn,
+    bar: &Bar,
+    zones: &mut Vec<LocalZone>,
+) -> R<()> {
+    let plate = super::tendons::anchor_plate(ctx, &format!("tendons[{i}]"), t, bar.area)?;
+    if t.local_zone == Some(false) || plate == 0.0 {
+        return Ok(());
+    }
+    let by_s = |a: &&crate::model::BarGaussPoint, b: &&crate::model::BarGaussPoint| {
+        a.point.s.total_cmp(&b.point.s)
+    };
+    let (Some(first), Some(last)) = (
+        bar.points.iter().min_by(by_s),
+        bar.points.iter().max_by(by_s),
+    ) else {
+        return Ok(());
+    };
+    let length: f64 = bar.points.iter().map(|p| p.point.weight_length).sum();
+    let (p, d) = (&first.point, first.point.dir);
+    zones.push(LocalZone {
+        centre: [p.x[0] - p.s * d[0], p.x[1] - p.s * d[1]],
+        axis: d,
+        plate,
+    });
+    let (p, d) = (&last.point, last.point.dir);
+    let rest = length - p.s;
+    zones.push(LocalZone {
+        centre: [p.x[0] + rest * d[0], p.x[1] + rest * d[1]],
+        axis: [-d[0], -d[1]],
+        plate,
+    });
+    Ok(())
+}
+
 /// A pre-tensioned tendon (`kind = "pretensioned"`): an embedded prestressing-steel bar
 /// bonded from the start that carries `initial_stress` at zero displacement (the stress in
 /// the bed before release); its elastic shortening at transfer follows from equilibrium.
@@ -438,6 +484,8 @@ pub(super) fn pretensioned_tendon(
             ("deviator_friction", t.deviator_friction.is_some()),
             ("stressed_in_step", t.stressed_in_step.is_some()),
             ("grouted_in_step", t.grouted_in_step.is_some()),
+            ("anchor_plate", t.anchor_plate.is_some()),
+            ("local_zone", t.local_zone.is_some()),
         ],
         "not a key of a pre-tensioned tendon (bonded from the start with initial_stress, the stress before release)",
     )?;

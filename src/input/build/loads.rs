@@ -1,12 +1,13 @@
 //! `[[load_cases]]`: gravity, point loads, line loads along element edges and thermal
 //! actions (temperature fields, imposed strains).
 
+use super::anchorage::{self, LocalZone};
 use super::fields::{locate_nodes, unique_names};
 use super::R;
 use crate::input::error::Ctx;
 use crate::input::gmsh_mesh;
 use crate::input::locate;
-use crate::input::schema::{File, LoadCaseIn};
+use crate::input::schema::{File, LoadCaseIn, PointLoadIn};
 use crate::model::{EdgeLoad, LoadCase, Model, PathControl};
 
 /// The load cases, located in the mesh.
@@ -16,6 +17,7 @@ pub(super) fn build(
     groups: &gmsh_mesh::Groups,
     model: &mut Model,
     used: &[bool],
+    zones: &mut Vec<LocalZone>,
 ) -> R<()> {
     unique_names(ctx, "load_cases", list.iter().map(|c| c.name.as_str()))?;
     for (i, c) in list.iter().enumerate() {
@@ -39,7 +41,14 @@ pub(super) fn build(
                 return Err(ctx.err(format!("{key}.force"), "must be finite numbers"));
             }
             let n = locate_nodes(ctx, &key, model, used, p.node, p.point, None)?[0];
-            case.point_forces.push((n, p.force));
+            match bearing(ctx, &key, p, model, n, zones)? {
+                Some(weights) => case.point_forces.extend(
+                    weights
+                        .into_iter()
+                        .map(|(m, w)| (m, [w * p.force[0], w * p.force[1]])),
+                ),
+                None => case.point_forces.push((n, p.force)),
+            }
         }
         for (j, l) in c.line_loads.iter().enumerate() {
             let key = format!("load_cases[{i}].line_loads[{j}]");
@@ -87,6 +96,64 @@ pub(super) fn build(
         model.load_cases.push(case);
     }
     Ok(())
+}
+
+/// `point_loads[j].bearing`: the load spread as a uniform pressure over a bearing of that
+/// length [m] centred on node `n`, along the element edge through the node most nearly
+/// perpendicular to the force (nodes and shares of the force, summing to 1), and its local
+/// zone if `local_zone = true`; None without a bearing.
+fn bearing(
+    ctx: &Ctx,
+    key: &str,
+    p: &PointLoadIn,
+    model: &Model,
+    n: usize,
+    zones: &mut Vec<LocalZone>,
+) -> R<Option<Vec<(usize, f64)>>> {
+    let b = match p.bearing {
+        None | Some(0.0) => {
+            if p.local_zone.is_some() {
+                return Err(ctx.err(
+                    format!("{key}.local_zone"),
+                    "only with a bearing (the local zone is the concrete under it)",
+                ));
+            }
+            return Ok(None);
+        }
+        Some(b) if b.is_finite() && b > 0.0 => b,
+        Some(b) => {
+            return Err(ctx.err(
+                format!("{key}.bearing"),
+                format!("must be a bearing length ≥ 0 in m (got {b})"),
+            ))
+        }
+    };
+    let f = p.force[0].hypot(p.force[1]);
+    if f == 0.0 {
+        return Ok(None);
+    }
+    let axis = [p.force[0] / f, p.force[1] / f];
+    let s = anchorage::spread(model, n, axis, b);
+    if s.covered < (1.0 - 1e-6) * b {
+        return Err(ctx.err(
+            format!("{key}.bearing"),
+            format!(
+                "the {b} m bearing centred on ({:.3}, {:.3}) runs off the element edges (it lies on them over {:.4} m): shorten it or move the load",
+                model.nodes[n][0], model.nodes[n][1], s.covered
+            ),
+        ));
+    }
+    // Opt-in: a load bearing's pressure is usually far below f_cm (EN 1992-1-1 6.7 checks
+    // it), and an elastic block in a member's compression zone would attract the bending
+    // compression that plain concrete carries there.
+    if p.local_zone == Some(true) {
+        zones.push(LocalZone {
+            centre: model.nodes[n],
+            axis,
+            plate: b,
+        });
+    }
+    Ok(Some(s.weights))
 }
 
 /// EN 1992-1-1 3.1.3(5) (and EN 1991-1-5 Table C.1): α of normal-weight concrete [1/K].

@@ -5,6 +5,7 @@
 //! Model"); [`build`] calls them in the order the parts depend on each other, so that a
 //! later part can refer to an earlier one by name (regions to materials, monitors to bars).
 
+mod anchorage;
 mod bars;
 mod controls;
 mod fields;
@@ -91,14 +92,31 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         joints::add(ctx, mesh, &mut model, &joints, &joint_materials)?;
     }
     let used = mesh::used_nodes(ctx, &model, w);
-    supports::build(ctx, &file.supports, &groups, &mut model, &used)?;
+    // Local zones behind anchor plates and under bearings, made elastic at the end.
+    let mut zones = Vec::new();
+    supports::build(ctx, &file.supports, &groups, &mut model, &used, &mut zones)?;
     // The steps tendons are stressed in are resolved once the steps are known (below).
-    let external_of = tendons::build_external(ctx, &file.tendons, &mut model, &used, w)?;
+    let external_of =
+        tendons::build_external(ctx, &file.tendons, &mut model, &used, &mut zones, w)?;
     supports::hold_unused(&mut model, &used);
     supports::check_rigid_body(ctx, &model, &used)?;
-    loads::build(ctx, &file.load_cases, &groups, &mut model, &used)?;
+    loads::build(
+        ctx,
+        &file.load_cases,
+        &groups,
+        &mut model,
+        &used,
+        &mut zones,
+    )?;
     // Embedded bars before the monitors, which can name them.
-    bars::build(ctx, &file.bars, &file.tendons, &steels, &mut model)?;
+    bars::build(
+        ctx,
+        &file.bars,
+        &file.tendons,
+        &steels,
+        &mut model,
+        &mut zones,
+    )?;
     super::bar_layers::build(ctx, &file.bar_layers, &steels, &mut model)?;
     monitors::build(ctx, &file, &mut model, &used)?;
     controls::geometry(ctx, file.analysis.as_ref(), &mut model)?;
@@ -115,5 +133,8 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     loads::thermal_coefficients(ctx, &file, &mut model)?;
     stages::check_tendons(ctx, &model)?;
     controls::solver(ctx, file.solver.as_ref(), &mut model)?;
+    // Last, once stages and thermal coefficients are known (the zones' region copies
+    // inherit them).
+    anchorage::apply_local_zones(&mut model, &zones, &used);
     Ok(Built { model, warnings })
 }

@@ -1,6 +1,7 @@
 //! `[[supports]]`: restrained displacements; the check that every part of the mesh is held
 //! against rigid-body motion.
 
+use super::anchorage::{self, LocalZone};
 use super::fields::{locate_nodes, unique_names};
 use super::R;
 use crate::input::error::Ctx;
@@ -17,6 +18,7 @@ pub(super) fn build(
     groups: &gmsh_mesh::Groups,
     model: &mut Model,
     used: &[bool],
+    zones: &mut Vec<LocalZone>,
 ) -> R<()> {
     unique_names(ctx, "supports", list.iter().map(|s| s.name.as_str()))?;
     if list.is_empty() {
@@ -58,12 +60,61 @@ pub(super) fn build(
         if s.ux.is_none() && s.uy.is_none() {
             return Err(ctx.err(&key, "restrains nothing: give ux and/or uy (0.0 = fixed)"));
         }
+        if let Some(z) = bearing_zone(ctx, &key, s, model, &dofs)? {
+            zones.push(z);
+        }
         model.supports.push(Support {
             name: s.name.clone(),
             dofs,
         });
     }
     Ok(())
+}
+
+/// `supports[i].bearing`: a pinned bearing. The support holds its node (a pin at the
+/// bearing's centre: no fixed-end moment), and the concrete under the bearing is a local
+/// zone (unless `local_zone = false`) that spreads the reaction as the bearing plate does.
+fn bearing_zone(
+    ctx: &Ctx,
+    key: &str,
+    s: &SupportIn,
+    model: &Model,
+    dofs: &[(usize, Dir, f64)],
+) -> R<Option<LocalZone>> {
+    let b = match s.bearing {
+        None | Some(0.0) => {
+            if s.local_zone.is_some() {
+                return Err(ctx.err(
+                    format!("{key}.local_zone"),
+                    "only with a bearing (the local zone is the concrete over it)",
+                ));
+            }
+            return Ok(None);
+        }
+        Some(b) if b.is_finite() && b > 0.0 => b,
+        Some(b) => {
+            return Err(ctx.err(
+                format!("{key}.bearing"),
+                format!("must be a bearing length ≥ 0 in m (got {b})"),
+            ))
+        }
+    };
+    if s.line.is_some() || s.group.is_some() {
+        return Err(ctx.err(
+            format!("{key}.bearing"),
+            "only for a support at a node or point (a line support is already spread)",
+        ));
+    }
+    if s.local_zone == Some(false) {
+        return Ok(None);
+    }
+    let node = dofs[0].0;
+    let held = if s.uy.is_some() {
+        [0.0, 1.0]
+    } else {
+        [1.0, 0.0]
+    };
+    Ok(Some(anchorage::support_zone(model, node, held, b)))
 }
 
 /// Hold the nodes no element uses, so that they add no zero pivots.

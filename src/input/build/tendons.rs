@@ -2,6 +2,7 @@
 //! with friction losses); the steel, jacking and relaxation checks shared with bonded and
 //! pre-tensioned tendons (built as bars, in `bars`).
 
+use super::anchorage::{self, LocalZone};
 use super::fields::{index_by_name, positive, unique_names};
 use super::R;
 use crate::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
@@ -19,6 +20,7 @@ pub(super) fn build_external(
     list: &[TendonIn],
     model: &mut Model,
     used: &[bool],
+    zones: &mut Vec<LocalZone>,
     warnings: &mut Vec<String>,
 ) -> R<Vec<Option<usize>>> {
     unique_names(ctx, "tendons", list.iter().map(|t| t.name.as_str()))?;
@@ -37,7 +39,7 @@ pub(super) fn build_external(
         if is_bonded_kind(&t.kind) {
             continue;
         }
-        let tendon = build_tendon(ctx, i, t, model, used, warnings)?;
+        let tendon = build_tendon(ctx, i, t, model, used, zones, warnings)?;
         external_of[i] = Some(model.tendons.len());
         model.tendons.push(tendon);
     }
@@ -159,6 +161,7 @@ pub(super) fn build_tendon(
     t: &TendonIn,
     model: &Model,
     used: &[bool],
+    zones: &mut Vec<LocalZone>,
     warnings: &mut Vec<String>,
 ) -> R<TendonEl> {
     let k = |f: &str| format!("tendons[{i}].{f}");
@@ -203,6 +206,7 @@ pub(super) fn build_tendon(
     )?;
     let nodes = tendon_nodes(ctx, i, t, model, used, warnings)?;
     let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| model.nodes[n]).collect();
+    let ties = anchor_ties(ctx, i, t, model, &nodes, area, zones, warnings)?;
     let span_stress = span_stresses(ctx, i, t, &coords, area, ep, fptk)?;
     let mode = deviator_mode(ctx, i, t)?;
     // Check the element can be built (zero-length spans, etc.).
@@ -227,6 +231,7 @@ pub(super) fn build_tendon(
         relaxation,
         name: t.name.clone(),
         nodes,
+        ties,
         area,
         ep,
         fptk,
@@ -490,4 +495,63 @@ pub(super) fn friction_of(ctx: &Ctx, i: usize, t: &TendonIn) -> R<(FrictionParam
         ));
     }
     Ok((FrictionParams { mu, wobble }, jacking, draw_in))
+}
+
+/// The anchor plate of tendon `t` [m]: `anchor_plate` (0: the anchor at its node alone), or
+/// the default from the strand count ([`anchorage::default_plate`]).
+pub(super) fn anchor_plate(ctx: &Ctx, key: &str, t: &TendonIn, area: f64) -> R<f64> {
+    match t.anchor_plate {
+        None => Ok(anchorage::default_plate(area)),
+        Some(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        Some(v) => Err(ctx.err(
+            format!("{key}.anchor_plate"),
+            format!("must be a plate size ≥ 0 in m (0: no plate; got {v})"),
+        )),
+    }
+}
+
+/// The ties of an external tendon's points: each anchor spread over the nodes under its
+/// plate (along the element edge through the anchor most nearly perpendicular to the
+/// tendon), the deviators on their own nodes; the local zones behind the plates.
+#[allow(clippy::too_many_arguments)]
+fn anchor_ties(
+    ctx: &Ctx,
+    i: usize,
+    t: &TendonIn,
+    model: &Model,
+    nodes: &[usize],
+    area: f64,
+    zones: &mut Vec<LocalZone>,
+    warnings: &mut Vec<String>,
+) -> R<Vec<Vec<(usize, f64)>>> {
+    let key = format!("tendons[{i}]");
+    let plate = anchor_plate(ctx, &key, t, area)?;
+    let mut ties: Vec<Vec<(usize, f64)>> = nodes.iter().map(|&n| vec![(n, 1.0)]).collect();
+    if plate == 0.0 {
+        return Ok(ties);
+    }
+    let m = nodes.len() - 1;
+    for (p, q) in [(0, 1), (m, m - 1)] {
+        let (a, b) = (model.nodes[nodes[p]], model.nodes[nodes[q]]);
+        let l = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let axis = [(b[0] - a[0]) / l, (b[1] - a[1]) / l];
+        let s = anchorage::spread(model, nodes[p], axis, plate);
+        // A given plate that overhangs the member is warned about; the default plate is a
+        // size rule and is limited to the member without a word (docs/input.md).
+        if t.anchor_plate.is_some() && s.covered < (1.0 - 1e-6) * plate {
+            warnings.push(format!(
+                "{}: {key}.anchor_plate: the {plate:.3} m plate at ({:.3}, {:.3}) lies on element edges over {:.3} m only (the mesh ends): the force is spread over that part",
+                ctx.file, a[0], a[1], s.covered
+            ));
+        }
+        ties[p] = s.weights;
+        if t.local_zone != Some(false) {
+            zones.push(LocalZone {
+                centre: a,
+                axis,
+                plate,
+            });
+        }
+    }
+    Ok(ties)
 }

@@ -540,6 +540,8 @@ fn supports(layout: &Layout) -> Vec<SupportIn> {
         group: None,
         ux,
         uy: Some(0.0),
+        bearing: None,
+        local_zone: None,
     };
     let mut list = Vec::new();
     for (i, &x) in b.iter().enumerate() {
@@ -709,6 +711,8 @@ fn tendon(
         stressed_in_step: None,
         relaxation_class: None,
         thermal_expansion: None,
+        anchor_plate: None,
+        local_zone: None,
     }
 }
 

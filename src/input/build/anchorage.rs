@@ -1,0 +1,239 @@
+//! Load introduction as members take it: anchor plates of tendons and bearings of point
+//! loads spread a force over the nodes under the plate (consistent nodal weights of a
+//! uniform pressure), and the local zone behind a plate or under a bearing is made elastic,
+//! standing for the spiral or local reinforcement that the anchorage approval (or the
+//! bearing's design) provides (docs/theory-prestress.md, "Anchor plates, bearings and local
+//! zones").
+
+use crate::elements::continuum::edge_force_partial;
+use crate::input::locate;
+use crate::materials::point::Material;
+use crate::model::{Model, NamedMaterial, Region};
+
+/// Cross-section of one 0.6" (15.7 mm) prestressing strand [m²] (EN 10138-3 Y1860S7,
+/// 150 mm²; 140 mm² for the common 15.2 mm strand): the strand count of the default plate.
+pub const STRAND_AREA: f64 = 140e-6;
+
+/// Side of a typical ETA bearing plate per √(number of 0.6" strands) [m]: approved
+/// multi-strand anchorages (4 to 31 strands) have square bearing plates of about
+/// 0.085 √n m (4 strands ≈ 0.17 m, 12 ≈ 0.29 m, 19 ≈ 0.37 m, 31 ≈ 0.47 m), a bearing
+/// pressure under the jacking force near 25–30 MPa.
+pub const PLATE_SIDE_PER_ROOT_STRAND: f64 = 0.085;
+
+/// Default anchor plate [m] of a tendon of steel area `area` [m²]: n = ⌈area / 140 mm²⌉
+/// 0.6" strands, side 0.085 m × √n ([`PLATE_SIDE_PER_ROOT_STRAND`]).
+pub fn default_plate(area: f64) -> f64 {
+    let n = (area / STRAND_AREA - 1e-9).ceil().max(1.0);
+    PLATE_SIDE_PER_ROOT_STRAND * n.sqrt()
+}
+
+/// A force spread over the nodes under a plate or bearing: (node, weight), weights summing
+/// to 1, and the length of the plate that lies on element edges [m].
+pub struct Spread {
+    /// Nodes and their shares of the force.
+    pub weights: Vec<(usize, f64)>,
+    /// Length of the plate on element edges [m] (less than the plate where the mesh ends).
+    pub covered: f64,
+}
+
+/// The unit vector of the element edge through `node` that is most nearly perpendicular to
+/// `axis` (the line a plate bearing along `axis` lies on), or None if no edge has the node.
+pub fn plate_line(model: &Model, node: usize, axis: [f64; 2]) -> Option<[f64; 2]> {
+    let mut best: Option<([f64; 2], f64)> = None;
+    for e in &model.elements {
+        if !e.nodes.contains(&node) {
+            continue;
+        }
+        for k in 0..4 {
+            let nodes: Vec<usize> = e.kind.edge_nodes(k).iter().map(|&l| e.nodes[l]).collect();
+            if !nodes.contains(&node) {
+                continue;
+            }
+            let (a, b) = (model.nodes[nodes[0]], model.nodes[nodes[1]]);
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let l = dx.hypot(dy);
+            if l == 0.0 {
+                continue;
+            }
+            let t = [dx / l, dy / l];
+            let cos = (t[0] * axis[0] + t[1] * axis[1]).abs();
+            if best.is_none_or(|(_, c)| cos < c - 1e-12) {
+                best = Some((t, cos));
+            }
+        }
+    }
+    best.map(|(t, _)| t)
+}
+
+/// Spread over a plate of length `length` [m] centred on `node`, lying along the element
+/// edge through the node most nearly perpendicular to `axis` (unit): the consistent nodal
+/// forces of a uniform pressure on the part of the plate on element edges, per unit force.
+pub fn spread(model: &Model, node: usize, axis: [f64; 2], length: f64) -> Spread {
+    let Some(t) = plate_line(model, node, axis) else {
+        return Spread {
+            weights: vec![(node, 1.0)],
+            covered: 0.0,
+        };
+    };
+    let c = model.nodes[node];
+    let h = 0.5 * length;
+    let a = [c[0] - h * t[0], c[1] - h * t[1]];
+    let b = [c[0] + h * t[0], c[1] + h * t[1]];
+    let (edges, covered) = locate::edges_on_segment(model, a, b);
+    if edges.is_empty() || covered <= 0.0 {
+        return Spread {
+            weights: vec![(node, 1.0)],
+            covered: 0.0,
+        };
+    }
+    let mut weights: Vec<(usize, f64)> = Vec::new();
+    for (nodes, [r0, r1]) in edges {
+        let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| model.nodes[n]).collect();
+        let f = edge_force_partial(&coords, [1.0 / covered, 0.0], r0, r1);
+        for (k, &n) in nodes.iter().enumerate() {
+            match weights.iter_mut().find(|(m, _)| *m == n) {
+                Some((_, w)) => *w += f[2 * k],
+                None => weights.push((n, f[2 * k])),
+            }
+        }
+    }
+    weights.retain(|(_, w)| *w != 0.0);
+    weights.sort_by_key(|(n, _)| *n);
+    Spread { weights, covered }
+}
+
+/// A local zone to make elastic: the box behind a plate (or under a bearing) of length
+/// `plate` [m] at `centre`, `depth` [m] deep along `axis` (unit, into the concrete), as
+/// wide as the plate.
+pub struct LocalZone {
+    /// Centre of the plate [m].
+    pub centre: [f64; 2],
+    /// Direction the plate pushes the concrete (unit).
+    pub axis: [f64; 2],
+    /// Plate or bearing length [m] (the zone's width).
+    pub plate: f64,
+}
+
+/// Depth of a local zone per plate length [-]: AASHTO LRFD 5.8.4.1 takes the local zone
+/// at least as long as the plate's largest lateral dimension (and at most 1.5 times it);
+/// EN 1992-1-1 6.7 spreads a partially loaded area over a depth h ≥ b2 − b1 with b2 ≤ 3 b1.
+/// The lower bound keeps the zone within the spiral of an approved anchorage.
+pub const LOCAL_ZONE_DEPTH: f64 = 1.0;
+
+/// Make the concrete of the local zones elastic: every element whose centroid (mean of its
+/// corner nodes) lies in a zone's box (and, if none does, the elements at the plate's
+/// centre on the zone's side) and whose material is `concrete` moves to a copy of its
+/// region with an elastic material of the concrete's initial modulus, Poisson ratio and
+/// density. Elastic and creep regions are left alone (they cannot fail locally). The copy
+/// keeps the region's construction stage and thermal coefficient.
+pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[bool]) {
+    let n_regions = model.regions.len();
+    // Copy of region r (index into model.regions), made on first use.
+    let mut copy_of: Vec<Option<usize>> = vec![None; n_regions];
+    for z in zones {
+        let n = locate::nearest_node(model, used, z.centre);
+        let centroid = |e: &crate::model::Element| {
+            let k = e.nodes.len().min(4) as f64;
+            e.nodes.iter().take(4).fold([0.0, 0.0], |c, &n| {
+                [c[0] + model.nodes[n][0] / k, c[1] + model.nodes[n][1] / k]
+            })
+        };
+        let local = |p: [f64; 2]| {
+            let d = [p[0] - z.centre[0], p[1] - z.centre[1]];
+            let s = d[0] * z.axis[0] + d[1] * z.axis[1];
+            let t = -d[0] * z.axis[1] + d[1] * z.axis[0];
+            (s, t)
+        };
+        let tol = 1e-9 * locate::model_size(model);
+        let depth = LOCAL_ZONE_DEPTH * z.plate;
+        let mut hits: Vec<usize> = (0..model.elements.len())
+            .filter(|&e| {
+                let (s, t) = local(centroid(&model.elements[e]));
+                s >= -tol && s <= depth + tol && t.abs() <= 0.5 * z.plate + tol
+            })
+            .collect();
+        if hits.is_empty() {
+            hits = (0..model.elements.len())
+                .filter(|&e| {
+                    model.elements[e].nodes.contains(&n)
+                        && local(centroid(&model.elements[e])).0 > 0.0
+                })
+                .collect();
+        }
+        for e in hits {
+            let r = model.elements[e].region;
+            let r = if r < n_regions { r } else { continue };
+            let host = &model.regions[r];
+            let Material::Concrete { params, density } = &model.materials[host.material].law else {
+                continue;
+            };
+            let target = match copy_of[r] {
+                Some(c) => c,
+                None => {
+                    let mat = NamedMaterial {
+                        name: format!("{} (local zone)", model.materials[host.material].name),
+                        law: Material::Elastic {
+                            e: params.ec,
+                            nu: params.nu,
+                            density: *density,
+                        },
+                    };
+                    model.materials.push(mat);
+                    let region = Region {
+                        name: format!("{} (local zone)", host.name),
+                        material: model.materials.len() - 1,
+                        thickness: host.thickness,
+                    };
+                    model.regions.push(region);
+                    let c = model.regions.len() - 1;
+                    if !model.staging.regions.is_empty() {
+                        let life = model.staging.regions[r];
+                        model.staging.regions.push(life);
+                    }
+                    for case in model.load_cases.iter_mut() {
+                        if let Some(th) = case.thermal.as_mut() {
+                            if let Some(&a) = th.region_alpha.get(r) {
+                                th.region_alpha.push(a);
+                            }
+                        }
+                    }
+                    copy_of[r] = Some(c);
+                    c
+                }
+            };
+            model.elements[e].region = target;
+        }
+    }
+}
+
+/// The local zone of a support over a bearing of length `bearing` [m] at `node` that holds
+/// the direction `held` (unit): the bearing lies along the element edge through the node
+/// most nearly perpendicular to `held`, and the zone reaches into the concrete on the side
+/// of the elements at the node.
+pub fn support_zone(model: &Model, node: usize, held: [f64; 2], bearing: f64) -> LocalZone {
+    let c = model.nodes[node];
+    let t = plate_line(model, node, held).unwrap_or([-held[1], held[0]]);
+    let normal = [-t[1], t[0]];
+    let side: f64 = model
+        .elements
+        .iter()
+        .filter(|e| e.nodes.contains(&node))
+        .map(|e| {
+            let k = e.nodes.len().min(4) as f64;
+            let m = e.nodes.iter().take(4).fold([0.0, 0.0], |a, &n| {
+                [a[0] + model.nodes[n][0] / k, a[1] + model.nodes[n][1] / k]
+            });
+            (m[0] - c[0]) * normal[0] + (m[1] - c[1]) * normal[1]
+        })
+        .sum();
+    let axis = if side >= 0.0 {
+        normal
+    } else {
+        [-normal[0], -normal[1]]
+    };
+    LocalZone {
+        centre: c,
+        axis,
+        plate: bearing,
+    }
+}
