@@ -331,7 +331,7 @@ pub fn seed_long_term_case(refine: usize) -> Result<NonlinearRow, String> {
     let text = head
         .replace(
             "kind = \"elastic\"\nE = 35.5e9          # MC90 Eci for fcm = 45 MPa",
-            "kind = \"elastic_creep\"\nfcm = 45e6\nrh = 0.70\nh0 = 0.200\ncement = \"N\"",
+            "kind = \"elastic_creep\"\nrh = 0.70\nh0 = 0.200\ncement = \"N\"",
         )
         .replace(
             "deviators = \"held\"",

@@ -177,6 +177,9 @@ pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[
                             nu: params.nu,
                             density: *density,
                         },
+                        // Stands for the confined concrete of the anchorage's approval:
+                        // not checked against the unconfined strength.
+                        strength: None,
                     };
                     model.materials.push(mat);
                     let region = Region {
