@@ -69,6 +69,19 @@ pub struct PairStart {
     pub prev_size: Option<f64>,
     /// What the step kind keeps of the pair's start (a time step: the clock reached [d]).
     pub mark: f64,
+    /// The norm the error is measured in.
+    pub norm: PairNorm,
+}
+
+/// The norm of a pair's error and of its displacement change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PairNorm {
+    /// The largest component (time steps: every point creeps smoothly).
+    Max,
+    /// The root mean square over all dofs (load and displacement steps: a crack opening
+    /// inside a pair is a local jump whose size no increment length controls; the rms
+    /// weighs it by the part of the structure it moves).
+    Rms,
 }
 
 impl Pair {
@@ -99,7 +112,7 @@ impl Pair {
     pub fn rejects(&self, u: &[f64], tol: Option<f64>, may_shorten: bool) -> bool {
         match (self, tol) {
             (Pair::Second(s), Some(tol)) if may_shorten => {
-                let (err, change) = pair_error(&s.probe, &s.start_u, u);
+                let (err, change) = pair_error(&s.probe, &s.start_u, u, s.norm);
                 err > tol * change
             }
             _ => false,
@@ -113,7 +126,7 @@ impl PairStart {
     /// where nothing moved).
     pub fn growth(&self, u: &[f64], tol: Option<f64>) -> f64 {
         let Some(tol) = tol else { return 1.0 };
-        let (err, change) = pair_error(&self.probe, &self.start_u, u);
+        let (err, change) = pair_error(&self.probe, &self.start_u, u, self.norm);
         if err <= 0.0 || !err.is_finite() {
             return 2.0;
         }
@@ -122,7 +135,7 @@ impl PairStart {
 
     /// The pair's relative error max|probe − u| / max|u − u_a| [-] (0 where nothing moved).
     pub fn relative_error(&self, u: &[f64]) -> f64 {
-        let (err, change) = pair_error(&self.probe, &self.start_u, u);
+        let (err, change) = pair_error(&self.probe, &self.start_u, u, self.norm);
         if change > 0.0 {
             err / change
         } else {
@@ -131,9 +144,16 @@ impl PairStart {
     }
 }
 
-/// Step-doubling error of a pair and the displacement change over it: (max|probe − u|,
-/// max|u − start|) [m].
-pub fn pair_error(probe: &[f64], start: &[f64], u: &[f64]) -> (f64, f64) {
+/// Step-doubling error of a pair and the displacement change over it: (‖probe − u‖,
+/// ‖u − start‖) [m] in the norm `norm`.
+pub fn pair_error(probe: &[f64], start: &[f64], u: &[f64], norm: PairNorm) -> (f64, f64) {
+    if norm == PairNorm::Rms {
+        let rms = |a: &[f64], b: &[f64]| {
+            (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len().max(1) as f64)
+                .sqrt()
+        };
+        return (rms(probe, u), rms(start, u));
+    }
     let err = probe
         .iter()
         .zip(u)
@@ -185,9 +205,22 @@ pub(super) struct Controller {
     pub tolerance: Option<f64>,
     /// Shortest pair [-]: the tolerance is given up below it.
     pub min_pair: f64,
+    /// Longest pair [-] (unbounded for time steps; the user's increment for load and
+    /// displacement steps, so their output is never sparser than asked).
+    pub max_size: f64,
     /// Phase of the current pair.
     pub pair: Pair,
+    /// The norm of the pairs' errors.
+    pub norm: PairNorm,
+    /// Path pairs: the relative error of the last rejected pair at this level, if any (a
+    /// shorter pair whose error did not fall below [`MIN_REDUCTION`] of it is kept: the
+    /// error is not controlled by the size there).
+    pub last_rejected: Option<f64>,
 }
+
+/// A shorter pair must bring the relative error below this fraction of the rejected one's,
+/// or it is kept as it is (load and displacement steps).
+const MIN_REDUCTION: f64 = 0.9;
 
 impl Controller {
     /// A step of `increments` increments with `max_cuts` cuts allowed.
@@ -206,7 +239,10 @@ impl Controller {
             growth,
             tolerance,
             min_pair: nominal / 1024.0,
+            max_size: f64::INFINITY,
             pair: Pair::Probe,
+            norm: PairNorm::Max,
+            last_rejected: None,
         }
     }
 
@@ -262,6 +298,7 @@ impl Controller {
                 saved: None,
                 prev_size: self.prev_size,
                 mark: 0.0,
+                norm: self.norm,
             }));
             return Verdict::Probed;
         }
@@ -275,6 +312,7 @@ impl Controller {
         if self
             .pair
             .rejects(u, self.tolerance, self.size > self.min_pair)
+            && self.error_falls(u)
         {
             // The halves disagree with the probe beyond the tolerance: back to the start
             // of the pair, with a shorter one.
@@ -284,6 +322,9 @@ impl Controller {
             self.size = (self.size * start.growth(u, self.tolerance)).max(self.min_pair);
             self.level = start.level;
             self.prev_size = start.prev_size;
+            if self.norm == PairNorm::Rms {
+                self.last_rejected = Some(start.relative_error(u));
+            }
             return Verdict::Rejected(start);
         }
         if implex_over(self) {
@@ -301,13 +342,27 @@ impl Controller {
         let mut error = None;
         if let Pair::Second(start) = std::mem::replace(&mut self.pair, Pair::Probe) {
             // An accepted pair: the next one as long as the error allows.
-            self.size = (self.size * start.growth(u, self.tolerance)).max(self.min_pair);
+            self.size = (self.size * start.growth(u, self.tolerance))
+                .max(self.min_pair)
+                .min(self.max_size);
             error = Some(start.relative_error(u));
         }
         self.prev_size = Some(target - self.level);
         self.level = target;
         self.increment += 1;
+        self.last_rejected = None;
         Verdict::Accepted { pair_error: error }
+    }
+
+    /// Whether a second half ending at `u` has an error that fell enough since the last
+    /// rejected pair at this level (always true for time steps and at a first rejection).
+    fn error_falls(&self, u: &[f64]) -> bool {
+        match (&self.pair, self.last_rejected) {
+            (Pair::Second(s), Some(last)) if self.norm == PairNorm::Rms => {
+                s.relative_error(u) < MIN_REDUCTION * last
+            }
+            _ => true,
+        }
     }
 }
 
@@ -662,5 +717,31 @@ mod tests {
         assert_eq!(u, Some(vec![1.0]));
         assert_eq!(rejected, 0);
         assert_eq!(sizes, vec![0.125, 0.125, 0.25, 0.25, 0.125, 0.125]);
+    }
+
+    #[test]
+    fn a_pair_whose_error_does_not_fall_with_its_size_is_kept_on_a_path() {
+        // du/dλ = 1 below u = 0.3, 20 above (a crack opening: a jump of the slope). A pair
+        // that crosses 0.3 has a relative error of about (20 − 1)/(20 + 1) ≈ 0.9 whatever
+        // its length (forward Euler: the probe keeps the slope 1 over the whole pair).
+        // With the path rule a shorter pair that does not lower the error below 0.9 of the
+        // rejected one's is kept: a few rejections only. The time-step rule (max norm, no
+        // such check) halves on to the shortest pair, 1/1024 of the nominal size.
+        let jump = |l: f64, t: f64, u0: &[f64]| {
+            let slope = if u0[0] < 0.3 { 1.0 } else { 20.0 };
+            Some((vec![u0[0] + slope * (t - l)], 3))
+        };
+        let mut path = Controller::new(4, 6, Growth::Kept, Some(0.05));
+        path.norm = PairNorm::Rms;
+        path.max_size = path.nominal;
+        let (u, _, rejected) = drive(&mut path, 0.0, jump);
+        assert!(u.is_some());
+        assert!(rejected <= 4, "{rejected} rejected pairs");
+
+        let mut time = Controller::new(4, 6, Growth::Kept, Some(0.05));
+        let (_, sizes, rejected_time) = drive(&mut time, 0.0, jump);
+        let shortest = sizes.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(rejected_time > rejected, "{rejected_time} vs {rejected}");
+        assert!(shortest < 0.25 / 100.0, "shortest increment {shortest}");
     }
 }

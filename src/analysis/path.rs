@@ -6,7 +6,7 @@
 use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{
-    self, external_forces, external_forces_along, ArcSizing, Controller, Growth,
+    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm,
 };
 use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
@@ -238,7 +238,19 @@ fn displacement_step(
     // increment (equal to it when they start equal).
     let v0 = ctl[0].v0;
     let controls = &ctx.sys.model.controls;
-    let mut sizing = Controller::new(step.increments, controls.max_cuts, Growth::WhenEasy, None);
+    // Nonlinear materials: pairs of increments with `[solver] increment_tolerance`, never
+    // longer than the user's increment (pairs set their own growth).
+    let tolerance = (!ctx.sys.linear)
+        .then_some(controls.increment_tolerance)
+        .flatten();
+    let growth = if tolerance.is_some() {
+        Growth::Kept
+    } else {
+        Growth::WhenEasy
+    };
+    let mut sizing = Controller::new(step.increments, controls.max_cuts, growth, tolerance);
+    sizing.max_size = sizing.nominal;
+    sizing.norm = PairNorm::Rms;
     // The last increment's move of the first controlled dof (whatever step it belonged to)
     // scales the first extrapolation; then the increments of this step.
     let c0 = ctl[0].c;

@@ -7,7 +7,7 @@ pub use super::driver::{
     Timings,
 };
 use super::failure::{report, FailedAt, NewtonFailure};
-use super::increments::{self, external_forces, Controller, Growth};
+use super::increments::{self, external_forces, Controller, Growth, PairNorm};
 use super::loads::load_vector;
 use super::newton::newton;
 use super::solver::{SolverError, SparseCholesky};
@@ -203,7 +203,12 @@ fn load_step(
     // Error-controlled substeps of a time step (`substep_tolerance`): the controller's size
     // is then the length of a pair of substeps, solved once whole (the probe) and then as
     // its two halves, which are kept if they agree with the probe (docs/theory-time.md §9).
-    let tolerance = step.time.and_then(|t| t.tolerance);
+    // Instantaneous load steps on nonlinear materials: pairs of increments with
+    // `[solver] increment_tolerance`, never longer than the user's increment.
+    let path_tolerance = (step.kind == StepKind::Load && step.time.is_none() && !ctx.sys.linear)
+        .then_some(model.controls.increment_tolerance)
+        .flatten();
+    let tolerance = step.time.and_then(|t| t.tolerance).or(path_tolerance);
     // With the IMPL-EX error control the increments grow back after cuts, as in
     // displacement control (time steps with substep pairs set their own).
     let growth = if model.controls.implex_tolerance.is_some() && tolerance.is_none() {
@@ -212,6 +217,10 @@ fn load_step(
         Growth::Kept
     };
     let mut ctl = Controller::new(step.increments, model.controls.max_cuts, growth, tolerance);
+    if path_tolerance.is_some() {
+        ctl.max_size = ctl.nominal;
+        ctl.norm = PairNorm::Rms;
+    }
     let mut stepper = LoadStepper {
         si,
         step,
