@@ -442,6 +442,12 @@ pub struct SolverControls {
     /// most `max_cuts` times (docs/theory-concrete.md §5.2). None (the default): off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub implex_tolerance: Option<f64>,
+    /// Error-controlled increments of load steps (without `time`) and displacement steps
+    /// on nonlinear materials (`[solver] increment_tolerance`, docs/theory.md): each pair
+    /// of increments is solved whole and as its halves and kept if they agree within this
+    /// fraction of the displacement change over the pair [-]. None (the default): off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub increment_tolerance: Option<f64>,
     /// Print every Newton iteration's residual and energy norms to standard error
     /// (set by `segfem run --verbose`, not by the model file).
     pub verbose: bool,
@@ -456,6 +462,7 @@ impl Default for SolverControls {
             max_cuts: 6,
             predictor: Predictor::LastConverged,
             implex_tolerance: None,
+            increment_tolerance: None,
             verbose: false,
         }
     }

@@ -184,6 +184,15 @@ pub struct Timings {
     /// control is off).
     #[serde(skip_serializing_if = "is_zero_f")]
     pub implex_max_error: f64,
+    /// Error-controlled increments (`[solver] increment_tolerance`, time steps'
+    /// `substep_tolerance`): pairs of increments rejected because the halves missed the
+    /// whole by more than the tolerance.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub increments_rejected: usize,
+    /// The largest estimated path error of a kept pair of increments [-]:
+    /// max|u_whole − u_halves| / max|Δu over the pair| (0 without error control).
+    #[serde(skip_serializing_if = "is_zero_f")]
+    pub increment_max_error: f64,
 }
 
 /// Counts of the displacement driver's line searches ([`Timings::line_searches`]).

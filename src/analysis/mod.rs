@@ -4,6 +4,7 @@ pub mod bonded_time;
 mod driver;
 pub mod failure;
 pub mod families;
+mod increments;
 pub mod loads;
 mod newton;
 pub mod ordering;

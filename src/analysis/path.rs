@@ -3,10 +3,11 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
-use super::driver::{
-    check_stop, implex_retry, note_limit_point, AnalysisError, Observer, Snapshot, Timings,
-};
+use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
 use super::failure::{report, FailedAt, NewtonFailure};
+use super::increments::{
+    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm,
+};
 use super::newton::{cycling, damping, newton, norm, overshot};
 use super::solver::SparseCholesky;
 use super::system::{Assembled, System};
@@ -33,18 +34,6 @@ pub(super) struct PathContext<'a, 's> {
 }
 
 impl PathContext<'_, '_> {
-    /// Σ_c w_c f_c over all dofs [N].
-    fn combine(&self, weights: &[f64]) -> Vec<f64> {
-        let mut f = vec![0.0; self.sys.model.n_dofs()];
-        for (c, w) in self.cases.iter().zip(weights) {
-            if *w != 0.0 {
-                f.iter_mut().zip(c).for_each(|(a, v)| *a += w * v);
-            }
-        }
-        f
-    }
-
-    /// Assemble at `u` with the tangent, factorise it (LDLᵀ fallback).
     /// Throw the trial state of an attempt away: the displacements back to the committed
     /// ones and the iteration's crack holds released.
     pub(super) fn back_to_committed(&mut self) {
@@ -217,6 +206,8 @@ fn row_positions(sys: &System, q: usize) -> Vec<(usize, usize)> {
     v
 }
 
+/// Run one displacement step: the controlled dofs driven to `value` in increments sized by
+/// the increment controller ([`increments::run`]).
 fn displacement_step(
     ctx: &mut PathContext,
     si: usize,
@@ -242,86 +233,127 @@ fn displacement_step(
             row_pos: row_positions(ctx.sys, q),
         });
     }
-    let f_ext = ctx.combine(&ctx.factors.clone());
+    let f_ext = external_forces(ctx.sys.model.n_dofs(), ctx.cases, ctx.factors);
     // The step drives the first controlled dof to `value`; the others follow with the same
     // increment (equal to it when they start equal).
     let v0 = ctl[0].v0;
-    let n_inc = step.increments.max(1);
-    let (mut level, mut d_level) = (0.0, 1.0 / n_inc as f64);
-    let (mut increment, mut cuts) = (0, 0);
+    let controls = &ctx.sys.model.controls;
+    // Nonlinear materials: pairs of increments with `[solver] increment_tolerance`, never
+    // longer than the user's increment (pairs set their own growth).
+    let tolerance = (!ctx.sys.linear)
+        .then_some(controls.increment_tolerance)
+        .flatten();
+    let growth = if tolerance.is_some() {
+        Growth::Kept
+    } else {
+        Growth::WhenEasy
+    };
+    let mut sizing = Controller::new(step.increments, controls.max_cuts, growth, tolerance);
+    sizing.max_size = sizing.nominal;
+    sizing.norm = PairNorm::Rms;
     // The last increment's move of the first controlled dof (whatever step it belonged to)
     // scales the first extrapolation; then the increments of this step.
     let c0 = ctl[0].c;
     let last_move = (ctx.sys.u[c0] - ctx.sys.u_prev[c0]).abs();
     let full = (value - v0).abs();
-    let mut prev_size: Option<f64> = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
-    // Whether the last attempt failed: its retry starts from the last converged state.
-    let mut retry = false;
-    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
-    let mut implex_last = None;
-    while level < 1.0 - 1e-12 {
-        let target = (level + d_level).min(1.0);
-        let shift = (value - v0) * target;
+    sizing.prev_size = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
+    let mut stepper = DisplacementStepper {
+        si,
+        ctl,
+        f_ext,
+        value,
+        v0,
+    };
+    increments::run(&mut sizing, &mut stepper, ctx, obs)
+}
+
+/// What a displacement step supplies to the increment controller.
+struct DisplacementStepper {
+    /// Step index.
+    si: usize,
+    /// The controlled dofs.
+    ctl: Vec<Controlled>,
+    /// External forces held over the step [N].
+    f_ext: Vec<f64>,
+    /// Value the first controlled dof is driven to [m].
+    value: f64,
+    /// Its value at the step's start [m].
+    v0: f64,
+}
+
+impl increments::Stepper for DisplacementStepper {
+    fn attempt(
+        &mut self,
+        ctx: &mut PathContext,
+        _obs: &mut dyn Observer,
+        sizing: &Controller,
+        target: f64,
+    ) -> Result<(Vec<f64>, usize), NewtonFailure> {
+        let shift = (self.value - self.v0) * target;
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
-        ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
+        ctx.sys.time.extrapolation = sizing.extrapolation(target);
         // Path extrapolation from the last increment of this step ([`Predictor`]).
         let extrapolate = (ctx.sys.model.controls.predictor == Predictor::Extrapolated
-            && increment > 0
-            && !retry)
-            .then(|| prev_size.map(|p| (target - level) / p))
+            && sizing.increment > 0
+            && !sizing.retry)
+            .then(|| sizing.prev_size.map(|p| (target - sizing.level) / p))
             .flatten();
-        match newton_controlled(ctx, &f_ext, &ctl, shift, extrapolate) {
-            Ok((_, iterations))
-                if implex_retry(
-                    ctx.sys,
-                    ctx.timings,
-                    (target - level, 1.0 / n_inc as f64),
-                    &mut implex_last,
-                ) =>
-            {
-                // The IMPL-EX error is above the tolerance: retried at half the size, as
-                // after a failed attempt (not counted against the step's cuts).
-                ctx.timings.iterations += iterations;
-                ctx.back_to_committed();
-                retry = true;
-                d_level *= 0.5;
-            }
-            Ok((f_int, iterations)) => {
-                retry = false;
-                let u = ctx.u.clone();
-                ctx.sys.commit(&u);
-                prev_size = Some(target - level);
-                level = target;
-                increment += 1;
-                let force: f64 = ctl.iter().map(|k| f_int[k.c] - f_ext[k.c]).sum();
-                ctx.report(
-                    obs,
-                    si,
-                    increment,
-                    level >= 1.0 - 1e-12,
-                    &f_int,
-                    &f_ext,
-                    iterations,
-                    None,
-                    Some(force),
-                )?;
-                // Grow back after cuts (at most to the nominal size).
-                if iterations <= 4 {
-                    d_level = (2.0 * d_level).min(1.0 / n_inc as f64);
-                }
-            }
-            Err(f) => {
-                ctx.back_to_committed();
-                retry = true;
-                if cuts >= ctx.sys.model.controls.max_cuts {
-                    return Err(not_converged(ctx, si, increment + 1, target, cuts, &f));
-                }
-                cuts += 1;
-                d_level *= 0.5;
-            }
-        }
+        newton_controlled(ctx, &self.f_ext, &self.ctl, shift, extrapolate)
     }
-    Ok(())
+
+    fn discard(&mut self, ctx: &mut PathContext) {
+        ctx.back_to_committed();
+    }
+
+    fn commit_half(&mut self, ctx: &mut PathContext) {
+        let u = ctx.u.clone();
+        ctx.sys.commit(&u);
+    }
+
+    fn accept(
+        &mut self,
+        ctx: &mut PathContext,
+        obs: &mut dyn Observer,
+        sizing: &Controller,
+        f_int: Vec<f64>,
+        iterations: usize,
+    ) -> Result<(), AnalysisError> {
+        let u = ctx.u.clone();
+        ctx.sys.commit(&u);
+        let force: f64 = self.ctl.iter().map(|k| f_int[k.c] - self.f_ext[k.c]).sum();
+        ctx.report(
+            obs,
+            self.si,
+            sizing.increment,
+            sizing.finished(),
+            &f_int,
+            &self.f_ext,
+            iterations,
+            None,
+            Some(force),
+        )
+    }
+
+    fn failed(
+        &mut self,
+        ctx: &mut PathContext,
+        sizing: &Controller,
+        target: f64,
+        failure: NewtonFailure,
+        give_up: bool,
+    ) -> Option<AnalysisError> {
+        ctx.back_to_committed();
+        give_up.then(|| {
+            not_converged(
+                ctx,
+                self.si,
+                sizing.increment + 1,
+                target,
+                sizing.cuts,
+                &failure,
+            )
+        })
+    }
 }
 
 /// A controlled dof: full index, free equation, value at the start of the step [m], and
@@ -629,15 +661,15 @@ fn arc_length_step(
     obs: &mut dyn Observer,
 ) -> Result<(), AnalysisError> {
     let held = ctx.factors.clone();
-    let f_base = ctx.combine(&held);
-    let q_full = ctx.combine(&a.reference);
+    let n_dofs = ctx.sys.model.n_dofs();
+    let f_base = external_forces(n_dofs, ctx.cases, &held);
+    let q_full = external_forces(n_dofs, ctx.cases, &a.reference);
     let q_free = ctx.sys.to_free(&q_full);
     let max_cuts = ctx.sys.model.controls.max_cuts;
     let mut lambda = 0.0;
-    let mut dl: Option<f64> = None;
-    let mut dl0 = 0.0;
+    let mut sizing = ArcSizing::default();
     let mut du_prev: Option<Vec<f64>> = None;
-    let (mut increment, mut cuts) = (0, 0);
+    let mut increment = 0;
     let start_disp = a
         .target_displacement
         .map(|(n, d, _)| ctx.sys.u[2 * n + d.index()]);
@@ -647,44 +679,20 @@ fn arc_length_step(
             .map(|(h, r)| h + lam * r)
             .collect()
     };
-    let mut failed_dl: Option<f64> = None;
-    let mut prev_dl: Option<f64> = None;
-    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
-    let mut implex_last = None;
     while increment < a.max_increments {
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
-        ctx.sys.time.extrapolation = match (prev_dl, dl) {
-            (Some(p), Some(l)) if p > 0.0 => l / p,
-            _ => 0.0,
-        };
-        let dl_try = dl;
-        match arc_increment(ctx, &f_base, &q_full, &q_free, lambda, &mut dl, a, &du_prev) {
-            Ok(inc)
-                if implex_retry(
-                    ctx.sys,
-                    ctx.timings,
-                    (
-                        dl.unwrap_or(0.0),
-                        if dl0 == 0.0 { dl.unwrap_or(0.0) } else { dl0 },
-                    ),
-                    &mut implex_last,
-                ) =>
-            {
+        ctx.sys.time.extrapolation = sizing.extrapolation();
+        let dl_try = sizing.dl;
+        let loads = (f_base.as_slice(), q_full.as_slice(), q_free.as_slice());
+        match arc_increment(ctx, loads, lambda, &mut sizing.dl, a, &du_prev) {
+            Ok(inc) if sizing.implex_retry(ctx.sys, ctx.timings) => {
                 // The IMPL-EX error is above the tolerance: the arc retried at half its
                 // length (not counted against the cuts).
                 ctx.timings.iterations += inc.iterations;
                 ctx.back_to_committed();
-                if dl0 == 0.0 {
-                    dl0 = dl.expect("set by the first increment");
-                }
-                dl = dl.map(|l| 0.5 * l);
             }
             Ok(inc) => {
-                prev_dl = dl_try.or(dl);
-                if dl0 == 0.0 {
-                    dl0 = dl.expect("set by the first increment");
-                }
-                cuts = 0;
+                sizing.accept(dl_try);
                 let mut lam_new = lambda + inc.d_lambda;
                 let mut f_int = inc.f_int;
                 let mut iterations = inc.iterations;
@@ -694,29 +702,10 @@ fn arc_length_step(
                 if let Some(t) = a.target_factor {
                     if lambda < t && lam_new >= t {
                         reached = true;
-                        let mut u_try = ctx.sys.u.clone();
-                        let f_t: Vec<f64> =
-                            f_base.iter().zip(&q_full).map(|(b, q)| b + t * q).collect();
-                        let mut factored = false;
-                        if let Ok((fi, it)) = newton(
-                            ctx.sys,
-                            ctx.solver,
-                            &mut u_try,
-                            &f_t,
-                            ctx.timings,
-                            &mut factored,
-                            StepKind::Load,
-                        ) {
-                            ctx.u.copy_from_slice(&u_try);
+                        if let Some((fi, it)) = land_on_factor(ctx, &f_base, &q_full, t)? {
                             f_int = fi;
                             iterations += it;
                             lam_new = t;
-                        } else {
-                            // Restore the trial states of the arc-length point.
-                            let u = ctx.u.clone();
-                            ctx.sys.assemble(&u, false).map_err(|(e, err)| {
-                                AnalysisError::Mechanism(format!("element {}: {err}", e + 1))
-                            })?;
                         }
                     }
                 }
@@ -732,11 +721,7 @@ fn arc_length_step(
                     }
                 }
                 let end = reached || increment >= a.max_increments;
-                let f_ext: Vec<f64> = f_base
-                    .iter()
-                    .zip(&q_full)
-                    .map(|(b, q)| b + lambda * q)
-                    .collect();
+                let f_ext = external_forces_along(&f_base, &q_full, lambda);
                 ctx.report(
                     obs,
                     si,
@@ -748,12 +733,7 @@ fn arc_length_step(
                     Some(lambda),
                     None,
                 )?;
-                // Step-size adaptation: Δl ← Δl √(N_desired/N), bounded to [½, 2] per
-                // increment and to max_growth × the first arc length.
-                let ratio = (a.desired_iterations as f64 / inc.iterations.max(1) as f64)
-                    .sqrt()
-                    .clamp(0.5, 2.0);
-                dl = dl.map(|l| (l * ratio).min(a.max_growth * dl0));
+                sizing.grow(a.desired_iterations, inc.iterations, a.max_growth);
                 du_prev = Some(inc.du);
                 if end {
                     break;
@@ -761,28 +741,46 @@ fn arc_length_step(
             }
             Err(f) => {
                 ctx.back_to_committed();
-                if cuts >= max_cuts || dl.is_none() {
+                let cuts = sizing.cuts;
+                if !sizing.cut(max_cuts) {
                     return Err(not_converged(ctx, si, increment + 1, lambda, cuts, &f));
                 }
-                if cuts == 0 {
-                    failed_dl = dl;
-                }
-                // Retry with Δl × ½, 2, ¼, 4, … of the failed length: a material jump (a crack
-                // forming, the stress dropping at fixed strain) leaves a gap in the path that
-                // a shorter arc cannot cross when the last point sits just before it; a
-                // longer one steps over it.
-                cuts += 1;
-                let k = cuts.div_ceil(2) as i32;
-                let factor = if cuts % 2 == 1 {
-                    0.5_f64.powi(k)
-                } else {
-                    2.0_f64.powi(k)
-                };
-                dl = failed_dl.map(|l| factor * l);
             }
         }
     }
     Ok(())
+}
+
+/// Load-controlled correction from the arc-length point in `ctx.u` onto the load factor
+/// `t` (forces `f_base + t q_full` [N]): Some((internal forces, iterations)) with `ctx.u`
+/// there, or None with the arc-length point's trial states restored if Newton fails.
+fn land_on_factor(
+    ctx: &mut PathContext,
+    f_base: &[f64],
+    q_full: &[f64],
+    t: f64,
+) -> Result<Option<(Vec<f64>, usize)>, AnalysisError> {
+    let mut u_try = ctx.sys.u.clone();
+    let f_t = external_forces_along(f_base, q_full, t);
+    let mut factored = false;
+    if let Ok((fi, it)) = newton(
+        ctx.sys,
+        ctx.solver,
+        &mut u_try,
+        &f_t,
+        ctx.timings,
+        &mut factored,
+        StepKind::Load,
+    ) {
+        ctx.u.copy_from_slice(&u_try);
+        return Ok(Some((fi, it)));
+    }
+    // Restore the trial states of the arc-length point.
+    let u = ctx.u.clone();
+    ctx.sys
+        .assemble(&u, false)
+        .map_err(|(e, err)| AnalysisError::Mechanism(format!("element {}: {err}", e + 1)))?;
+    Ok(None)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -792,12 +790,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// One arc-length increment from the committed state at load factor `lambda_n`, with
 /// arc length `dl` (set from the initial load-factor increment if None): cylindrical
 /// constraint ‖Δu‖ = Δl over the free equations (Crisfield 1981).
-#[allow(clippy::too_many_arguments)]
 fn arc_increment(
     ctx: &mut PathContext,
-    f_base: &[f64],
-    q_full: &[f64],
-    q_free: &[f64],
+    (f_base, q_full, q_free): (&[f64], &[f64], &[f64]),
     lambda_n: f64,
     dl: &mut Option<f64>,
     a: &ArcLengthControl,
@@ -893,46 +888,7 @@ fn arc_increment(
         ctx.solver.solve_in_place(&mut dur);
         let mut dut = q_free.to_vec();
         ctx.solver.solve_in_place(&mut dut);
-        // ‖Δu + δu_r + δλ δu_t‖² = Δl²  →  a1 δλ² + a2 δλ + a3 = 0.
-        let w: Vec<f64> = du.iter().zip(&dur).map(|(a, b)| a + b).collect();
-        let a1 = dot(&dut, &dut);
-        let a2 = 2.0 * dot(&dut, &w);
-        let a3 = dot(&w, &w) - l * l;
-        let disc = a2 * a2 - 4.0 * a1 * a3;
-        let dlam = if disc < 0.0 {
-            // No intersection with the cylinder: take the closest point (the minimum of the
-            // quadratic); the next iterations pull back onto the constraint.
-            -a2 / (2.0 * a1)
-        } else {
-            // Of the two roots take the one whose new Δu makes the smaller angle with the
-            // current one (no backtracking along the path).
-            let sq = disc.sqrt();
-            let r1 = (-a2 + sq) / (2.0 * a1);
-            let r2 = (-a2 - sq) / (2.0 * a1);
-            let cosang = |r: f64| {
-                w.iter()
-                    .zip(&dut)
-                    .zip(&du)
-                    .map(|((wi, ti), di)| (wi + r * ti) * di)
-                    .sum::<f64>()
-            };
-            let (near, far) = if cosang(r1) >= cosang(r2) {
-                (r1, r2)
-            } else {
-                (r2, r1)
-            };
-            // Stagnation (the residual not falling over two iterations) means Newton cycles
-            // across a kink of the response — typically at a crack that snaps back, where the
-            // root nearest the predictor lies on the wrong side of the peak: take the other
-            // root then.
-            let n = history.len();
-            let stagnating = n >= 3 && history[n - 1] >= 0.9 * history[n - 3];
-            if stagnating {
-                far
-            } else {
-                near
-            }
-        };
+        let dlam = constraint_root(&du, &dur, &dut, l, &history);
         let corr: Vec<f64> = dur.iter().zip(&dut).map(|(r, t)| r + dlam * t).collect();
         let energy = dot(&corr, &rf).abs();
         first_energy.get_or_insert(energy);
@@ -953,6 +909,53 @@ fn arc_increment(
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
+}
+
+/// The load-factor correction δλ of an arc-length iteration: the root of the cylindrical
+/// constraint ‖Δu + δu_r + δλ δu_t‖ = Δl (increment `du`, residual and load corrections
+/// `dur`, `dut` over the free equations [m], arc length `l`), given the relative residuals
+/// of the iterations so far (`history`).
+fn constraint_root(du: &[f64], dur: &[f64], dut: &[f64], l: f64, history: &[f64]) -> f64 {
+    // ‖Δu + δu_r + δλ δu_t‖² = Δl²  →  a1 δλ² + a2 δλ + a3 = 0.
+    let w: Vec<f64> = du.iter().zip(dur).map(|(a, b)| a + b).collect();
+    let a1 = dot(dut, dut);
+    let a2 = 2.0 * dot(dut, &w);
+    let a3 = dot(&w, &w) - l * l;
+    let disc = a2 * a2 - 4.0 * a1 * a3;
+    if disc < 0.0 {
+        // No intersection with the cylinder: take the closest point (the minimum of the
+        // quadratic); the next iterations pull back onto the constraint.
+        -a2 / (2.0 * a1)
+    } else {
+        // Of the two roots take the one whose new Δu makes the smaller angle with the
+        // current one (no backtracking along the path).
+        let sq = disc.sqrt();
+        let r1 = (-a2 + sq) / (2.0 * a1);
+        let r2 = (-a2 - sq) / (2.0 * a1);
+        let cosang = |r: f64| {
+            w.iter()
+                .zip(dut)
+                .zip(du)
+                .map(|((wi, ti), di)| (wi + r * ti) * di)
+                .sum::<f64>()
+        };
+        let (near, far) = if cosang(r1) >= cosang(r2) {
+            (r1, r2)
+        } else {
+            (r2, r1)
+        };
+        // Stagnation (the residual not falling over two iterations) means Newton cycles
+        // across a kink of the response — typically at a crack that snaps back, where the
+        // root nearest the predictor lies on the wrong side of the peak: take the other
+        // root then.
+        let n = history.len();
+        let stagnating = n >= 3 && history[n - 1] >= 0.9 * history[n - 3];
+        if stagnating {
+            far
+        } else {
+            near
+        }
+    }
 }
 
 /// One corrective iteration of the arc-length driver, kept to backtrack along it.
@@ -981,11 +984,7 @@ fn arc_residual(
     q_full: &[f64],
 ) -> Result<Residual, NewtonFailure> {
     let (f_int, k, scale) = ctx.tangent(u)?;
-    let f_ext: Vec<f64> = f_base
-        .iter()
-        .zip(q_full)
-        .map(|(b, q)| b + lam * q)
-        .collect();
+    let f_ext = external_forces_along(f_base, q_full, lam);
     let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
     let rf = ctx.sys.to_free(&r);
     let rel = norm(&rf)

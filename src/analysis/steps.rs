@@ -1,18 +1,18 @@
 //! The step driver: load-controlled increments solved by Newton–Raphson with automatic
 //! step cutting; every converged increment is reported to an observer.
 
-use super::driver::{check_stop, implex_retry, note_limit_point};
+use super::driver::{check_stop, note_limit_point};
 pub use super::driver::{
     AnalysisError, IdleWork, LineSearchStats, Observer, RunOptions, Snapshot, StepEnd, StopReason,
     Timings,
 };
 use super::failure::{report, FailedAt, NewtonFailure};
+use super::increments::{self, external_forces, Controller, Growth, PairNorm};
 use super::loads::load_vector;
 use super::newton::newton;
 use super::solver::{SolverError, SparseCholesky};
 use super::state::DriverState;
 use super::system::System;
-use super::time::{Pair, PairStart};
 use crate::materials::point::TimeContext;
 use crate::model::{Model, Predictor, Step, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
@@ -187,8 +187,8 @@ pub fn run_with(
 }
 
 /// Run one load, linear or time step: increments of the load-case factors (and of the clock
-/// over a time span), each solved by Newton, halved on failure up to `max_cuts` times.
-/// `reached_clock` follows the time of the last converged increment.
+/// over a time span), each solved by Newton, sized by the increment controller
+/// ([`increments::run`]). `reached_clock` follows the time of the last converged increment.
 #[allow(clippy::too_many_arguments)]
 fn load_step(
     ctx: &mut super::path::PathContext,
@@ -200,214 +200,222 @@ fn load_step(
     obs: &mut dyn Observer,
 ) -> Result<(), AnalysisError> {
     let model = ctx.sys.model;
-    let start = ctx.factors.clone();
-    let n_inc = step.increments.max(1);
-    let mut level = 0.0; // fraction of the step reached
-    let mut d_level = 1.0 / n_inc as f64;
-    let mut increment = 0;
-    let mut cuts = 0;
-    let mut prev_size: Option<f64> = None;
-    // Error-controlled substeps of a time step (`substep_tolerance`): `d_level` is then the
-    // length of a pair of substeps, solved once whole (the probe) and then as its two halves,
-    // which are kept if they agree with the probe (docs/theory-time.md §9).
-    let tolerance = step.time.and_then(|t| t.tolerance);
-    let min_pair = d_level / 1024.0;
-    let mut pair = Pair::Probe;
-    // Path extrapolation ([`Predictor`]) in instantaneous load steps only: time steps keep
-    // their error-controlled substeps as they are.
-    let extrapolating = step.kind == StepKind::Load
-        && step.time.is_none()
-        && model.controls.predictor == Predictor::Extrapolated;
-    // Whether the last attempt failed: its retry starts from the last converged state.
-    let mut retry = false;
-    // IMPL-EX error of the last attempt of this increment, if it was cut for it.
-    let mut implex_last = None;
-    while level < 1.0 - 1e-12 {
-        let target = pair.target(level, d_level);
-        let lam: Vec<f64> = start
+    // Error-controlled substeps of a time step (`substep_tolerance`): the controller's size
+    // is then the length of a pair of substeps, solved once whole (the probe) and then as
+    // its two halves, which are kept if they agree with the probe (docs/theory-time.md §9).
+    // Instantaneous load steps on nonlinear materials: pairs of increments with
+    // `[solver] increment_tolerance`, never longer than the user's increment.
+    let path_tolerance = (step.kind == StepKind::Load && step.time.is_none() && !ctx.sys.linear)
+        .then_some(model.controls.increment_tolerance)
+        .flatten();
+    let tolerance = step.time.and_then(|t| t.tolerance).or(path_tolerance);
+    // With the IMPL-EX error control the increments grow back after cuts, as in
+    // displacement control (time steps with substep pairs set their own).
+    let growth = if model.controls.implex_tolerance.is_some() && tolerance.is_none() {
+        Growth::WhenEasy
+    } else {
+        Growth::Kept
+    };
+    let mut ctl = Controller::new(step.increments, model.controls.max_cuts, growth, tolerance);
+    if path_tolerance.is_some() {
+        ctl.max_size = ctl.nominal;
+        ctl.norm = PairNorm::Rms;
+    }
+    let mut stepper = LoadStepper {
+        si,
+        step,
+        start: ctx.factors.clone(),
+        clock,
+        reached_clock: *reached_clock,
+        factored_linear: *factored_linear,
+        // Path extrapolation ([`Predictor`]) in instantaneous load steps only: time steps
+        // keep their error-controlled substeps as they are.
+        extrapolating: step.kind == StepKind::Load
+            && step.time.is_none()
+            && model.controls.predictor == Predictor::Extrapolated,
+        lam: Vec::new(),
+        f_ext: Vec::new(),
+    };
+    let result = increments::run(&mut ctl, &mut stepper, ctx, obs);
+    *reached_clock = stepper.reached_clock;
+    *factored_linear = stepper.factored_linear;
+    result
+}
+
+/// What a load, linear or time step supplies to the increment controller.
+struct LoadStepper<'a> {
+    /// Step index.
+    si: usize,
+    /// The step.
+    step: &'a Step,
+    /// Load-case factors at the step's start.
+    start: Vec<f64>,
+    /// Clock of an instantaneous step [d].
+    clock: f64,
+    /// Time of the last converged increment [d].
+    reached_clock: f64,
+    /// Whether the linear system is factorised (linear steps).
+    factored_linear: bool,
+    /// Whether attempts start from the extrapolated path.
+    extrapolating: bool,
+    /// Factors of the current attempt.
+    lam: Vec<f64>,
+    /// External forces of the current attempt [N].
+    f_ext: Vec<f64>,
+}
+
+impl increments::Stepper for LoadStepper<'_> {
+    fn attempt(
+        &mut self,
+        ctx: &mut super::path::PathContext,
+        obs: &mut dyn Observer,
+        ctl: &Controller,
+        target: f64,
+    ) -> Result<(Vec<f64>, usize), NewtonFailure> {
+        let step = self.step;
+        self.lam = self
+            .start
             .iter()
             .zip(&step.factors)
             .map(|(a, b)| a + (b - a) * target)
             .collect();
-        let mut f_ext = vec![0.0; model.n_dofs()];
-        for (c, l) in ctx.cases.iter().zip(&lam) {
-            if *l != 0.0 {
-                f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
-            }
-        }
-        ctx.sys.set_thermal(&lam);
+        self.f_ext = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.lam);
+        ctx.sys.set_thermal(&self.lam);
         // Reactions of supports removed at the start of the step, released over it.
         if let Some(st) = &ctx.sys.stages {
-            st.add_release(&mut f_ext, target);
+            st.add_release(&mut self.f_ext, target);
         }
         ctx.sys.begin_time_increment(match &step.time {
             Some(span) => TimeContext {
-                t_from: span.time_at(level),
+                t_from: span.time_at(ctl.level),
                 t_to: span.time_at(target),
                 extrapolation: 0.0,
             },
-            None => TimeContext::at(clock),
+            None => TimeContext::at(self.clock),
         });
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
-        ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);
-        if let (true, false, true, Some(p)) = (extrapolating, retry, increment > 0, prev_size) {
-            ctx.sys.extrapolate(ctx.u, (target - level) / p);
+        ctx.sys.time.extrapolation = ctl.extrapolation(target);
+        if let (true, false, true, Some(p)) = (
+            self.extrapolating,
+            ctl.retry,
+            ctl.increment > 0,
+            ctl.prev_size,
+        ) {
+            ctx.sys.extrapolate(ctx.u, (target - ctl.level) / p);
         }
         if let Some(work) = obs.idle_work() {
             ctx.solver.beside_next_factorisation(work);
         }
-        match newton(
+        newton(
             ctx.sys,
             ctx.solver,
             ctx.u,
-            &f_ext,
+            &self.f_ext,
             ctx.timings,
-            factored_linear,
+            &mut self.factored_linear,
             step.kind,
-        ) {
-            Ok((_, iterations)) if tolerance.is_some() && pair.is_probe() => {
-                // The whole pair as one substep: keep its displacements, throw its state
-                // away, and keep the committed state in case the halves are rejected.
-                ctx.timings.iterations += iterations;
-                let probe = ctx.u.clone();
-                discard_trial(ctx);
-                pair = Pair::First(Box::new(PairStart {
-                    level,
-                    end: target,
-                    probe,
-                    saved: ctx.sys.snapshot(),
-                    prev_size,
-                    reached_clock: *reached_clock,
-                }));
-            }
-            Ok((_, iterations)) if matches!(pair, Pair::First(_)) => {
-                // The first half: committed, reported with the second.
-                ctx.sys.commit(ctx.u);
-                ctx.timings.iterations += iterations;
-                prev_size = Some(target - level);
-                level = target;
-                *reached_clock = ctx.sys.time.t_to;
-                pair = pair.second();
-            }
-            Ok((_, iterations)) if pair.rejects(ctx.u, tolerance, d_level > min_pair) => {
-                // The halves disagree with the probe beyond the tolerance: back to the
-                // start of the pair, with a shorter one.
-                ctx.timings.iterations += iterations;
-                let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) else {
-                    unreachable!("rejects() is true only for a second half")
-                };
-                d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);
-                level = start.level;
-                prev_size = start.prev_size;
-                *reached_clock = start.reached_clock;
-                ctx.sys
-                    .restore(start.saved)
-                    .map_err(AnalysisError::Mechanism)?;
-                discard_trial(ctx);
-            }
-            Ok((_, iterations))
-                if step.kind != StepKind::Linear
-                    && implex_retry(
-                        ctx.sys,
-                        ctx.timings,
-                        (target - level, 1.0 / n_inc as f64),
-                        &mut implex_last,
-                    ) =>
-            {
-                // The IMPL-EX error is above the tolerance: retried at half the size, as
-                // after a failed attempt (not counted against the step's cuts).
-                ctx.timings.iterations += iterations;
-                discard_trial(ctx);
-                retry = true;
-                d_level *= 0.5;
-                pair = Pair::Probe;
-            }
-            Ok((f_int, iterations)) => {
-                retry = false;
-                // With the IMPL-EX error control the increments grow back after cuts, as in
-                // displacement control (time steps with substep pairs set their own).
-                if model.controls.implex_tolerance.is_some()
-                    && tolerance.is_none()
-                    && iterations <= 4
-                {
-                    d_level = (2.0 * d_level).min(1.0 / n_inc as f64);
-                }
-                if let Pair::Second(start) = std::mem::replace(&mut pair, Pair::Probe) {
-                    // An accepted pair: the next one as long as the error allows.
-                    d_level = (d_level * start.growth(ctx.u, tolerance)).max(min_pair);
-                }
-                ctx.sys.commit(ctx.u);
-                prev_size = Some(target - level);
-                level = target;
-                increment += 1;
-                *ctx.factors = lam;
-                *reached_clock = ctx.sys.time.t_to;
-                let end_of_step = level >= 1.0 - 1e-12;
-                ctx.timings.increments += 1;
-                ctx.timings.iterations += iterations;
-                note_limit_point(
-                    ctx.timings,
-                    ctx.neg_pivots,
-                    ctx.solver.negative_pivots,
-                    &step.name,
-                    increment,
-                );
-                // The run's last increment: no solve follows, and its output is written
-                // into the factor's pages ([`SparseCholesky::release`]).
-                if end_of_step && si + 1 == model.steps.len() {
-                    ctx.solver.release();
-                }
-                let t = Instant::now();
-                obs.increment(&Snapshot {
-                    system: ctx.sys,
-                    step: si,
-                    increment,
-                    end_of_step,
-                    factors: ctx.factors,
-                    f_int: &f_int,
-                    f_ext: &f_ext,
-                    iterations,
-                    negative_pivots: ctx.solver.negative_pivots,
-                    arc_length_factor: None,
-                    control_force: None,
-                })?;
-                ctx.timings.output_s += t.elapsed().as_secs_f64();
-                check_stop(obs, si, increment, end_of_step)?;
-            }
-            Err(NewtonFailure::Singular(e)) if cuts == 0 && ctx.sys.linear => {
-                return Err(mechanism(ctx.sys, e));
-            }
-            Err(failure) => {
-                let give_up = cuts >= model.controls.max_cuts || step.kind == StepKind::Linear;
-                // The report reads the trial states of the failed attempt: build it first.
-                let rep = give_up.then(|| {
-                    report(
-                        ctx.sys,
-                        FailedAt {
-                            step: si,
-                            increment: increment + 1,
-                            level: target,
-                            cuts,
-                            factors: ctx.factors,
-                            negative_pivots: ctx.solver.negative_pivots,
-                        },
-                        &failure,
-                    )
-                });
-                // Throw the trial state away and retry with half the increment (a failed
-                // half of a substep pair: a new pair from the level reached).
-                discard_trial(ctx);
-                retry = true;
-                if let Some(rep) = rep {
-                    return Err(AnalysisError::NotConverged(Box::new(rep)));
-                }
-                cuts += 1;
-                d_level *= 0.5;
-                pair = Pair::Probe;
+        )
+    }
+
+    fn implex_controlled(&self) -> bool {
+        self.step.kind != StepKind::Linear
+    }
+
+    fn discard(&mut self, ctx: &mut super::path::PathContext) {
+        discard_trial(ctx);
+    }
+
+    fn mark(&self) -> f64 {
+        self.reached_clock
+    }
+
+    fn restore_mark(&mut self, mark: f64) {
+        self.reached_clock = mark;
+    }
+
+    fn commit_half(&mut self, ctx: &mut super::path::PathContext) {
+        ctx.sys.commit(ctx.u);
+        self.reached_clock = ctx.sys.time.t_to;
+    }
+
+    fn accept(
+        &mut self,
+        ctx: &mut super::path::PathContext,
+        obs: &mut dyn Observer,
+        ctl: &Controller,
+        f_int: Vec<f64>,
+        iterations: usize,
+    ) -> Result<(), AnalysisError> {
+        let si = self.si;
+        ctx.sys.commit(ctx.u);
+        *ctx.factors = std::mem::take(&mut self.lam);
+        self.reached_clock = ctx.sys.time.t_to;
+        let end_of_step = ctl.finished();
+        ctx.timings.increments += 1;
+        ctx.timings.iterations += iterations;
+        note_limit_point(
+            ctx.timings,
+            ctx.neg_pivots,
+            ctx.solver.negative_pivots,
+            &self.step.name,
+            ctl.increment,
+        );
+        // The run's last increment: no solve follows, and its output is written
+        // into the factor's pages ([`SparseCholesky::release`]).
+        if end_of_step && si + 1 == ctx.sys.model.steps.len() {
+            ctx.solver.release();
+        }
+        let t = Instant::now();
+        obs.increment(&Snapshot {
+            system: ctx.sys,
+            step: si,
+            increment: ctl.increment,
+            end_of_step,
+            factors: ctx.factors,
+            f_int: &f_int,
+            f_ext: &self.f_ext,
+            iterations,
+            negative_pivots: ctx.solver.negative_pivots,
+            arc_length_factor: None,
+            control_force: None,
+        })?;
+        ctx.timings.output_s += t.elapsed().as_secs_f64();
+        check_stop(obs, si, ctl.increment, end_of_step)
+    }
+
+    fn failed(
+        &mut self,
+        ctx: &mut super::path::PathContext,
+        ctl: &Controller,
+        target: f64,
+        failure: NewtonFailure,
+        give_up: bool,
+    ) -> Option<AnalysisError> {
+        if let NewtonFailure::Singular(e) = &failure {
+            if ctl.cuts == 0 && ctx.sys.linear {
+                return Some(mechanism(ctx.sys, e.clone()));
             }
         }
+        let give_up = give_up || self.step.kind == StepKind::Linear;
+        // The report reads the trial states of the failed attempt: build it first.
+        let rep = give_up.then(|| {
+            report(
+                ctx.sys,
+                FailedAt {
+                    step: self.si,
+                    increment: ctl.increment + 1,
+                    level: target,
+                    cuts: ctl.cuts,
+                    factors: ctx.factors,
+                    negative_pivots: ctx.solver.negative_pivots,
+                },
+                &failure,
+            )
+        });
+        // Throw the trial state away; the controller retries with half the increment.
+        discard_trial(ctx);
+        rep.map(|rep| AnalysisError::NotConverged(Box::new(rep)))
     }
-    Ok(())
 }
 
 /// Throw the trial state of a failed (or probing) increment away: the displacements back to
@@ -430,10 +438,7 @@ fn enter_stage(
     factors: &[f64],
 ) -> Result<(), AnalysisError> {
     let model = sys.model;
-    let mut f_ext = vec![0.0; model.n_dofs()];
-    for (c, l) in cases.iter().zip(factors) {
-        f_ext.iter_mut().zip(c).for_each(|(f, v)| *f += l * v);
-    }
+    let f_ext = external_forces(model.n_dofs(), cases, factors);
     sys.begin_time_increment(TimeContext::at(clock));
     sys.enter_stage(si, &f_ext).map_err(|(e, err)| {
         AnalysisError::Mechanism(format!(

@@ -13,7 +13,6 @@
 //!
 //! Units: days, Pa, strains dimensionless.
 
-use super::state::SystemState;
 use super::system::System;
 use crate::materials::chain::SteelRelaxationChain;
 use crate::materials::point::TimeContext;
@@ -196,101 +195,4 @@ impl System<'_> {
             }
         }
     }
-}
-
-/// Phase of an error-controlled pair of time substeps (`substep_tolerance` of a time step,
-/// docs/theory-time.md §9). The pair over the levels [a, b] of the step is solved once as
-/// one substep (the probe, not kept) and then as its two halves; the halves are kept if
-/// max|u_probe − u| ≤ tol · max|u − u_a| (step doubling: the difference estimates the
-/// probe's error and bounds the halves' own, about 1/(2^p − 1) of it for a method of order
-/// p ≥ 1), else the state goes back to a and a shorter pair is tried.
-#[derive(Debug, Clone)]
-pub enum Pair {
-    /// Next: the whole pair as one substep.
-    Probe,
-    /// Next: the first half.
-    First(Box<PairStart>),
-    /// Next: the second half.
-    Second(Box<PairStart>),
-}
-
-/// What a pair of substeps keeps from its start.
-#[derive(Debug, Clone)]
-pub struct PairStart {
-    /// Level (fraction of the step) at the pair's start.
-    pub level: f64,
-    /// Level at the pair's end.
-    pub end: f64,
-    /// Displacements of the probe [m].
-    pub probe: Vec<f64>,
-    /// Committed state at the pair's start (restored if the halves are rejected).
-    pub saved: SystemState,
-    /// Size of the increment before the pair (IMPL-EX extrapolation).
-    pub prev_size: Option<f64>,
-    /// Clock reached before the pair [d].
-    pub reached_clock: f64,
-}
-
-impl Pair {
-    /// Level the next increment ends at, from the level reached and the pair length.
-    pub fn target(&self, level: f64, pair_length: f64) -> f64 {
-        match self {
-            Pair::Probe => (level + pair_length).min(1.0),
-            Pair::First(s) => 0.5 * (s.level + s.end),
-            Pair::Second(s) => s.end,
-        }
-    }
-
-    /// True before the probe of a pair.
-    pub fn is_probe(&self) -> bool {
-        matches!(self, Pair::Probe)
-    }
-
-    /// The phase after the first half.
-    pub fn second(self) -> Pair {
-        match self {
-            Pair::First(s) => Pair::Second(s),
-            p => p,
-        }
-    }
-
-    /// True when this is a second half whose end displacements `u` [m] miss the probe's by
-    /// more than `tol` times the change over the pair, and the pair may still be shortened.
-    pub fn rejects(&self, u: &[f64], tol: Option<f64>, may_shorten: bool) -> bool {
-        match (self, tol) {
-            (Pair::Second(s), Some(tol)) if may_shorten => {
-                let (err, change) = pair_error(&s.probe, &s.saved.u, u);
-                err > tol * change
-            }
-            _ => false,
-        }
-    }
-}
-
-impl PairStart {
-    /// Factor on the pair length after a pair ending at `u` [m]: the probe's error grows
-    /// as h² for the first-order exponential algorithm, so 0.9 (tol·change/err)^½, between
-    /// ¼ and 2 (2 where nothing moved).
-    pub fn growth(&self, u: &[f64], tol: Option<f64>) -> f64 {
-        let Some(tol) = tol else { return 1.0 };
-        let (err, change) = pair_error(&self.probe, &self.saved.u, u);
-        if err <= 0.0 || !err.is_finite() {
-            return 2.0;
-        }
-        (0.9 * (tol * change / err).sqrt()).clamp(0.25, 2.0)
-    }
-}
-
-/// Step-doubling error of a pair and the displacement change over it: (max|probe − u|,
-/// max|u − start|) [m].
-pub fn pair_error(probe: &[f64], start: &[f64], u: &[f64]) -> (f64, f64) {
-    let err = probe
-        .iter()
-        .zip(u)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    let change = start
-        .iter()
-        .zip(u)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    (err, change)
 }

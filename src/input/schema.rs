@@ -330,6 +330,7 @@ pub struct SolverIn {
     pub max_cuts: Option<usize>,
     pub predictor: Option<String>,
     pub implex_tolerance: Option<f64>,
+    pub increment_tolerance: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

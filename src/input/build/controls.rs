@@ -71,6 +71,13 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
         if let Some(v) = sv.implex_tolerance {
             c.implex_tolerance = Some(positive(ctx, "solver.implex_tolerance", v)?);
         }
+        if let Some(v) = sv.increment_tolerance {
+            c.increment_tolerance = Some(super::time::error_tolerance(
+                ctx,
+                "solver.increment_tolerance",
+                v,
+            )?);
+        }
         if let Some(v) = sv.predictor.as_deref() {
             c.predictor = match v {
                 "extrapolated" => Predictor::Extrapolated,

@@ -24,6 +24,21 @@ const MAX_TOLERANCE: f64 = 0.5;
 /// Latest analysis day accepted [d].
 const MAX_DAY: f64 = 1e6;
 
+/// A step-doubling tolerance (`substep_tolerance`, `[solver] increment_tolerance`) at
+/// `key`, checked to lie between [`MIN_TOLERANCE`] and [`MAX_TOLERANCE`].
+pub(super) fn error_tolerance(ctx: &Ctx, key: &str, v: f64) -> R<f64> {
+    if (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&v) {
+        return Ok(v);
+    }
+    Err(ctx.err(
+        key,
+        format!(
+            "must be a fraction between {MIN_TOLERANCE:e} and {MAX_TOLERANCE} (got {v}): \
+             the error allowed per pair of increments relative to its displacement change"
+        ),
+    ))
+}
+
 /// The interval and substeps of a time step; `clock` = end of the previous time step.
 pub(super) fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) -> R<TimeSpan> {
     if !s.loads.is_empty() {
@@ -102,16 +117,11 @@ pub(super) fn time_span(ctx: &Ctx, key: &str, s: &StepIn, clock: Option<f64>) ->
     };
     let tolerance = match s.substep_tolerance {
         None => None,
-        Some(v) if (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&v) => Some(v),
-        Some(v) => {
-            return Err(ctx.err(
-                format!("{key}.substep_tolerance"),
-                format!(
-                    "must be a fraction between {MIN_TOLERANCE:e} and {MAX_TOLERANCE} (got {v}): \
-                     the error allowed per pair of substeps relative to its displacement change"
-                ),
-            ))
-        }
+        Some(v) => Some(error_tolerance(
+            ctx,
+            &format!("{key}.substep_tolerance"),
+            v,
+        )?),
     };
     Ok(TimeSpan {
         from,
