@@ -122,10 +122,11 @@ duration = 1e4
 fn uncracked_concrete_reproduces_elastic_creep() {
     // Where nothing cracks or yields the series of chain and crack law is the chain alone:
     // the local equation is solved by its first (elastic) evaluation and the stress is
-    // σ_n + E''D1(Δε − Δε'' − Δε_sh) computed in another order. Round-off: 1e-9 of the
-    // largest displacement and stress (the accumulated difference of the two orders over
-    // ~30 increments is ~1e-14; a missing creep or shrinkage term or a wrong age changes
-    // the deflection by tens of per cent).
+    // σ_n + E''D1(Δε − Δε'' − Δε_sh) computed in another order. Round-off: 1e-11 of the
+    // largest displacement and stress (was 1e-9; docs/validation.md, tolerance changes;
+    // measured 1.4e-13 and 5.6e-13: the two orders differ by round-off accumulated over ~30
+    // increments; a missing creep or shrinkage term or a wrong age changes the deflection by
+    // tens of per cent).
     let a = run(&uncracked_beam(ELASTIC_CREEP));
     let b = run(&uncracked_beam(CRACKING_CREEP));
     assert_eq!(a.len(), b.len(), "same increments");
@@ -151,7 +152,7 @@ fn uncracked_concrete_reproduces_elastic_creep() {
         }
     }
     eprintln!("uncracked: worst |Δu|/umax = {worst_u:.2e}, |Δσ|/σmax = {worst_s:.2e}");
-    assert!(worst_u < 1e-9 && worst_s < 1e-9);
+    assert!(worst_u < 1e-11 && worst_s < 1e-11);
     // And the beam really crept: the deflection grows by more than 1 + φ/2.
     let first = a[0].u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let last = a

@@ -379,10 +379,11 @@ loads = {{ T = 1.0 }}
     // The total strain is linear (plane sections), which Q8 elements hold; the imposed
     // strain is exact at the Gauss points. Only the kinks of the profile inside elements
     // (0.39 m below the top is no element edge) disturb the element's equilibrium, locally:
-    // 0.5 % of E α T1.
+    // 0.1 % of E α T1 = 3.9 kPa (was 0.5 %; docs/validation.md, tolerance changes; measured
+    // 1.16 kPa).
     eprintln!("I beam: worst σx error {worst} Pa against E α T1 = {scale} Pa");
     assert!(
-        worst < 0.005 * scale,
+        worst < 0.001 * scale,
         "worst σx error {worst} Pa of {scale}"
     );
     let mid = node_at(&model, [5.0, 0.0]);
