@@ -4,10 +4,12 @@
 //! modulus closed form, and the elastic shortening of pre-tensioned tendons against n·σ_c.
 //! Run with `cargo test --release --test bonded_losses`.
 
+mod common;
+
+// MC90 references from the test's own implementation (tests/common/mc90.rs).
+use common::mc90::{compliance, relaxation_loss};
 use segfem::analysis::steps;
-use segfem::materials::mc90_time::{
-    compliance, relaxation_loss, CementClass, CreepShrinkageParams, RelaxationClass,
-};
+use segfem::materials::mc90_time::{CementClass, CreepShrinkageParams, RelaxationClass};
 use segfem::model::Model;
 use segfem::results::recorder::Recorder;
 

@@ -2,9 +2,7 @@
 //! and of strut crushing with compression softening (docs/validation.md, "Membrane
 //! panels").
 
-use segfem::materials::concrete::compression::hardening_curve;
 use segfem::materials::concrete::panel_bench::{run_panel, Panel};
-use segfem::materials::concrete::{reduction, CompressionReduction, ConcreteParams};
 
 fn panel(rho: [f64; 2], fcm: f64) -> Panel {
     Panel {
@@ -55,14 +53,33 @@ fn unequally_reinforced_panel_reaches_the_rotating_truss_strength() {
 /// fixed point β = β(β σ_c/(ρ E_s) + β x) is found by iteration (a contraction: |dβ/dε1|
 /// (σ_c/(ρE_s) + x) < 0.3 here);
 /// the peak is the largest v over a fine x grid.
-fn crushing_peak(p: &ConcreteParams, rho: f64, es: f64) -> f64 {
+///
+/// Every function here is written out from its source, not taken from the library (the code
+/// under test): σ_c is the MC90 uniaxial curve (CEB-FIP MC90 eq. 2.1-26)
+/// σ_c = f_cm (k η − η²)/(1 + (k − 2) η), η = x/ε_c1, ε_c1 = 0.0022, k = E_ci ε_c1/f_cm,
+/// E_ci = 21 500 MPa (f_cm/10 MPa)^⅓ (eq. 2.1-16); β = 1/(1 + C_d), C_d = 0.27 (ε1/ε_c1 −
+/// 0.37) ≥ 0 (Vecchio & Collins 1993, J. Struct. Eng. 119(12), strength-and-strain form),
+/// floored at β_min = 0.4. The grid stops at 1.5 ε_c1: past ε_c1 both σ_c and β fall, so the
+/// peak lies below ε_c1, well inside the ascending branch where the MC90 formula holds.
+fn crushing_peak(fcm: f64, rho: f64, es: f64) -> f64 {
+    let eps_c1 = 0.0022;
+    let eci = 21_500e6 * (fcm / 10e6).powf(1.0 / 3.0);
+    let k = eci * eps_c1 / fcm;
+    let sigma_c = |x: f64| {
+        let eta = x / eps_c1;
+        fcm * (k * eta - eta * eta) / (1.0 + (k - 2.0) * eta)
+    };
+    let beta = |eps1: f64| {
+        let cd = (0.27 * (eps1 / eps_c1 - 0.37)).max(0.0);
+        (1.0 / (1.0 + cd)).max(0.4)
+    };
     let mut best: f64 = 0.0;
-    for k in 1..=6000 {
-        let x = 6e-3 * k as f64 / 6000.0;
-        let s = hardening_curve(p, x).0;
+    for i in 1..=6000 {
+        let x = 1.5 * eps_c1 * i as f64 / 6000.0;
+        let s = sigma_c(x);
         let mut b = 1.0;
         for _ in 0..200 {
-            b = reduction::factor(p, b * s / (rho * es) + b * x, 1.0).0;
+            b = beta(b * s / (rho * es) + b * x);
         }
         best = best.max(0.5 * b * s);
     }
@@ -71,18 +88,15 @@ fn crushing_peak(p: &ConcreteParams, rho: f64, es: f64) -> f64 {
 
 /// Over-reinforced panel (ρx = ρy = 5 %, ρ f_y = 20 MPa, C30): with compression softening
 /// the strut crushes before the steel yields, at the closed-form peak of
-/// [`crushing_peak`] (tolerance 1 %: the arc length samples the peak, the closed form
-/// neglects the crack-band tension), well below the f_cm/2 = 15 MPa of the unsoftened
+/// [`crushing_peak`] (tolerance 0.3 %, was 1 % (docs/validation.md, tolerance changes): the
+/// arc length samples the peak and the closed form neglects the crack-band tension; measured
+/// 1.1021e7 against 1.1021e7 (< 1e-4), while a 5 % error in the Vecchio–Collins coefficient
+/// 0.27 moves the peak by 1 %), well below the f_cm/2 = 15 MPa of the unsoftened
 /// strut; without compression softening the peak is f_cm/2 (1 %).
 #[test]
 fn over_reinforced_panel_fails_by_strut_crushing_with_compression_softening() {
     let p = panel([0.05, 0.05], 30e6);
-    let mut cp = ConcreteParams::from_mc90(30e6, 0.2);
-    cp.compression_reduction = CompressionReduction::VecchioCollins1993 {
-        beta_min: 0.4,
-        spacing: 0.0,
-    };
-    let want = crushing_peak(&cp, 0.05, 200e9);
+    let want = crushing_peak(30e6, 0.05, 200e9);
     let keys = "crack_model = \"rotating\"\ntension_softening = \"crack_band\"\n";
     let soft = format!("{keys}compression_reduction = \"vecchio_collins_1993\"\n");
     let r = run_panel(&p, &soft, 1).unwrap();
@@ -91,7 +105,7 @@ fn over_reinforced_panel_fails_by_strut_crushing_with_compression_softening() {
         r.v_peak, r.mode
     );
     assert!(
-        (r.v_peak - want).abs() < 0.01 * want,
+        (r.v_peak - want).abs() < 0.003 * want,
         "peak {:.4e} vs closed form {want:.4e}",
         r.v_peak
     );
@@ -173,8 +187,13 @@ fn fixed_crack_on_the_unequal_panel_stalls_below_the_rotating_truss_a_known_devi
 /// more or less increment at a peak, so that a regression and an unexplained improvement
 /// both fail; and the rotating option must scatter less than the seed's model (26.7 %),
 /// whose fixed cracks stall near ρ_weak f_y on the unequally reinforced panels.
+///
+/// **Change detector, not validation** (issue 42; docs/validation.md, "Change detectors"):
+/// the mean and COV bands are this program's own measurement on strengths recalled, not
+/// checked against the paper; every one of the file's 23 panels with a measured strength
+/// must take part (the file, not a run, fixes that count).
 #[test]
-fn panel_series_recommended_option_a_known_deviation() {
+fn panel_series_change_detector() {
     use segfem::materials::concrete::panel_bench::{mean_cov, options, read_panels};
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/panels/panels.csv");
@@ -183,7 +202,11 @@ fn panel_series_recommended_option_a_known_deviation() {
         .into_iter()
         .filter(|p| p.v_test.is_finite())
         .collect();
-    assert!(panels.len() >= 15, "{} panels", panels.len());
+    assert_eq!(
+        panels.len(),
+        23,
+        "panels with a measured strength in panels.csv"
+    );
     // Every row names its laboratory (the `series` column), for the per-lab statistics.
     assert!(
         panels.iter().all(|p| !p.lab.is_empty()),

@@ -5,9 +5,12 @@
 //! continuous in one go shows no redistribution.
 //! Run with `cargo nextest run --release -E 'binary(stages)'`.
 
+mod common;
+
 use segfem::analysis::steps::{self, Observer, Snapshot};
-use segfem::materials::chain::relaxation_function;
-use segfem::materials::mc90_time::{compliance, CementClass, CreepShrinkageParams};
+// φ and χ come from the test's own MC90 (tests/common/mc90.rs), not the library's.
+use common::mc90::{compliance, relaxation_function};
+use segfem::materials::mc90_time::{CementClass, CreepShrinkageParams};
 use segfem::model::{Dir, Model};
 
 /// One record per step end: step, time, displacements, Gauss stresses, vertical reaction of
@@ -613,11 +616,13 @@ loads = { q = 1.0 }
     eprintln!(
         "M(t)/M_cont: FE {ratio:.4}, closed form {closed:.4} (φ = {phi:.3}, χ = {chi:.3}, M_cont = {m_cont:.1} N m)"
     );
-    // 5 % (issue 20): the ageing-coefficient method is exact for a strain imposed at t0 and
-    // held, approximate for the restraint of a creep rotation growing like φ(t, t0); the
-    // chain follows MC90's J within 1 % (docs/validation.md).
+    // 2 % (was 5 %, issue 42; docs/validation.md, tolerance changes): the ageing-coefficient
+    // method is exact for a strain imposed at t0 and held, approximate for the restraint of a
+    // creep rotation growing like φ(t, t0); the chain follows MC90's J within 1 %
+    // (docs/validation.md). Measured 0.69 %. At 5 % a 13 % error in φ0 (β(fcm)'s 5.3 → 6.0)
+    // passed (FE 0.7056); at 2 % it fails.
     assert!(
-        (ratio / closed - 1.0).abs() < 0.05,
+        (ratio / closed - 1.0).abs() < 0.02,
         "M(t)/M_cont: FE {ratio:.4}, closed form {closed:.4} (φ = {phi:.3}, χ = {chi:.3})"
     );
 }

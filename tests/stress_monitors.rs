@@ -82,16 +82,20 @@ point = [{x}, {y_axis}]
         let (a, b) = (sx(y_top) / 2.0, txy(y_top));
         a + a.hypot(b)
     };
-    // 1 %: the Q8 field is exact for the linear σx of pure bending; what differs is the
-    // cubic part of the exact displacement and the fully clamped wall (felt within about h
-    // of x = 0, here 2 m away).
-    for (name, got, want) in [
-        ("sx_top", monitor(&s, "sx_top"), sx(y_top)),
-        ("s1_top", monitor(&s, "s1_top"), s1),
-        ("txy_axis", monitor(&s, "txy_axis"), txy(y_axis)),
+    // σx 1e-7 (was 1 %; docs/validation.md, tolerance changes; measured 1.8e-11): the Q8
+    // field is exact for the linear σx of pure bending at its Gauss points; the fully
+    // clamped wall is felt within about h of x = 0, here 2 m away, where its disturbance has
+    // decayed like e^(−πx/h) (~1e-11). τxy 1 % (measured 0.67 %): the Q8's shear stress at a
+    // Gauss point of a parabolic τ field. σ1 1e-4 (was 1 %; measured 7.3e-6): at the top
+    // fibre τ is small and its 0.7 % error enters σ1 only as τ²/σx.
+    for (name, got, want, tol) in [
+        ("sx_top", monitor(&s, "sx_top"), sx(y_top), 1e-7),
+        ("s1_top", monitor(&s, "s1_top"), s1, 1e-4),
+        ("txy_axis", monitor(&s, "txy_axis"), txy(y_axis), 1e-2),
     ] {
+        eprintln!("{name}: relative error {:.2e}", (got / want - 1.0).abs());
         assert!(
-            (got - want).abs() <= 1e-2 * want.abs(),
+            (got - want).abs() <= tol * want.abs(),
             "{name}: {got:.6e} Pa vs beam theory {want:.6e} Pa"
         );
     }
@@ -220,12 +224,15 @@ joint = "all"
     let s = run("joint", &text);
     let (n, b, h, e) = (600e3, 0.3, 0.5, 0.05);
     let want = n / (b * h) + n * e / (b * h * h / 6.0);
-    // 1 %: the linear stress distribution is exact for the Q8 segments; the end load's
-    // local distribution has decayed 4 depths away (Saint-Venant).
+    // 1e-5 (was 1 %; docs/validation.md, tolerance changes; measured 1.13e-6): the linear
+    // stress distribution is exact for the Q8 segments; the end load's local distribution
+    // has decayed 4 depths away (Saint-Venant, ~e^(−4π)); what remains is of the order of
+    // the Newton force tolerance (1e-6 of the load).
     for name in ["J1_sn", "all_sn"] {
         let got = monitor(&s, name);
+        eprintln!("{name}: relative error {:.2e}", (got / want - 1.0).abs());
         assert!(
-            (got - want).abs() <= 1e-2 * want,
+            (got - want).abs() <= 1e-5 * want,
             "{name}: {got:.6e} Pa vs N/A + Ne/W = {want:.6e} Pa"
         );
     }

@@ -379,10 +379,11 @@ loads = {{ T = 1.0 }}
     // The total strain is linear (plane sections), which Q8 elements hold; the imposed
     // strain is exact at the Gauss points. Only the kinks of the profile inside elements
     // (0.39 m below the top is no element edge) disturb the element's equilibrium, locally:
-    // 0.5 % of E α T1.
+    // 0.1 % of E α T1 = 3.9 kPa (was 0.5 %; docs/validation.md, tolerance changes; measured
+    // 1.16 kPa).
     eprintln!("I beam: worst σx error {worst} Pa against E α T1 = {scale} Pa");
     assert!(
-        worst < 0.005 * scale,
+        worst < 0.001 * scale,
         "worst σx error {worst} Pa of {scale}"
     );
     let mid = node_at(&model, [5.0, 0.0]);
@@ -394,6 +395,128 @@ loads = {{ T = 1.0 }}
         (rise - k * 100.0 / 8.0).abs() < 0.01 * rise.abs(),
         "rise {rise}"
     );
+}
+
+/// The I beam of [`nonlinear_profile_gives_self_equilibrating_eigenstresses`] under the
+/// temperature table `temperature` (one linear step): the model and its last state.
+fn i_beam_under(temperature: &str) -> (Model, Last) {
+    let bands: String = ["bottom", "web", "top"]
+        .iter()
+        .zip(&I_BANDS)
+        .map(|(r, (y0, y1, _))| {
+            format!(
+                "{{ region = \"{r}\", depth = {}, rows = {} }},",
+                y1 - y0,
+                if *r == "web" { 10 } else { 3 }
+            )
+        })
+        .collect();
+    let regions: String = ["bottom", "web", "top"]
+        .iter()
+        .zip(&I_BANDS)
+        .map(|(r, (_, _, b))| {
+            format!("[[regions]]\nname = \"{r}\"\nmaterial = \"c\"\nthickness = {b}\n\n")
+        })
+        .collect();
+    let text = format!(
+        r#"
+[[materials]]
+name = "c"
+kind = "elastic"
+E = {E}
+nu = 0.2
+thermal_expansion = {ALPHA}
+
+{regions}
+[mesh]
+type = "banded"
+length = 10.0
+nx = 40
+element = "Q8"
+bands = [{bands}]
+
+{PIN_ROLLER}
+
+[[load_cases]]
+name = "T"
+temperature = {temperature}
+
+[[steps]]
+name = "heat"
+kind = "linear"
+loads = {{ T = 1.0 }}
+"#
+    )
+    .replace("[4.0, 0.0]", "[10.0, 0.0]");
+    solve(&text)
+}
+
+/// The AASHTO LRFD 3.12.3 vertical gradients (Fig. 3.12.3-2, Table 3.12.3-1) on the same
+/// simply supported I beam (h = 0.8 m ≥ 0.40 m, so A = 0.30 m; T3 = 0), in a mechanical run:
+/// positive gradient of zone 3 (T1 = 23 °C at the top, T2 = 6 °C at 0.10 m, 0 at 0.30 m) and
+/// negative gradient of zone 1 (T1 = 30, T2 = 7.8 °C) times −0.30 (plain concrete deck, the
+/// default `negative_factor`). The profile points are typed here from the code, not read from
+/// the library; the reference is the plane-section eigenstress σ = −E (α T − ε0 − κ (y − y_c))
+/// with ε0, κ from N = M = 0 over the bands, and the midspan rise κ L²/8. Tolerances: σ 1e-6
+/// of E α T1 within 1 m of midspan — the kinks at 0.10 and 0.30 m below the top fall on
+/// element edges, so the Q8 holds the plane-section field exactly and only round-off and the
+/// reference's strip integration (~1e-9) remain (measured 8e-9 and 8e-9); rise 1 % (the ends,
+/// free of the eigenstress pattern over about h; measured −0.29 %).
+#[test]
+fn aashto_gradients_give_self_equilibrating_eigenstresses() {
+    let h = 0.8;
+    for (label, table, t1, t2) in [
+        (
+            "positive, zone 3",
+            "{ code_profile = \"aashto-positive\", zone = 3 }",
+            23.0,
+            6.0,
+        ),
+        (
+            "negative, zone 1",
+            "{ code_profile = \"aashto-negative\", zone = 1 }",
+            -0.30 * 30.0,
+            -0.30 * 7.8,
+        ),
+    ] {
+        let (model, last) = i_beam_under(table);
+        let profile = [[0.0, t1], [0.10, t2], [0.30, 0.0]];
+        let t = |y: f64| by_depth(&profile, h - y);
+        let (_, yc, _, e0, k) = section(&I_BANDS, t);
+        let gps = gauss_points(&model);
+        let scale = E * ALPHA * t1.abs();
+        let mut worst: f64 = 0.0;
+        let mut checked = 0;
+        for (s, x) in last.stress.iter().zip(&gps) {
+            if (x[0] - 5.0).abs() > 1.0 {
+                continue;
+            }
+            let expected = -E * (ALPHA * t(x[1]) - e0 - k * (x[1] - yc));
+            worst = worst.max((s[0] - expected).abs());
+            checked += 1;
+        }
+        assert_eq!(gps.len(), last.stress.len());
+        assert!(checked >= 100, "{label}: {checked} Gauss points checked");
+        // The top fibre's eigenstress is compressive under heating, tensile under cooling,
+        // and a sizeable part of E α T1 (the pattern is really there).
+        let top = -E * (ALPHA * t(h) - e0 - k * (h - yc));
+        assert!(
+            top * t1 < 0.0 && top.abs() > 0.3 * scale,
+            "{label}: top {top}"
+        );
+        let mid = node_at(&model, [5.0, 0.0]);
+        let rise = last.u[2 * mid + 1];
+        eprintln!(
+            "AASHTO {label}: worst σx error {worst:.3e} Pa over {checked} points of E α T1 = {scale:.0} Pa (top eigenstress {top:.0} Pa); rise {rise:.4e} m, κ L²/8 = {:.4e} m",
+            k * 100.0 / 8.0
+        );
+        assert!(worst < 1e-6 * scale, "{label}: worst σx error {worst} Pa");
+        assert!(
+            (rise - k * 100.0 / 8.0).abs() < 0.01 * rise.abs(),
+            "{label}: rise {rise} vs κ L²/8 = {}",
+            k * 100.0 / 8.0
+        );
+    }
 }
 
 /// A free block (4 m × 0.4 m × 0.3 m, ν = 0) with a steel bar (A_s = 2000 mm², E_s = 200 GPa,

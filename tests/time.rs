@@ -2,10 +2,13 @@
 //! ageing Maxwell chain, relaxation of external tendons, prestress losses over time.
 //! Run with `cargo test --release --test time` (the beam tests take a few seconds).
 
+mod common;
+
+// Expected values come from the test's own MC90 (tests/common/mc90.rs), never from the
+// library's `mc90_time`/`chain` functions under test.
+use common::mc90::{self, compliance, shrinkage_strain};
 use segfem::analysis::steps::{self, Observer, Snapshot};
-use segfem::materials::mc90_time::{
-    compliance, shrinkage_strain, CementClass, CreepShrinkageParams,
-};
+use segfem::materials::mc90_time::{CementClass, CreepShrinkageParams};
 use segfem::model::LossPart;
 
 /// One record per converged increment.
@@ -67,6 +70,65 @@ fn run(text: &str) -> Vec<Rec> {
     let mut k = Keep::default();
     steps::run(&model, &mut k).unwrap();
     k.0
+}
+
+/// The test's own MC90 (tests/common/mc90.rs), which builds the expected values of this file
+/// and of tests/stages.rs, bonded_losses.rs and creep_cracking.rs, against the hand table of
+/// docs/theory-time.md §5 (checks 8, 11, 12: the MC90 formulas evaluated by hand for the check
+/// case, 6 significant digits, so 1e-5 relative).
+#[test]
+fn test_reference_mc90_reproduces_the_hand_table() {
+    let p = params(7.0);
+    let rel = |a: f64, b: f64| ((a - b) / b).abs();
+    assert!(rel(mc90::eci(&p), 35495.72e6) < 1e-5);
+    for (t, e) in [
+        (3.0, 27454.5),
+        (7.0, 31324.9),
+        (90.0, 37513.1),
+        (365.0, 38853.2),
+    ] {
+        assert!(rel(mc90::eci_at(&p, t), e * 1e6) < 1e-5, "E_ci({t})");
+    }
+    // (t − t0, φ, J [1e-6/MPa]) for t0 = 28 d; φ printed with 5 decimals.
+    for (d, phi, j) in [
+        (1.0, 0.27687, 35.9724),
+        (10.0, 0.54980, 43.6617),
+        (100.0, 1.05003, 57.7542),
+        (1000.0, 1.61982, 73.8067),
+        (10000.0, 1.82188, 79.4991),
+    ] {
+        assert!((mc90::creep_coefficient(&p, 28.0 + d, 28.0) - phi).abs() <= 5.01e-6);
+        assert!(
+            rel(compliance(&p, 28.0 + d, 28.0), j * 1e-12) < 1e-5,
+            "J({d})"
+        );
+    }
+    assert!(rel(compliance(&p, 1007.0, 7.0), 91.2130e-12) < 1e-5);
+    // ε_cs(7 + d, 7) [1e-6].
+    for (d, eps) in [(7.0, -27.654), (100.0, -101.231), (10000.0, -367.202)] {
+        assert!(
+            rel(shrinkage_strain(&p, 7.0 + d), eps * 1e-6) < 1e-5,
+            "ε_cs({d})"
+        );
+    }
+    // Relaxation, class 2 at 0.7 f_ptk: ρ1000 = 2.5 %; at 1000 h = 41.667 d exactly that,
+    // at 1e4 d × (240)^0.19 (hand: ln 240 = 5.4806, × 0.19 = 1.04132, e^ = 2.8330).
+    use segfem::materials::mc90_time::RelaxationClass::Class2;
+    assert!(rel(mc90::relaxation_loss(Class2, 0.7, 1000.0 / 24.0), 0.025) < 1e-12);
+    assert!(rel(mc90::relaxation_loss(Class2, 0.7, 1e4), 0.025 * 2.8330) < 1e-4);
+    assert_eq!(mc90::relaxation_loss(Class2, 0.5, 1e4), 0.0);
+    // Relaxation function: R(t0, t0) = E_ci(t0); for a non-ageing J = (1 + φ)/E it would be
+    // E/(1 + φ) — the ageing MC90 J gives R(t0 + 1e4, t0) between E_ci(t0)/(1 + φ) and the
+    // AAEM value with χ = 0.8 … 0.9 quoted for MC90 (Bažant 1972; CEB Bulletin 215).
+    let (t0, d) = (28.0, 1e4);
+    let grid: Vec<f64> = (0..=240)
+        .map(|k| 1e-3 * (d / 1e-3_f64).powf(k as f64 / 240.0))
+        .collect();
+    let r = *mc90::relaxation_function(&p, t0, &grid).last().unwrap();
+    let e0 = mc90::eci_at(&p, t0);
+    let phi = mc90::creep_coefficient(&p, t0 + d, t0) * mc90::eci(&p) / e0;
+    let chi = e0 / (e0 - r) - 1.0 / phi;
+    assert!((0.7..0.95).contains(&chi), "χ = {chi}");
 }
 
 /// The MC90 data of the check case (docs/theory-time.md §2): fcm 45 MPa, RH 70 %, h = 200 mm,
@@ -410,7 +472,8 @@ fn results_do_not_depend_on_the_substeps() {
 /// (nearly) constant, so the stress must follow the MC90 relaxation ρ(t).
 #[test]
 fn tendon_relaxation_at_constant_strain_follows_mc90() {
-    use segfem::materials::mc90_time::{relaxation_loss, RelaxationClass};
+    use common::mc90::relaxation_loss;
+    use segfem::materials::mc90_time::RelaxationClass;
     // Rigid block: E = 1e16 Pa makes the concrete shortening under 1.3 MN ~1e-8 of the
     // tendon strain, so the strain is constant to that order.
     let text = prestressed_beam("relaxation_class = 2", "")
@@ -474,7 +537,7 @@ duration = 1e4
 
 #[test]
 fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
-    use segfem::materials::mc90_time::creep_coefficient;
+    use common::mc90::creep_coefficient;
     let text = seed_beam_creep("");
     let rec = run(&text);
     let p0 = rec[0].forces[0]; // after the instantaneous step [N]
@@ -488,7 +551,7 @@ fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
     let phi = creep_coefficient(&p, t, t0);
     let eps_cs = -(shrinkage_strain(&p, t) - shrinkage_strain(&p, t0));
     let (ep, ap) = (195e9, 560e-6);
-    let alpha = ep / p.eci();
+    let alpha = ep / mc90::eci(&p);
     // Box section of the seed beam: bands (width, depth) bottom to top.
     let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
     let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
@@ -524,7 +587,7 @@ fn seed_beam_long_term_loss_matches_the_ec2_estimate() {
         sc += w * (p0 / ac + p0 * z * z / ic - m * z / ic); // compression positive
         z2 += w * z * z;
     }
-    let rho = segfem::materials::mc90_time::relaxation_loss(
+    let rho = mc90::relaxation_loss(
         segfem::materials::mc90_time::RelaxationClass::Class2,
         p0 / ap / 1900e6,
         t - t0,
@@ -655,7 +718,8 @@ fn viscoplastic_overstress_relaxes_exponentially() {
     // substeps, 3.8 % with the 400 used here (last substeps ≈ 0.08 t_r). The curvature of
     // the MC90 peak changes σ_c by < 1e-4 f_cm.
     let fcm = 45e6;
-    let e = segfem::materials::mc90::eci(fcm);
+    // E_ci of fcm = 45 MPa from the test's MC90 (params() has the same fcm).
+    let e = mc90::eci(&params(7.0));
     let gamma = 1e-3;
     let t_r = fcm / (gamma * e);
     let x0 = 0.02;
@@ -1000,7 +1064,7 @@ fn decompression(rows: &[LifeRow]) -> (f64, f64, f64) {
 /// and a little stiffer, which moves deflections but none of the statics checked here).
 #[test]
 fn seed_beam_fails_from_its_long_term_state_as_statics_says() {
-    use segfem::materials::mc90_time::creep_coefficient;
+    use common::mc90::creep_coefficient;
     let run_life = |long_term: bool| {
         let model = segfem::input::parse(&seed_beam_life(long_term), "seed-beam-life.toml")
             .unwrap_or_else(|e| panic!("{e}"))
@@ -1022,7 +1086,7 @@ fn seed_beam_fails_from_its_long_term_state_as_statics_says() {
     let [fe_cs, fe_rel] = long[end].losses;
     let p = CreepShrinkageParams::new(45e6, 0.70, 0.15, CementClass::N, 7.0);
     let (ep, ap, l) = (195e9, 560e-6, 7.2);
-    let alpha = ep / p.eci();
+    let alpha = ep / mc90::eci(&p);
     let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
     let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
     for (b, h) in bands {
@@ -1068,7 +1132,7 @@ fn seed_beam_fails_from_its_long_term_state_as_statics_says() {
     }
     // At σp0 = 0.46 f_ptk MC90 class 2 gives no relaxation (none below 0.5 f_ptk).
     let s0 = spans[1] / ap;
-    let rho = segfem::materials::mc90_time::relaxation_loss(
+    let rho = mc90::relaxation_loss(
         segfem::materials::mc90_time::RelaxationClass::Class2,
         s0 / 1900e6,
         1e4,
@@ -1213,7 +1277,7 @@ fn seed_beam_life_concrete(
 /// the same beam pushed to failure at once. Release test (four runs, ≈ 10 s).
 #[test]
 fn seed_beam_with_cracking_concrete_over_its_life() {
-    use segfem::materials::mc90_time::creep_coefficient;
+    use common::mc90::creep_coefficient;
     const Q_SUS: f64 = 30.0; // kN at each load point
     let run_life = |text: String| {
         let model = segfem::input::parse(&text, "seed-beam-life.toml")
@@ -1290,7 +1354,7 @@ fn seed_beam_with_cracking_concrete_over_its_life() {
     let [fe_cs, fe_rel] = long[end].losses;
     let p = CreepShrinkageParams::new(45e6, 0.70, 0.15, CementClass::N, 7.0);
     let (ep, ap, l) = (195e9, 560e-6, 7.2);
-    let alpha = ep / p.eci();
+    let alpha = ep / mc90::eci(&p);
     let bands: [(f64, f64); 3] = [(0.70, 0.10), (0.20, 0.40), (1.20, 0.10)];
     let (mut y0, mut ac, mut sy) = (0.0f64, 0.0f64, 0.0f64);
     for (b, h) in bands {

@@ -504,6 +504,49 @@ impl StressProfile {
 mod tests {
     use super::*;
 
+    /// Mutants missed by the friction tests (docs/validation.md, "Mutation testing"): a path
+    /// that does not start at s = 0, or whose arc lengths do not increase, is refused each
+    /// on its own (not only when both are wrong).
+    #[test]
+    fn arc_path_needs_a_start_at_zero_and_increasing_lengths() {
+        let turns = vec![0.0, 0.1];
+        assert!(TendonPath::from_arc_and_turns(vec![1.0, 2.0], turns.clone()).is_err());
+        assert!(TendonPath::from_arc_and_turns(vec![0.0, 0.0], turns.clone()).is_err());
+        assert!(TendonPath::from_arc_and_turns(vec![0.0, 2.0], turns).is_ok());
+    }
+
+    /// A piece's integral and its excess over a level, against closed forms: σ = e^s on
+    /// [0, 1] above 2 from s = ln 2: ∫ (e^s − 2) = e − 4 + 2 ln 2; σ = e^(−s) above 0.5 up to
+    /// s = ln 2: ∫ (e^(−s) − 0.5) = 0.5 − 0.5 ln 2; a nearly flat exponential (r = 1e-9, the
+    /// series branch): ∫_0^1 e^(r s) ds = expm1(r)/r. Tolerances 1e-12 and 1e-15 (round-off;
+    /// the series' truncation is r³/24 ≈ 4e-29).
+    #[test]
+    fn piece_integral_and_excess_follow_closed_forms() {
+        let rising = Piece {
+            s0: 0.0,
+            s1: 1.0,
+            c: 0.0,
+            a: 1.0,
+            r: 1.0,
+        };
+        let want = std::f64::consts::E - 4.0 + 2.0 * 2f64.ln();
+        assert!(
+            (rising.excess(2.0) - want).abs() < 1e-12,
+            "{}",
+            rising.excess(2.0)
+        );
+        let falling = Piece { r: -1.0, ..rising };
+        let want = 0.5 - 0.5 * 2f64.ln();
+        assert!((falling.excess(0.5) - want).abs() < 1e-12);
+        let flat = Piece { r: 1e-9, ..rising };
+        let want = 1e-9f64.exp_m1() / 1e-9;
+        assert!(
+            (flat.integral(0.0, 1.0) - want).abs() < 1e-15,
+            "{}",
+            flat.integral(0.0, 1.0)
+        );
+    }
+
     /// Check 19 (docs/theory-joints-tendons.md §4): μ = 0.2, Δα = 0.1 rad, s = 1000 cm → 0.960789;
     /// μ = 0.05, Δα = 0.2 rad, s = 2500 cm → 0.977751. The table gives 6 digits, so the
     /// tolerance is 1e-6 rel (§9 #19).
