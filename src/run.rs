@@ -497,6 +497,11 @@ pub fn run_file_opts(
         (Err(e), Ok(_)) => Err(AnalysisError::Output(e)),
         (_, r) => r,
     };
+    // A refused restart (the saved state does not fit the model) leaves the directory as it
+    // was: nothing was computed, and the checkpoint still continues the stopped run.
+    if let Err(AnalysisError::Restore(m)) = &result {
+        return Err(RunError::Restart(format!("{}: {m}", path.display())));
+    }
     let mut rec = obs.rec;
     let watch = obs.watch;
     let plausibility = obs.plausible.findings();

@@ -57,11 +57,6 @@ pub fn run_with(
         limit_points: Vec::new(),
     };
     match options.resume {
-        Some(_) if sys.stages.is_some() => {
-            return Err(AnalysisError::Restore(
-                "resuming a model with construction stages from a checkpoint is not supported yet: run it from the start".into(),
-            ));
-        }
         Some((d, s)) => {
             if d.factors.len() != driver.factors.len() || d.next_step > model.steps.len() {
                 return Err(AnalysisError::Restore(format!(
