@@ -9,6 +9,7 @@ use crate::input::{self, InputError};
 use crate::model::Model;
 use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
+use crate::results::lock;
 use crate::results::plausibility::Plausibility;
 use crate::results::recorder::Recorder;
 use crate::results::stages::{self as stage_results, StageResult};
@@ -60,13 +61,19 @@ pub enum RunError {
     /// Files could not be written (exit 1).
     #[error("{0}")]
     Io(String),
+    /// Another run is writing into the output directory (exit 2): `results::lock`.
+    #[error("{0}")]
+    Busy(String),
 }
 
 impl RunError {
     /// Process exit status for this error.
     pub fn exit_code(&self) -> i32 {
         match self {
-            RunError::Input(_) | RunError::Mechanism { .. } | RunError::Restart(_) => 2,
+            RunError::Input(_)
+            | RunError::Mechanism { .. }
+            | RunError::Restart(_)
+            | RunError::Busy(_) => 2,
             RunError::NotConverged(_) => 3,
             RunError::Stopped(_) => 4,
             RunError::Implausible(_) => 5,
@@ -387,6 +394,12 @@ pub fn run_file_opts(
     opts: &RunOptions,
 ) -> Result<Summary, RunError> {
     let t0 = Instant::now();
+    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
+    // is locked once its input is valid (bad input writes nothing, not even a directory).
+    let mut lock = None;
+    if opts.restart && out.is_dir() {
+        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
+    }
     let saved = if opts.restart {
         Some(checkpoint::read(out).map_err(RunError::Restart)?)
     } else {
@@ -416,6 +429,17 @@ pub fn run_file_opts(
         }
     }
     let input_s = t0.elapsed().as_secs_f64();
+    if lock.is_none() {
+        std::fs::create_dir_all(out).map_err(|e| {
+            RunError::Io(format!(
+                "{}: cannot create the output directory: {e}",
+                out.display()
+            ))
+        })?;
+        lock = Some(lock::acquire(out, path).map_err(RunError::Busy)?);
+    }
+    // Held until the run returns (dropped with this binding).
+    let _lock = lock;
     if saved.is_none() {
         let n = clear_stale(out)?;
         if n > 0 {

@@ -670,3 +670,83 @@ fn extrapolated_predictor_converges_to_the_same_path_in_fewer_iterations() {
         iterations(&s_last)
     );
 }
+
+/// One run per output directory: while a run writes into `out` (held stopped by SIGSTOP once
+/// its lock is in place), a second run into `out` is refused (status 2) with a message
+/// naming the directory and the first run's process, and touches none of its files; the
+/// first then completes. A lock left by a process that no longer runs (killed) is stale and
+/// taken over.
+#[test]
+fn a_second_run_into_a_busy_directory_is_refused() {
+    let tmp = TempDir::new("busy");
+    std::fs::write(tmp.join("v.toml"), example("viaduct")).unwrap();
+    let mut first = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+        .args(["run", "v.toml", "-o", "out", "-q"])
+        .current_dir(tmp.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let lock = tmp.join("out/.segfem-lock");
+    // Wait for the lock (its content written), then hold the first run where it is.
+    let mut held = String::new();
+    for _ in 0..200_000 {
+        held = std::fs::read_to_string(&lock).unwrap_or_default();
+        if held.contains("model=") || first.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(100));
+    }
+    let pid = first.id().to_string();
+    let kill = |sig: &str| {
+        std::process::Command::new("kill")
+            .args([sig, &pid])
+            .status()
+            .unwrap()
+    };
+    assert!(kill("-STOP").success());
+    assert!(
+        held.contains(&format!("pid={pid}")),
+        "the first run's lock: {held:?}"
+    );
+    let o = segfem(tmp.path(), &["run", "v.toml", "-o", "out", "-q"]);
+    let err = stderr(&o);
+    assert!(kill("-CONT").success());
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "error: out: another segfem run (process {pid}, model "
+        )),
+        "{err}"
+    );
+    assert!(err.contains("is writing into this directory"), "{err}");
+    let status = first.wait().unwrap();
+    assert!(status.success(), "the first run failed");
+    assert!(!lock.exists(), "the lock outlived its run");
+    let s = summary(&tmp.join("out"));
+    assert_eq!(s["status"], "completed");
+    // The first run's files only: every .vtu results.pvd lists is there, and no other.
+    let pvd = read(&tmp.join("out/results.pvd"));
+    let listed: std::collections::BTreeSet<String> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|r| r.split('"').next().unwrap().to_string())
+        .collect();
+    let on_disk: std::collections::BTreeSet<String> = std::fs::read_dir(tmp.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".vtu"))
+        .collect();
+    assert_eq!(listed, on_disk);
+
+    // A stale lock: the process that wrote it has ended (a finished child's id).
+    let mut dead = std::process::Command::new("true").spawn().unwrap();
+    dead.wait().unwrap();
+    std::fs::write(
+        &lock,
+        format!("pid={}\nstart=1\nmodel=gone.toml\n", dead.id()),
+    )
+    .unwrap();
+    let o = segfem(tmp.path(), &["run", "v.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!lock.exists());
+}

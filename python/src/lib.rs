@@ -19,7 +19,8 @@ const SIGINT: usize = 2;
 
 /// What a run ended with: (exit status as the command line's, kind, message, summary.json
 /// text of a successful run). Kinds: "ok", "input", "mechanism", "restart",
-/// "not_converged", "interrupted", "stopped", "implausible", "io".
+/// "not_converged", "interrupted", "stopped", "implausible", "io", "busy" (another run
+/// writes into the output directory).
 type Outcome = (i32, &'static str, Option<String>, Option<String>);
 
 fn outcome(res: Result<segfem::run::Summary, RunError>) -> Outcome {
@@ -40,6 +41,7 @@ fn outcome(res: Result<segfem::run::Summary, RunError>) -> Outcome {
                 RunError::Stopped(_) => "stopped",
                 RunError::Implausible(_) => "implausible",
                 RunError::Io(_) => "io",
+                RunError::Busy(_) => "busy",
             };
             (e.exit_code(), kind, Some(e.to_string()), None)
         }
