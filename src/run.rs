@@ -267,6 +267,33 @@ fn clear_stale(out: &Path) -> Result<usize, RunError> {
     Ok(n)
 }
 
+/// Remove the field files (.vtu names of [`is_run_file`]) in `out` that results.pvd of
+/// `rec` does not list. Returns how many were removed.
+fn remove_unlisted_fields(out: &Path, rec: &Recorder) -> Result<usize, RunError> {
+    let listed: std::collections::HashSet<&str> = rec.field_files().collect();
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(0);
+    };
+    let mut n = 0;
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.ends_with(".vtu")
+            && is_run_file(&name)
+            && !listed.contains(name.as_str())
+            && e.file_type().is_ok_and(|t| t.is_file())
+        {
+            std::fs::remove_file(e.path()).map_err(|err| {
+                RunError::Io(format!(
+                    "{}: cannot remove a field file of the stopped run: {err}",
+                    e.path().display()
+                ))
+            })?;
+            n += 1;
+        }
+    }
+    Ok(n)
+}
+
 /// Peak resident set size of this process [bytes] (Linux: VmHWM), if known.
 pub fn peak_memory() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -527,6 +554,18 @@ pub fn run_file_opts(
         return Err(RunError::Restart(format!("{}: {m}", path.display())));
     }
     let mut rec = obs.rec;
+    let mut warnings = built.warnings;
+    if restarted_from_step.is_some() {
+        // Field files of the increments the stopped run did after its checkpoint and this
+        // run did not write again: results.pvd no longer lists them.
+        let n = remove_unlisted_fields(out, &rec)?;
+        if n > 0 {
+            warnings.push(format!(
+                "{}: removed {n} field files (.vtu) of the increments the stopped run did after its last checkpoint, which results.pvd no longer lists",
+                out.display()
+            ));
+        }
+    }
     let watch = obs.watch;
     let plausibility = obs.plausible.findings();
     let sustained = obs.sustained.warning(&model);
@@ -610,7 +649,6 @@ pub fn run_file_opts(
         &model,
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
-    let mut warnings = built.warnings;
     warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
     warnings.extend(sustained);
     if error.is_some() || !failures.is_empty() {

@@ -897,10 +897,22 @@ loads = { P = 1.0 }
 "#;
     std::fs::write(tmp.join("m.toml"), model).unwrap();
     assert_eq!(code(&segfem(tmp.path(), &["check", "m.toml"])), 0);
+    // Files of an earlier run in the directory: removed, and the terminal says so even
+    // though the run fails.
+    std::fs::create_dir_all(tmp.join("out")).unwrap();
+    std::fs::write(tmp.join("out/history.csv"), "old").unwrap();
+    std::fs::write(tmp.join("out/step001_inc0001.vtu"), "old").unwrap();
     let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let err = stderr(&o);
-    assert_eq!(err.lines().count(), 1, "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(
+        lines[0].starts_with("warning: out: removed 2 files of an earlier run"),
+        "{err}"
+    );
+    assert!(!tmp.join("out/step001_inc0001.vtu").exists());
+    let err = lines[1];
     assert!(err.starts_with("error: m.toml: "), "{err}");
     assert!(err.contains("mechanism"), "{err}");
     let s: serde_json::Value = serde_json::from_str(&read(&tmp.join("out/summary.json"))).unwrap();

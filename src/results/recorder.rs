@@ -189,6 +189,11 @@ impl<'m> Recorder<'m> {
         }
     }
 
+    /// Names of the field files results.pvd lists (in the output directory).
+    pub fn field_files(&self) -> impl Iterator<Item = &str> {
+        self.pvd.iter().map(|(_, _, name)| name.as_str())
+    }
+
     /// Continue from a saved state (rows and field files recorded before a restart).
     pub fn restore(&mut self, s: RecorderState) {
         self.rows = s.rows;
