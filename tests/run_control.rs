@@ -772,3 +772,50 @@ fn a_second_run_into_a_busy_directory_is_refused() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(!lock.exists());
 }
+
+/// A load step of ten increments to Q = 100 ends at Q = 100 exactly: 10 × 0.1 sums to
+/// 0.9999999999999999, and the last increment used to end there (Q = 99.999999999999986
+/// in history.csv and in a sweep's table). The same for a time step's clock.
+#[test]
+fn the_last_increment_lands_on_the_step_factors_exactly() {
+    let tmp = TempDir::new("exact-end");
+    let text = with_steps(
+        &example("cantilever"),
+        "[[monitors]]\nname = \"Q\"\nkind = \"load_factor\"\ncase = \"tip\"\n\n\
+         [[steps]]\nname = \"a\"\nkind = \"load\"\nloads = { tip = 0.3 }\nincrements = 10\n\n\
+         [[steps]]\nname = \"b\"\nkind = \"load\"\nloads = { tip = 100.0 }\nincrements = 10\n",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let s = run(
+        tmp.path(),
+        Some(&tmp.join("m.toml")),
+        "out",
+        &RunOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let h = read(&tmp.join("out/history.csv"));
+    let head: Vec<&str> = h.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|c| c.starts_with(name)).unwrap();
+    let (f, q) = (col("factor:tip"), col("Q ["));
+    // The rows that end steps a (10) and b (20).
+    for (row, want) in [(10, 0.3), (20, 100.0)] {
+        let cells: Vec<&str> = h.lines().nth(row).unwrap().split(',').collect();
+        assert_eq!(
+            cells[f].parse::<f64>().unwrap(),
+            want,
+            "row {row}: {}",
+            cells[f]
+        );
+        assert_eq!(
+            cells[q].parse::<f64>().unwrap(),
+            want,
+            "row {row}: {}",
+            cells[q]
+        );
+    }
+    assert_eq!(
+        s.final_monitors.iter().find(|(n, _)| n == "Q").unwrap().1,
+        100.0
+    );
+}

@@ -260,7 +260,7 @@ fn displacement_step(
     // IMPL-EX error of the last attempt of this increment, if it was cut for it.
     let mut implex_last = None;
     while level < 1.0 - 1e-12 {
-        let target = (level + d_level).min(1.0);
+        let target = super::time::end_level(level + d_level);
         let shift = (value - v0) * target;
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
         ctx.sys.time.extrapolation = prev_size.map_or(0.0, |p| (target - level) / p);

@@ -222,7 +222,15 @@ fn load_step(
         let lam: Vec<f64> = start
             .iter()
             .zip(&step.factors)
-            .map(|(a, b)| a + (b - a) * target)
+            // At the step's end its factors exactly (a + (b − a) · 1 can differ from b in
+            // the last bit).
+            .map(|(a, b)| {
+                if target == 1.0 {
+                    *b
+                } else {
+                    a + (b - a) * target
+                }
+            })
             .collect();
         let mut f_ext = vec![0.0; model.n_dofs()];
         for (c, l) in ctx.cases.iter().zip(&lam) {
