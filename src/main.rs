@@ -335,6 +335,7 @@ fn main() -> ExitCode {
                 stop_after_step,
                 signal: Some(stop_on_signals()),
                 restart: restart.is_some(),
+                caller_stop: None,
             };
             let out = match (&restart, &output, &model) {
                 (Some(d), _, _) => d.clone(),
@@ -696,8 +697,10 @@ fn check(model: PathBuf) -> ExitCode {
 
 fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
     let Some(name) = name else {
+        // Descriptions in one column, after the longest name.
+        let w = EXAMPLES.iter().map(|e| e.0.len()).max().unwrap_or(0);
         for (n, d, _) in EXAMPLES {
-            outln!("{n:12} {d}");
+            outln!("{n:w$}  {d}");
         }
         return ExitCode::SUCCESS;
     };

@@ -96,6 +96,16 @@ pub struct RunOptions {
     pub signal: Option<Arc<AtomicUsize>>,
     /// Continue the run whose output directory is `out` from its checkpoint.
     pub restart: bool,
+    /// Set to why (e.g. "the progress callback raised ValueError: ...") to stop after the
+    /// current increment at the request of the program running the analysis: status
+    /// "stopped", exit 4, that reason in the message.
+    pub caller_stop: Option<Arc<std::sync::Mutex<Option<String>>>>,
+}
+
+/// The reason a caller asked to stop with, if it did ([`RunOptions::caller_stop`]).
+fn caller_reason(stop: &Option<Arc<std::sync::Mutex<Option<String>>>>) -> Option<String> {
+    stop.as_ref()
+        .and_then(|m| m.lock().unwrap_or_else(|p| p.into_inner()).clone())
 }
 
 /// Model size figures.
@@ -324,6 +334,7 @@ struct Progress<'a, 'm> {
     stop_after_step: Option<usize>,
     stop_now: bool,
     signal: Option<Arc<AtomicUsize>>,
+    caller_stop: Option<Arc<std::sync::Mutex<Option<String>>>>,
     /// Timings when a step stopped early (the analysis returns none with its error).
     timings: Option<Timings>,
     /// The last checkpoint, still being written (waited for before the next and at the end).
@@ -380,6 +391,8 @@ impl Observer for Progress<'_, '_> {
         let sig = self.signal.as_ref().map_or(0, |s| s.load(Ordering::SeqCst));
         if sig != 0 {
             Some(StopReason::Signal(sig as i32))
+        } else if caller_reason(&self.caller_stop).is_some() {
+            Some(StopReason::Caller)
         } else if self.stop_now {
             self.stop_after_step.map(StopReason::AfterStep)
         } else {
@@ -527,6 +540,7 @@ pub fn run_file_opts(
         stop_after_step: opts.stop_after_step,
         stop_now: false,
         signal: opts.signal.clone(),
+        caller_stop: opts.caller_stop.clone(),
         timings: None,
         checkpoint: None,
     };
@@ -618,13 +632,25 @@ pub fn run_file_opts(
         }) => (
             match reason {
                 StopReason::Signal(_) => "interrupted",
-                StopReason::AfterStep(_) => "stopped",
+                StopReason::AfterStep(_) | StopReason::Caller => "stopped",
             },
             Some(resume_step + 1),
         ),
         Some(_) => ("failed", None),
     };
     let error_text = match (&error, failures.len()) {
+        (
+            Some(
+                e @ AnalysisError::Stopped {
+                    reason: StopReason::Caller,
+                    ..
+                },
+            ),
+            _,
+        ) => Some(format!(
+            "{e}: {}",
+            caller_reason(&opts.caller_stop).unwrap_or_default()
+        )),
         (Some(e), _) => Some(e.to_string()),
         (None, 0) if !plausibility.is_empty() => Some(format!(
             "every step converged but the result is not physically meaningful:\n{}",
@@ -728,6 +754,10 @@ pub fn run_file_opts(
                 }),
                 StopReason::AfterStep(_) => Err(RunError::Stopped(format!(
                     "{file}: stopped {done} as asked; {how}"
+                ))),
+                StopReason::Caller => Err(RunError::Stopped(format!(
+                    "{file}: stopped {done}: {}; {how}",
+                    caller_reason(&opts.caller_stop).unwrap_or_default()
                 ))),
             }
         }

@@ -4,7 +4,7 @@
 //! hands back plain values (JSON text, bytes of little-endian f64) that the Python side turns
 //! into dicts, pandas and numpy objects. docs/python.md describes the package.
 
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use segfem::analysis::steps::Snapshot;
@@ -91,12 +91,14 @@ fn run(
     restart: bool,
 ) -> (Outcome, Option<PyErr>) {
     let flag = Arc::new(AtomicUsize::new(0));
+    let stop = Arc::new(std::sync::Mutex::new(None));
     let opts = RunOptions {
         verbose,
         continue_on_failure,
         stop_after_step,
         signal: Some(flag.clone()),
         restart,
+        caller_stop: Some(stop.clone()),
     };
     let mut raised: Option<PyErr> = None;
     let res = {
@@ -115,8 +117,23 @@ fn run(
             })
             .err();
             if let Some(e) = err {
+                // Ctrl-C is the signal it is; any other exception stops the run as the
+                // caller's request, recorded as that exception (not as SIGINT).
+                let ctrl_c = Python::attach(|py| e.is_instance_of::<PyKeyboardInterrupt>(py));
+                if ctrl_c {
+                    flag.store(SIGINT, Ordering::SeqCst);
+                } else {
+                    let what = Python::attach(|py| {
+                        let name = e
+                            .get_type(py)
+                            .name()
+                            .map(|n| n.to_string())
+                            .unwrap_or_else(|_| "exception".into());
+                        format!("the progress callback raised {name}: {}", e.value(py))
+                    });
+                    *stop.lock().unwrap_or_else(|p| p.into_inner()) = Some(what);
+                }
                 raised = Some(e);
-                flag.store(SIGINT, Ordering::SeqCst);
             }
         };
         py.detach(|| {
