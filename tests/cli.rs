@@ -336,6 +336,16 @@ fn example_lists_bundled_examples_and_writes_them() {
         .collect();
     assert!(names.contains(&"box-beam"), "{list}");
     assert!(names.contains(&"cantilever"), "{list}");
+    // The descriptions start in one column (after the longest name and two spaces).
+    let starts: Vec<usize> = list
+        .lines()
+        .map(|l| {
+            let name = l.split_whitespace().next().unwrap();
+            name.len() + l[name.len()..].len() - l[name.len()..].trim_start().len()
+        })
+        .collect();
+    let longest = names.iter().map(|n| n.len()).max().unwrap();
+    assert!(starts.iter().all(|&s| s == longest + 2), "{list}");
     // Every listed example is written verbatim (to stdout and to a file), and is the file
     // shipped in examples/.
     for name in &names {
