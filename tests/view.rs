@@ -852,3 +852,32 @@ fn key_numbers_are_in_design_units() {
         );
     }
 }
+
+/// The peak line names a load only for a load (issue 40: "Peak load: deflection_Q =
+/// 122.4 mm"): with a displacement on the curve's y axis it is the largest magnitude on the
+/// curve, in mm; with a reaction it is the peak load in kN.
+#[test]
+fn the_peak_line_calls_only_a_load_a_load() {
+    let dir = run_dir();
+    for (y, what, unit) in [
+        ("midspan_uy", "Largest magnitude on the curve", "mm"),
+        ("R_left", "Peak load", "kN"),
+    ] {
+        let out = tmp(&format!("peak-{y}"));
+        let (path, _) = report::report(&report::ReportOptions {
+            dir: dir.to_path_buf(),
+            out: Some(out.join("report.html")),
+            y: Some(y.into()),
+            ..Default::default()
+        })
+        .unwrap();
+        let html = std::fs::read_to_string(path).unwrap();
+        let line = html.split("<p id=\"peak\">").nth(1).unwrap();
+        let line = &line[..line.find("</p>").unwrap()];
+        assert!(
+            line.starts_with(&format!("<b>{what}:</b> {y} = ")),
+            "{line}"
+        );
+        assert!(line.ends_with(&format!(" {unit}")), "{line}");
+    }
+}

@@ -475,10 +475,12 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         let kinds = super::units::kinds(&opts.dir);
         let kind = kinds.iter().find(|(n, _)| *n == load.name).map(|(_, k)| k);
         let shown = super::units::shown(&load.name, &load.unit, kind, &load.values, opts.units);
-        let what = if load.unit == "-" {
-            "Peak load factor"
-        } else {
-            "Peak load"
+        // Only a load is called one: a deflection or a stress on the curve's y axis is its
+        // largest magnitude ("Peak load: deflection_Q = 122.4 mm" named a deflection a load).
+        let what = match load.unit.as_str() {
+            "-" => "Peak load factor",
+            "N" | "N·m" => "Peak load",
+            _ => "Largest magnitude on the curve",
         };
         let _ = writeln!(
             html,
