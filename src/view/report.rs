@@ -129,10 +129,9 @@ fn table_unit(unit: &str, units: super::UnitOptions) -> (String, f64) {
     }
 }
 
-/// Smallest joint opening the events count as an opening [m]: 0.01 mm. A joint that
-/// creep, shrinkage or round-off parts by a few micrometres has not opened in any sense a
-/// designer would act on (a 1.5 µm creep opening was reported as the first opening).
-const OPENING_THRESHOLD: f64 = 1e-5;
+/// Smallest joint opening the events count as an opening [m] (0.01 mm, as the stages'): a
+/// 1.5 µm creep parting was reported as the first opening.
+const OPENING_THRESHOLD: f64 = crate::results::stages::OPENING_THRESHOLD;
 
 /// Key numbers of a history: one table row per factor and monitor column, in design units.
 fn key_numbers(h: &Table, units: super::UnitOptions) -> String {
@@ -402,7 +401,12 @@ fn stages_section(dir: &Path) -> String {
         );
     }
     if !any {
-        s.push_str("<p id=\"stage-openings\">No joint opens during construction (the stages before the last).</p>\n");
+        let n = crate::results::stages::construction_stages(&stages);
+        let _ = writeln!(
+            s,
+            "<p id=\"stage-openings\">No joint opens by more than {} mm during construction (stages 1–{n}, up to the last that places or removes a part; later stages are service).</p>",
+            crate::results::stages::OPENING_THRESHOLD * 1e3
+        );
     }
     if let Some(fig) = StageFigure::new(&stages) {
         match svg_string(&fig) {
