@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 use std::sync::Arc;
@@ -340,6 +340,7 @@ fn main() -> ExitCode {
                 stop_after_step,
                 signal: Some(stop_on_signals()),
                 restart: restart.is_some(),
+                caller_stop: None,
             };
             let out = match (&restart, &output, &model) {
                 (Some(d), _, _) => d.clone(),
@@ -555,6 +556,21 @@ fn run(
             ExitCode::SUCCESS
         }
         Err(e) => {
+            use segfem::run::RunError;
+            // A run that got as far as solving wrote its summary, with the warnings (an
+            // earlier run's files removed, ...): said here too, before the error.
+            if matches!(
+                e,
+                RunError::NotConverged(_)
+                    | RunError::Mechanism { .. }
+                    | RunError::Interrupted { .. }
+                    | RunError::Stopped(_)
+                    | RunError::Implausible(_)
+            ) {
+                for w in summary_warnings(&out) {
+                    eprintln!("warning: {w}");
+                }
+            }
             eprintln!("error: {e}");
             match &e {
                 segfem::run::RunError::NotConverged(_) => eprintln!(
@@ -570,6 +586,21 @@ fn run(
             ExitCode::from(e.exit_code().clamp(0, 255) as u8)
         }
     }
+}
+
+/// The warnings of `out`/summary.json (empty if it cannot be read).
+fn summary_warnings(out: &Path) -> Vec<String> {
+    std::fs::read_to_string(out.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| {
+            v["warnings"].as_array().map(|a| {
+                a.iter()
+                    .filter_map(|w| w.as_str().map(String::from))
+                    .collect()
+            })
+        })
+        .unwrap_or_default()
 }
 
 fn check(model: PathBuf) -> ExitCode {
@@ -671,8 +702,10 @@ fn check(model: PathBuf) -> ExitCode {
 
 fn example(name: Option<String>, output: Option<PathBuf>) -> ExitCode {
     let Some(name) = name else {
+        // Descriptions in one column, after the longest name.
+        let w = EXAMPLES.iter().map(|e| e.0.len()).max().unwrap_or(0);
         for (n, d, _) in EXAMPLES {
-            outln!("{n:12} {d}");
+            outln!("{n:w$}  {d}");
         }
         return ExitCode::SUCCESS;
     };

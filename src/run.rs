@@ -9,6 +9,7 @@ use crate::input::{self, InputError};
 use crate::model::Model;
 use crate::results::atomic::write_atomic;
 use crate::results::checkpoint::{self, Origin};
+use crate::results::lock;
 use crate::results::plausibility::Plausibility;
 use crate::results::recorder::Recorder;
 use crate::results::stages::{self as stage_results, StageResult};
@@ -60,13 +61,19 @@ pub enum RunError {
     /// Files could not be written (exit 1).
     #[error("{0}")]
     Io(String),
+    /// Another run is writing into the output directory (exit 2): `results::lock`.
+    #[error("{0}")]
+    Busy(String),
 }
 
 impl RunError {
     /// Process exit status for this error.
     pub fn exit_code(&self) -> i32 {
         match self {
-            RunError::Input(_) | RunError::Mechanism { .. } | RunError::Restart(_) => 2,
+            RunError::Input(_)
+            | RunError::Mechanism { .. }
+            | RunError::Restart(_)
+            | RunError::Busy(_) => 2,
             RunError::NotConverged(_) => 3,
             RunError::Stopped(_) => 4,
             RunError::Implausible(_) => 5,
@@ -89,6 +96,16 @@ pub struct RunOptions {
     pub signal: Option<Arc<AtomicUsize>>,
     /// Continue the run whose output directory is `out` from its checkpoint.
     pub restart: bool,
+    /// Set to why (e.g. "the progress callback raised ValueError: ...") to stop after the
+    /// current increment at the request of the program running the analysis: status
+    /// "stopped", exit 4, that reason in the message.
+    pub caller_stop: Option<Arc<std::sync::Mutex<Option<String>>>>,
+}
+
+/// The reason a caller asked to stop with, if it did ([`RunOptions::caller_stop`]).
+fn caller_reason(stop: &Option<Arc<std::sync::Mutex<Option<String>>>>) -> Option<String> {
+    stop.as_ref()
+        .and_then(|m| m.lock().unwrap_or_else(|p| p.into_inner()).clone())
 }
 
 /// Model size figures.
@@ -264,6 +281,33 @@ fn clear_stale(out: &Path) -> Result<usize, RunError> {
     Ok(n)
 }
 
+/// Remove the field files (.vtu names of [`is_run_file`]) in `out` that results.pvd of
+/// `rec` does not list. Returns how many were removed.
+fn remove_unlisted_fields(out: &Path, rec: &Recorder) -> Result<usize, RunError> {
+    let listed: std::collections::HashSet<&str> = rec.field_files().collect();
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(0);
+    };
+    let mut n = 0;
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.ends_with(".vtu")
+            && is_run_file(&name)
+            && !listed.contains(name.as_str())
+            && e.file_type().is_ok_and(|t| t.is_file())
+        {
+            std::fs::remove_file(e.path()).map_err(|err| {
+                RunError::Io(format!(
+                    "{}: cannot remove a field file of the stopped run: {err}",
+                    e.path().display()
+                ))
+            })?;
+            n += 1;
+        }
+    }
+    Ok(n)
+}
+
 /// Peak resident set size of this process [bytes] (Linux: VmHWM), if known.
 pub fn peak_memory() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -294,6 +338,7 @@ struct Progress<'a, 'm> {
     stop_after_step: Option<usize>,
     stop_now: bool,
     signal: Option<Arc<AtomicUsize>>,
+    caller_stop: Option<Arc<std::sync::Mutex<Option<String>>>>,
     /// Timings when a step stopped early (the analysis returns none with its error).
     timings: Option<Timings>,
     /// The last checkpoint, still being written (waited for before the next and at the end).
@@ -350,6 +395,8 @@ impl Observer for Progress<'_, '_> {
         let sig = self.signal.as_ref().map_or(0, |s| s.load(Ordering::SeqCst));
         if sig != 0 {
             Some(StopReason::Signal(sig as i32))
+        } else if caller_reason(&self.caller_stop).is_some() {
+            Some(StopReason::Caller)
         } else if self.stop_now {
             self.stop_after_step.map(StopReason::AfterStep)
         } else {
@@ -391,6 +438,12 @@ pub fn run_file_opts(
     opts: &RunOptions,
 ) -> Result<Summary, RunError> {
     let t0 = Instant::now();
+    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
+    // is locked once its input is valid (bad input writes nothing, not even a directory).
+    let mut lock = None;
+    if opts.restart && out.is_dir() {
+        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
+    }
     let saved = if opts.restart {
         Some(checkpoint::read(out).map_err(RunError::Restart)?)
     } else {
@@ -420,6 +473,17 @@ pub fn run_file_opts(
         }
     }
     let input_s = t0.elapsed().as_secs_f64();
+    if lock.is_none() {
+        std::fs::create_dir_all(out).map_err(|e| {
+            RunError::Io(format!(
+                "{}: cannot create the output directory: {e}",
+                out.display()
+            ))
+        })?;
+        lock = Some(lock::acquire(out, path).map_err(RunError::Busy)?);
+    }
+    // Held until the run returns (dropped with this binding).
+    let _lock = lock;
     if saved.is_none() {
         let n = clear_stale(out)?;
         if n > 0 {
@@ -480,6 +544,7 @@ pub fn run_file_opts(
         stop_after_step: opts.stop_after_step,
         stop_now: false,
         signal: opts.signal.clone(),
+        caller_stop: opts.caller_stop.clone(),
         timings: None,
         checkpoint: None,
     };
@@ -501,7 +566,24 @@ pub fn run_file_opts(
         (Err(e), Ok(_)) => Err(AnalysisError::Output(e)),
         (_, r) => r,
     };
+    // A refused restart (the saved state does not fit the model) leaves the directory as it
+    // was: nothing was computed, and the checkpoint still continues the stopped run.
+    if let Err(AnalysisError::Restore(m)) = &result {
+        return Err(RunError::Restart(format!("{}: {m}", path.display())));
+    }
     let mut rec = obs.rec;
+    let mut warnings = built.warnings;
+    if restarted_from_step.is_some() {
+        // Field files of the increments the stopped run did after its checkpoint and this
+        // run did not write again: results.pvd no longer lists them.
+        let n = remove_unlisted_fields(out, &rec)?;
+        if n > 0 {
+            warnings.push(format!(
+                "{}: removed {n} field files (.vtu) of the increments the stopped run did after its last checkpoint, which results.pvd no longer lists",
+                out.display()
+            ));
+        }
+    }
     let watch = obs.watch;
     let plausibility = obs.plausible.findings();
     let sustained = obs.sustained.warning(&model);
@@ -554,13 +636,25 @@ pub fn run_file_opts(
         }) => (
             match reason {
                 StopReason::Signal(_) => "interrupted",
-                StopReason::AfterStep(_) => "stopped",
+                StopReason::AfterStep(_) | StopReason::Caller => "stopped",
             },
             Some(resume_step + 1),
         ),
         Some(_) => ("failed", None),
     };
     let error_text = match (&error, failures.len()) {
+        (
+            Some(
+                e @ AnalysisError::Stopped {
+                    reason: StopReason::Caller,
+                    ..
+                },
+            ),
+            _,
+        ) => Some(format!(
+            "{e}: {}",
+            caller_reason(&opts.caller_stop).unwrap_or_default()
+        )),
         (Some(e), _) => Some(e.to_string()),
         (None, 0) if !plausibility.is_empty() => Some(format!(
             "every step converged but the result is not physically meaningful:\n{}",
@@ -586,7 +680,6 @@ pub fn run_file_opts(
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
     let strength_exceeded = watch.strength_findings(&model);
-    let mut warnings = built.warnings;
     warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
     warnings.extend(strength_exceeded.iter().map(|f| f.text.clone()));
     warnings.extend(sustained);
@@ -668,6 +761,10 @@ pub fn run_file_opts(
                 }),
                 StopReason::AfterStep(_) => Err(RunError::Stopped(format!(
                     "{file}: stopped {done} as asked; {how}"
+                ))),
+                StopReason::Caller => Err(RunError::Stopped(format!(
+                    "{file}: stopped {done}: {}; {how}",
+                    caller_reason(&opts.caller_stop).unwrap_or_default()
                 ))),
             }
         }

@@ -801,3 +801,32 @@ fn incompatible_modes_are_for_q4_and_small_displacements() {
         &["incompatible-mode Q4", "Q8 or Q9"],
     );
 }
+
+/// Input files are read up to a cap (512 MiB): /dev/zero as the model file or as a Gmsh
+/// mesh file is refused once that much is read, naming the file, instead of reading on
+/// until the memory runs out.
+#[test]
+fn endless_input_files_are_refused_at_the_cap() {
+    let tmp = TempDir::new("endless");
+    let o = segfem(tmp.path(), &["check", "/dev/zero"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o).trim_end(),
+        "error: /dev/zero: larger than the limit of 512 MiB for an input file (the largest model segfem runs takes about half of it); not a model or mesh file?"
+    );
+    let model = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/gmsh-tapered.toml"),
+    )
+    .unwrap()
+    .replace("file = \"gmsh-tapered.msh\"", "file = \"/dev/zero\"");
+    std::fs::write(tmp.join("m.toml"), model).unwrap();
+    let o = segfem(tmp.path(), &["check", "m.toml"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).starts_with(
+            "error: m.toml: mesh.file: /dev/zero: larger than the limit of 512 MiB for an input file"
+        ),
+        "{}",
+        stderr(&o)
+    );
+}

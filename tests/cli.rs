@@ -336,6 +336,16 @@ fn example_lists_bundled_examples_and_writes_them() {
         .collect();
     assert!(names.contains(&"box-beam"), "{list}");
     assert!(names.contains(&"cantilever"), "{list}");
+    // The descriptions start in one column (after the longest name and two spaces).
+    let starts: Vec<usize> = list
+        .lines()
+        .map(|l| {
+            let name = l.split_whitespace().next().unwrap();
+            name.len() + l[name.len()..].len() - l[name.len()..].trim_start().len()
+        })
+        .collect();
+    let longest = names.iter().map(|n| n.len()).max().unwrap();
+    assert!(starts.iter().all(|&s| s == longest + 2), "{list}");
     // Every listed example is written verbatim (to stdout and to a file), and is the file
     // shipped in examples/.
     for name in &names {
@@ -804,7 +814,7 @@ fn no_convergence_exits_3_and_keeps_results() {
     let first = "name = \"self_weight\"\nkind = \"load\"";
     assert_eq!(text.matches(first).count(), 1);
     let text = text.replace(first, "name = \"self_weight\"\nkind = \"linear\"")
-        + "\n[solver]\nforce_tolerance = 1e-300\nmax_iterations = 1\nmax_cuts = 0\n";
+        + "\n[solver]\nforce_tolerance = 1e-14\nmax_iterations = 1\nmax_cuts = 0\n";
     std::fs::write(tmp.join("m.toml"), text).unwrap();
     let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
     assert_eq!(code(&o), 3, "{}", stderr(&o));
@@ -897,10 +907,22 @@ loads = { P = 1.0 }
 "#;
     std::fs::write(tmp.join("m.toml"), model).unwrap();
     assert_eq!(code(&segfem(tmp.path(), &["check", "m.toml"])), 0);
+    // Files of an earlier run in the directory: removed, and the terminal says so even
+    // though the run fails.
+    std::fs::create_dir_all(tmp.join("out")).unwrap();
+    std::fs::write(tmp.join("out/history.csv"), "old").unwrap();
+    std::fs::write(tmp.join("out/step001_inc0001.vtu"), "old").unwrap();
     let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out"]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let err = stderr(&o);
-    assert_eq!(err.lines().count(), 1, "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(
+        lines[0].starts_with("warning: out: removed 2 files of an earlier run"),
+        "{err}"
+    );
+    assert!(!tmp.join("out/step001_inc0001.vtu").exists());
+    let err = lines[1];
     assert!(err.starts_with("error: m.toml: "), "{err}");
     assert!(err.contains("mechanism"), "{err}");
     let s: serde_json::Value = serde_json::from_str(&read(&tmp.join("out/summary.json"))).unwrap();

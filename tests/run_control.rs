@@ -87,10 +87,9 @@ fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&read(&dir.join("summary.json"))).unwrap()
 }
 
-/// Every file of `a` except the checkpoint and summary (timings differ) equals the one of
-/// the same name in `b`, byte for byte.
-fn same_outputs(a: &Path, b: &Path) {
-    let mut names: Vec<PathBuf> = std::fs::read_dir(a)
+/// The files of `dir` except the checkpoint and summary (timings differ), sorted.
+fn output_files(dir: &Path) -> Vec<PathBuf> {
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| {
@@ -99,6 +98,21 @@ fn same_outputs(a: &Path, b: &Path) {
         })
         .collect();
     names.sort();
+    names
+}
+
+/// `a` and `b` hold the same files except the checkpoint and summary (timings differ),
+/// byte for byte: none missing, none left over.
+fn same_outputs(a: &Path, b: &Path) {
+    let names = output_files(a);
+    let name = |p: &PathBuf| p.file_name().unwrap().to_owned();
+    assert_eq!(
+        names.iter().map(name).collect::<Vec<_>>(),
+        output_files(b).iter().map(name).collect::<Vec<_>>(),
+        "{} and {} hold other files",
+        a.display(),
+        b.display()
+    );
     assert!(names.iter().any(|p| p.ends_with("history.csv")));
     for p in &names {
         let q = b.join(p.file_name().unwrap());
@@ -149,6 +163,30 @@ fn restart_matches(label: &str, text: &str, stops: &[usize]) {
         assert_eq!(s.restarted_from_step, Some(k + 1));
         same_outputs(&tmp.join("straight"), &tmp.join(&out));
     }
+}
+
+/// A staged model (the viaduct: regions and falsework supports activated and removed by its
+/// steps) restarts as well: the checkpoint holds the stage (active parts, the displacements
+/// they were born at) and the joints' openings per row. Stopped after step 3 (span 1 creeps)
+/// and after step 4 (span 2 placed: step 5 then strikes falsework, whose reactions the
+/// restart computes from the restored state).
+#[test]
+fn restart_of_the_staged_viaduct_is_bit_identical() {
+    restart_matches("restart-viaduct", &example("viaduct"), &[3, 4]);
+}
+
+/// Every file of `dir` with its bytes.
+fn files_of(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect()
 }
 
 #[test]
@@ -219,7 +257,15 @@ fn interruption_keeps_results_and_restarts() {
         restart: true,
         ..Default::default()
     };
-    run(tmp.path(), Some(&model), "cut", &again, &mut |_| {}).unwrap();
+    // The field files of increment 3 of step 2, written when the signal came, are not those
+    // of the restarted run (which writes step 2's at its end only): removed, and said.
+    let s = run(tmp.path(), Some(&model), "cut", &again, &mut |_| {}).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("removed")
+            && w.contains("field files (.vtu) of the increments the stopped run did")),
+        "{:?}",
+        s.warnings
+    );
     same_outputs(&tmp.join("straight"), &out);
 }
 
@@ -594,6 +640,7 @@ fn restart_refuses_what_it_cannot_continue() {
         edit(&text, "nx_per_segment = 6", "nx_per_segment = 12"),
     )
     .unwrap();
+    let before = files_of(&tmp.join("out"));
     let o = segfem(tmp.path(), &["run", "--restart", "out", "-q"]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let err = stderr(&o);
@@ -603,6 +650,11 @@ fn restart_refuses_what_it_cannot_continue() {
         "{err}"
     );
     assert!(!err.contains("panicked"), "{err}");
+    // Refused, the restart changed nothing: the directory still continues as it did.
+    assert!(
+        files_of(&tmp.join("out")) == before,
+        "a refused restart rewrote the output directory"
+    );
     // A damaged checkpoint.
     std::fs::write(tmp.join("out/checkpoint.bin"), b"segfem?").unwrap();
     let o = segfem(tmp.path(), &["run", "--restart", "out", "-q"]);
@@ -707,5 +759,132 @@ fn extrapolated_predictor_converges_to_the_same_path_in_fewer_iterations() {
         "RC beam: {} iterations extrapolated, {} from the last state",
         iterations(&s_ext),
         iterations(&s_last)
+    );
+}
+
+/// One run per output directory: while a run writes into `out` (held stopped by SIGSTOP once
+/// its lock is in place), a second run into `out` is refused (status 2) with a message
+/// naming the directory and the first run's process, and touches none of its files; the
+/// first then completes. A lock left by a process that no longer runs (killed) is stale and
+/// taken over.
+#[test]
+fn a_second_run_into_a_busy_directory_is_refused() {
+    let tmp = TempDir::new("busy");
+    std::fs::write(tmp.join("v.toml"), example("viaduct")).unwrap();
+    let mut first = std::process::Command::new(env!("CARGO_BIN_EXE_segfem"))
+        .args(["run", "v.toml", "-o", "out", "-q"])
+        .current_dir(tmp.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let lock = tmp.join("out/.segfem-lock");
+    // Wait for the lock (its content written), then hold the first run where it is.
+    let mut held = String::new();
+    for _ in 0..200_000 {
+        held = std::fs::read_to_string(&lock).unwrap_or_default();
+        if held.contains("model=") || first.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(100));
+    }
+    let pid = first.id().to_string();
+    let kill = |sig: &str| {
+        std::process::Command::new("kill")
+            .args([sig, &pid])
+            .status()
+            .unwrap()
+    };
+    assert!(kill("-STOP").success());
+    assert!(
+        held.contains(&format!("pid={pid}")),
+        "the first run's lock: {held:?}"
+    );
+    let o = segfem(tmp.path(), &["run", "v.toml", "-o", "out", "-q"]);
+    let err = stderr(&o);
+    assert!(kill("-CONT").success());
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "error: out: another segfem run (process {pid}, model "
+        )),
+        "{err}"
+    );
+    assert!(err.contains("is writing into this directory"), "{err}");
+    let status = first.wait().unwrap();
+    assert!(status.success(), "the first run failed");
+    assert!(!lock.exists(), "the lock outlived its run");
+    let s = summary(&tmp.join("out"));
+    assert_eq!(s["status"], "completed");
+    // The first run's files only: every .vtu results.pvd lists is there, and no other.
+    let pvd = read(&tmp.join("out/results.pvd"));
+    let listed: std::collections::BTreeSet<String> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|r| r.split('"').next().unwrap().to_string())
+        .collect();
+    let on_disk: std::collections::BTreeSet<String> = std::fs::read_dir(tmp.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".vtu"))
+        .collect();
+    assert_eq!(listed, on_disk);
+
+    // A stale lock: the process that wrote it has ended (a finished child's id).
+    let mut dead = std::process::Command::new("true").spawn().unwrap();
+    dead.wait().unwrap();
+    std::fs::write(
+        &lock,
+        format!("pid={}\nstart=1\nmodel=gone.toml\n", dead.id()),
+    )
+    .unwrap();
+    let o = segfem(tmp.path(), &["run", "v.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!lock.exists());
+}
+
+/// A load step of ten increments to Q = 100 ends at Q = 100 exactly: 10 × 0.1 sums to
+/// 0.9999999999999999, and the last increment used to end there (Q = 99.999999999999986
+/// in history.csv and in a sweep's table). The same for a time step's clock.
+#[test]
+fn the_last_increment_lands_on_the_step_factors_exactly() {
+    let tmp = TempDir::new("exact-end");
+    let text = with_steps(
+        &example("cantilever"),
+        "[[monitors]]\nname = \"Q\"\nkind = \"load_factor\"\ncase = \"tip\"\n\n\
+         [[steps]]\nname = \"a\"\nkind = \"load\"\nloads = { tip = 0.3 }\nincrements = 10\n\n\
+         [[steps]]\nname = \"b\"\nkind = \"load\"\nloads = { tip = 100.0 }\nincrements = 10\n",
+    );
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let s = run(
+        tmp.path(),
+        Some(&tmp.join("m.toml")),
+        "out",
+        &RunOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let h = read(&tmp.join("out/history.csv"));
+    let head: Vec<&str> = h.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|c| c.starts_with(name)).unwrap();
+    let (f, q) = (col("factor:tip"), col("Q ["));
+    // The rows that end steps a (10) and b (20).
+    for (row, want) in [(10, 0.3), (20, 100.0)] {
+        let cells: Vec<&str> = h.lines().nth(row).unwrap().split(',').collect();
+        assert_eq!(
+            cells[f].parse::<f64>().unwrap(),
+            want,
+            "row {row}: {}",
+            cells[f]
+        );
+        assert_eq!(
+            cells[q].parse::<f64>().unwrap(),
+            want,
+            "row {row}: {}",
+            cells[q]
+        );
+    }
+    assert_eq!(
+        s.final_monitors.iter().find(|(n, _)| n == "Q").unwrap().1,
+        100.0
     );
 }

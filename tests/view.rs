@@ -789,3 +789,95 @@ fn staged_report_has_the_stage_history_figure() {
         "no stages, no stage figure"
     );
 }
+
+/// The report's "Key numbers" table is in design units (issue 40): a history column in m,
+/// N or Pa is shown in mm, kN or MPa, and its final value is the history's last value so
+/// scaled (4 significant digits: 1e-3 relative); with `--units si` the file's units stay.
+#[test]
+fn key_numbers_are_in_design_units() {
+    let dir = run_dir();
+    let (header, rows) = history(dir);
+    let last = rows.last().unwrap();
+    for si in [false, true] {
+        let out = tmp(&format!("key-numbers-{si}"));
+        let (path, _) = report::report(&report::ReportOptions {
+            dir: dir.to_path_buf(),
+            out: Some(out.join("report.html")),
+            units: view::UnitOptions {
+                si,
+                ..Default::default()
+            },
+            ..Default::default()
+        })
+        .unwrap();
+        let html = std::fs::read_to_string(path).unwrap();
+        let table = html.split("<h2>Key numbers").nth(1).unwrap();
+        let table = &table[..table.find("</table>").unwrap()];
+        let mut checked = 0;
+        for (i, h) in header.iter().enumerate() {
+            let Some((name, unit)) = h.strip_suffix(']').and_then(|h| h.split_once(" [")) else {
+                continue;
+            };
+            let (shown, scale) = match (si, unit) {
+                (false, "m") => ("mm", 1e3),
+                (false, "N") => ("kN", 1e-3),
+                (false, "Pa") => ("MPa", 1e-6),
+                _ => (unit, 1.0),
+            };
+            let Some(row) = table
+                .split("<tr>")
+                .find(|r| r.starts_with(&format!("<td>{name}</td>")))
+            else {
+                continue;
+            };
+            let cells: Vec<&str> = row
+                .split("<td>")
+                .skip(1)
+                .map(|c| c.split("</td>").next().unwrap())
+                .collect();
+            assert_eq!(cells[1], shown, "{name}: {row}");
+            let v: f64 = cells[2].parse().unwrap();
+            let want = last[i] * scale;
+            assert!(
+                (v - want).abs() <= 1e-3 * want.abs(),
+                "{name}: final {v} vs {want} {shown}"
+            );
+            if unit != "-" {
+                checked += 1;
+            }
+        }
+        assert!(
+            checked >= 2,
+            "too few monitors with units checked:\n{table}"
+        );
+    }
+}
+
+/// The peak line names a load only for a load (issue 40: "Peak load: deflection_Q =
+/// 122.4 mm"): with a displacement on the curve's y axis it is the largest magnitude on the
+/// curve, in mm; with a reaction it is the peak load in kN.
+#[test]
+fn the_peak_line_calls_only_a_load_a_load() {
+    let dir = run_dir();
+    for (y, what, unit) in [
+        ("midspan_uy", "Largest magnitude on the curve", "mm"),
+        ("R_left", "Peak load", "kN"),
+    ] {
+        let out = tmp(&format!("peak-{y}"));
+        let (path, _) = report::report(&report::ReportOptions {
+            dir: dir.to_path_buf(),
+            out: Some(out.join("report.html")),
+            y: Some(y.into()),
+            ..Default::default()
+        })
+        .unwrap();
+        let html = std::fs::read_to_string(path).unwrap();
+        let line = html.split("<p id=\"peak\">").nth(1).unwrap();
+        let line = &line[..line.find("</p>").unwrap()];
+        assert!(
+            line.starts_with(&format!("<b>{what}:</b> {y} = ")),
+            "{line}"
+        );
+        assert!(line.ends_with(&format!(" {unit}")), "{line}");
+    }
+}

@@ -288,7 +288,7 @@ def _run(
         raise InputError(message)
     if kind == "restart":
         raise RestartError(message, code)
-    if kind == "io":
+    if kind in ("io", "busy"):
         raise OutputError(message, code)
     result = Result(
         out,

@@ -175,8 +175,16 @@ class Result:
 
     @classmethod
     def open(cls, out_dir: "str | Path") -> "Result":
-        """The results of an earlier run (its output directory)."""
-        return cls(Path(out_dir))
+        """The results of an earlier run (its output directory). Raises FileNotFoundError
+        when the directory holds no summary.json (not the output of a run, or a run still
+        going)."""
+        d = Path(out_dir)
+        if not (d / "summary.json").is_file():
+            raise FileNotFoundError(
+                f"{d}: no summary.json: not the output directory of a segfem run"
+                " (or its run has not ended yet)"
+            )
+        return cls(d)
 
     @property
     def status(self) -> str:

@@ -44,6 +44,13 @@ KEEP = ("all", "summary", "none")
 REDUCTIONS = ("final", "max", "min")
 #: Columns that differ between two runs of the same sweep (timing, where it ran).
 TIMING_COLUMNS = ("wall_s", "elapsed_s", "worker")
+#: Columns of the results table besides the parameters and monitors, and the history's own
+#: columns: no parameter may take one of these names (it would be overwritten in the table).
+RESERVED_COLUMNS = (
+    "case", "status", "exit_code", "ultimate_mode", "ultimate_factor", "peak_factor",
+    "increments", "iterations", "wall_s", "elapsed_s", "worker", "error",
+    "step", "increment", "time", "time [d]",
+)
 
 
 class SweepError(SegfemError, ValueError):
@@ -237,6 +244,19 @@ class Sweep:
         for r in self.reductions:
             if r not in REDUCTIONS:
                 raise SweepError(f"{label}: reductions: '{r}' is not one of {list(REDUCTIONS)}")
+        # A parameter column must not share its name with another column of the table: a
+        # result column would overwrite it.
+        monitor_columns = {m if r == "final" else f"{m}_{r}" for m in names for r in self.reductions}
+        for p in self.parameters:
+            if p.name in RESERVED_COLUMNS or p.name.startswith("factor:"):
+                raise SweepError(
+                    f"{label}: parameters.{p.name}: the name of a column the results table or the history already has "
+                    f"({', '.join(RESERVED_COLUMNS)}); choose another name"
+                )
+            if p.name in monitor_columns:
+                raise SweepError(
+                    f"{label}: parameters.{p.name}: the name of a monitor column of the model's results; choose another name"
+                )
         self.keep: str = spec.get("keep", "summary")
         if self.keep not in KEEP:
             raise SweepError(f"{label}: keep: '{self.keep}' is not one of {list(KEEP)}")
@@ -254,6 +274,7 @@ class Sweep:
                 why = str(e.args[0]).removeprefix(f"{parent}: ")
                 raise SweepError(f"{label}: parameters.{p.name}.path: {p.path}: {why}") from None
         self._cases: Optional[pd.DataFrame] = None
+        self._rows: Optional[List[Dict[str, Any]]] = None
 
     def _model(self, m: Any) -> Model:
         if isinstance(m, Model):
@@ -299,10 +320,19 @@ class Sweep:
     def cases(self) -> pd.DataFrame:
         """The planned cases: one row per case (index ``case``), one column per parameter."""
         if self._cases is None:
-            self._cases = self._plan()
+            rows = self._case_rows()
+            self._cases = pd.DataFrame(rows, columns=[p.name for p in self.parameters])
+            self._cases.index.name = "case"
         return self._cases.copy()
 
-    def _plan(self) -> pd.DataFrame:
+    def _case_rows(self) -> List[Dict[str, Any]]:
+        """The planned cases as the values given (an int stays an int: a table row would
+        turn it into the float of a column beside a float)."""
+        if self._rows is None:
+            self._rows = self._plan()
+        return self._rows
+
+    def _plan(self) -> List[Dict[str, Any]]:
         grid = [p for p in self.parameters if p.kind == "grid"]
         random = [p for p in self.parameters if p.kind == "random"]
         if self.method == "grid":
@@ -331,16 +361,14 @@ class Sweep:
             for p in self.parameters:
                 if p.kind == "expression":
                     row[p.name] = _evaluate(p, row)
-        df = pd.DataFrame(rows, columns=[p.name for p in self.parameters])
-        df.index.name = "case"
-        return df
+        return [{p.name: row[p.name] for p in self.parameters} for row in rows]
 
     def tasks(self, out_dir: Path, threads: int = 1) -> List[Dict[str, Any]]:
         """The work of each case as plain data (sent to a worker process or a Dask worker)."""
         digest = hashlib.sha256(self._text.encode()).hexdigest()
         name = self.model.path.name if self.model.path is not None else "model.toml"
         out = []
-        for case, row in self.cases.iterrows():
+        for case, row in enumerate(self._case_rows()):
             params = {k: _plain(v) for k, v in row.items()}
             out.append(
                 {
@@ -586,8 +614,22 @@ def run_case(task: Dict[str, Any]) -> Dict[str, Any]:
 # -- executors ---------------------------------------------------------------------------
 
 
-def _init_worker(threads: int) -> None:
+def _init_worker(threads: int, parent: int) -> None:
     os.environ["RAYON_NUM_THREADS"] = str(threads)
+    # A worker outlives a driver killed with SIGKILL (no chance to shut the pool down) and
+    # would run its case to the end: it watches its parent and ends itself once the parent
+    # is gone (it is then re-parented). The case it ran is not finished (no record) and is
+    # run again when the sweep is resumed. A polling thread rather than Linux's
+    # PR_SET_PDEATHSIG, which fires when the parent's *thread* that started the worker ends.
+    import threading
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent:
+                os._exit(137)
+            time.sleep(0.2)
+
+    threading.Thread(target=watch, name="segfem-parent-watch", daemon=True).start()
 
 
 def _run_local(todo: List[Dict[str, Any]], finish: Callable[[Dict[str, Any]], None], workers: Optional[int]) -> None:
@@ -598,7 +640,7 @@ def _run_local(todo: List[Dict[str, Any]], finish: Callable[[Dict[str, Any]], No
     # Fresh interpreters (spawn): a forked child would inherit a copy of a thread pool
     # the parent may have started and hang on it.
     ctx = mp.get_context("spawn")
-    ex = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker, initargs=(todo[0]["threads"],))
+    ex = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker, initargs=(todo[0]["threads"], os.getpid()))
     try:
         futures = [ex.submit(run_case, t) for t in todo]
         for f in cf.as_completed(futures):

@@ -4,7 +4,7 @@
 //! hands back plain values (JSON text, bytes of little-endian f64) that the Python side turns
 //! into dicts, pandas and numpy objects. docs/python.md describes the package.
 
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use segfem::analysis::steps::Snapshot;
@@ -19,7 +19,8 @@ const SIGINT: usize = 2;
 
 /// What a run ended with: (exit status as the command line's, kind, message, summary.json
 /// text of a successful run). Kinds: "ok", "input", "mechanism", "restart",
-/// "not_converged", "interrupted", "stopped", "implausible", "io".
+/// "not_converged", "interrupted", "stopped", "implausible", "io", "busy" (another run
+/// writes into the output directory).
 type Outcome = (i32, &'static str, Option<String>, Option<String>);
 
 fn outcome(res: Result<segfem::run::Summary, RunError>) -> Outcome {
@@ -40,6 +41,7 @@ fn outcome(res: Result<segfem::run::Summary, RunError>) -> Outcome {
                 RunError::Stopped(_) => "stopped",
                 RunError::Implausible(_) => "implausible",
                 RunError::Io(_) => "io",
+                RunError::Busy(_) => "busy",
             };
             (e.exit_code(), kind, Some(e.to_string()), None)
         }
@@ -89,12 +91,14 @@ fn run(
     restart: bool,
 ) -> (Outcome, Option<PyErr>) {
     let flag = Arc::new(AtomicUsize::new(0));
+    let stop = Arc::new(std::sync::Mutex::new(None));
     let opts = RunOptions {
         verbose,
         continue_on_failure,
         stop_after_step,
         signal: Some(flag.clone()),
         restart,
+        caller_stop: Some(stop.clone()),
     };
     let mut raised: Option<PyErr> = None;
     let res = {
@@ -113,8 +117,23 @@ fn run(
             })
             .err();
             if let Some(e) = err {
+                // Ctrl-C is the signal it is; any other exception stops the run as the
+                // caller's request, recorded as that exception (not as SIGINT).
+                let ctrl_c = Python::attach(|py| e.is_instance_of::<PyKeyboardInterrupt>(py));
+                if ctrl_c {
+                    flag.store(SIGINT, Ordering::SeqCst);
+                } else {
+                    let what = Python::attach(|py| {
+                        let name = e
+                            .get_type(py)
+                            .name()
+                            .map(|n| n.to_string())
+                            .unwrap_or_else(|_| "exception".into());
+                        format!("the progress callback raised {name}: {}", e.value(py))
+                    });
+                    *stop.lock().unwrap_or_else(|p| p.into_inner()) = Some(what);
+                }
                 raised = Some(e);
-                flag.store(SIGINT, Ordering::SeqCst);
             }
         };
         py.detach(|| {

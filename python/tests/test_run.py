@@ -143,8 +143,31 @@ def test_progress_exception_stops_the_run(cantilever, seed_beam, tmp_path):
 
     with pytest.raises(Stop) as e:
         segfem.load(seed_beam).run(tmp_path / "o", progress=progress)
-    assert e.value.result.status == "interrupted"
-    assert len(e.value.result.history) == 1
+    # Recorded as the exception it was, not as a Ctrl-C.
+    r = e.value.result
+    assert r.status == "stopped" and r.exit_code == 4
+    assert "the progress callback raised Stop: 1" in r.summary["error"]
+    assert "SIGINT" not in r.summary["error"] and "SIGINT" not in (r.error or "")
+    assert len(r.history) == 1
+
+
+def test_open_of_a_directory_without_results_raises(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no summary.json"):
+        segfem.Result.open("/nonexistent")
+    with pytest.raises(FileNotFoundError):
+        segfem.Result.open(tmp_path)
+
+
+def test_a_truncated_vtu_is_refused(seed_beam, tmp_path):
+    r = segfem.load(seed_beam).run(tmp_path / "o")
+    f = r.fields[-1].file
+    text = f.read_bytes()
+    cut = tmp_path / "cut.vtu"
+    # Cut after the cells: points and cells complete, every data array lost.
+    cut.write_bytes(text[: text.index(b"</Cells>") + len(b"</Cells>")])
+    with pytest.raises(OSError, match="truncated"):
+        segfem.Grid.read(cut)
+    assert len(segfem.Grid.read(f).point_data) > 0
 
 
 def test_run_releases_the_gil(seed_beam, tmp_path):

@@ -2,6 +2,7 @@
 Dask LocalCluster, resume."""
 
 import json
+import re
 import os
 from pathlib import Path
 
@@ -155,3 +156,97 @@ def test_sweep_file_and_command(cantilever, tmp_path):
     assert list(table["t"]) == [0.1, 0.2]
     # Half the thickness, twice the deflection (linear); round-off tolerance.
     assert np.isclose(table["tip_uy"][0], 2 * table["tip_uy"][1], rtol=1e-9)
+
+
+def test_an_int_parameter_stays_an_int_beside_a_float(cantilever, tmp_path):
+    # mesh.nx takes a whole number; beside a float parameter it used to reach the model as
+    # 16.0 (a table row has one dtype) and every case failed. Exact values: the tip
+    # deflection of the linear cantilever changes with the mesh but scales as 1/E exactly
+    # within one mesh (round-off 1e-9).
+    spec = {
+        "model": str(cantilever),
+        "method": "grid",
+        "monitors": ["tip_uy"],
+        "parameters": {
+            "nx": {"path": "mesh.nx", "values": [8, 16]},
+            "E": {"path": "materials.steel.E", "values": [100e9, 200e9]},
+        },
+    }
+    table = Sweep.from_dict(spec).run(tmp_path / "ints", workers=1)
+    assert (table["status"] == "completed").all(), table["error"].tolist()
+    assert table["nx"].tolist() == [8, 8, 16, 16]
+    assert all(type(v) is int for v in Sweep.from_dict(spec).tasks(tmp_path)[0]["values"].values() if v == 8)
+    assert pd.api.types.is_integer_dtype(table["nx"])
+    for nx in (8, 16):
+        t = table[table["nx"] == nx]
+        assert np.isclose(t["tip_uy"].iloc[0], 2 * t["tip_uy"].iloc[1], rtol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["tip_uy", "status", "step", "time [d]", "iterations"])
+def test_parameter_names_that_collide_are_refused(cantilever, name):
+    spec = cantilever_sweep(cantilever)
+    spec["parameters"][name] = {"path": "regions.web.thickness", "value": 0.1}
+    with pytest.raises(SweepError, match=re.escape(f"parameters.{name}: the name of a")):
+        Sweep.from_dict(spec)
+
+
+def test_a_monitor_named_like_a_history_column_is_refused(cantilever):
+    data = segfem.load(cantilever).to_dict()
+    data["monitors"][0]["name"] = "step"
+    with pytest.raises(segfem.InputError, match="'step' is a column history.csv already has"):
+        segfem.Model.from_dict(data, name="m.toml")
+
+
+def test_killed_driver_leaves_no_worker_running(tmp_path):
+    # A sweep of slow cases (the viaduct, about a second each) in two worker processes; the
+    # driver is killed with SIGKILL once the workers run, and the workers must end on their
+    # own (they watch their parent). Waits are bounded generously; no timing is asserted.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from conftest import EXAMPLES
+
+    model = tmp_path / "viaduct.toml"
+    model.write_text((EXAMPLES / "viaduct.toml").read_text())
+    sweep = tmp_path / "s.toml"
+    sweep.write_text(
+        'model = "viaduct.toml"\nmethod = "grid"\nkeep = "none"\n'
+        "[parameters.rho]\npath = \"materials.concrete.density\"\nvalues = " + str([2500.0 + i for i in range(40)]) + "\n"
+    )
+    driver = subprocess.Popen(
+        [sys.executable, "-m", "segfem.sweep", str(sweep), "-q", "--workers", "2"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+
+    def children(pid: int) -> list:
+        out = []
+        for d in Path("/proc").iterdir():
+            if d.name.isdigit():
+                try:
+                    stat = (d / "stat").read_text()
+                except OSError:
+                    continue
+                if int(stat[stat.rfind(")") + 2 :].split()[1]) == pid:
+                    out.append(int(d.name))
+        return out
+
+    workers = []
+    deadline = time.monotonic() + 120
+    # The workers have started once a case record is written (each ran a case).
+    while time.monotonic() < deadline and not list((tmp_path / "s" / "cases").glob("*.json")):
+        time.sleep(0.05)
+    workers = children(driver.pid)
+    assert workers, "no worker processes seen"
+    os.kill(driver.pid, signal.SIGKILL)
+    driver.wait()
+    deadline = time.monotonic() + 60
+    alive = workers
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.1)
+        alive = [w for w in workers if Path(f"/proc/{w}").exists() and "Z" not in (Path(f"/proc/{w}/stat").read_text().split(")")[1][:3])]
+    for w in alive:
+        os.kill(w, signal.SIGKILL)
+    assert not alive, f"workers {alive} still run after the driver was killed"

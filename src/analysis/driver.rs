@@ -91,6 +91,9 @@ pub enum StopReason {
     Signal(i32),
     /// The run was asked to stop after this step (1-based).
     AfterStep(usize),
+    /// The program running the analysis asked it to stop (an exception in a Python
+    /// progress callback): not a signal.
+    Caller,
 }
 
 /// Options of an analysis.
@@ -139,6 +142,7 @@ fn stopped_message(reason: StopReason, step: usize, increment: usize, resume: us
         StopReason::Signal(15) => "interrupted by SIGTERM".to_string(),
         StopReason::Signal(n) => format!("interrupted by signal {n}"),
         StopReason::AfterStep(_) => "stopped as asked".to_string(),
+        StopReason::Caller => "stopped by the program running it".to_string(),
     };
     let at = if increment == 0 {
         format!("after step {}", step + 1)

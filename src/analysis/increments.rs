@@ -84,11 +84,23 @@ pub enum PairNorm {
     Rms,
 }
 
+/// `level` [-], or exactly 1 (the end of the step) when it is within the step loop's 1e-12
+/// of it or beyond: ten increments of 0.1 sum to 0.9999999999999999, and the last would
+/// otherwise end short of the step's factors (a load factor of 100 recorded as
+/// 99.999999999999986).
+pub fn end_level(level: f64) -> f64 {
+    if level >= 1.0 - 1e-12 {
+        1.0
+    } else {
+        level
+    }
+}
+
 impl Pair {
     /// Level the next increment ends at, from the level reached and the pair length.
     pub fn target(&self, level: f64, pair_length: f64) -> f64 {
         match self {
-            Pair::Probe => (level + pair_length).min(1.0),
+            Pair::Probe => end_level(level + pair_length),
             Pair::First(s) => 0.5 * (s.level + s.end),
             Pair::Second(s) => s.end,
         }

@@ -14,8 +14,10 @@ use crate::fem::dofs::CONSTRAINED;
 use crate::fem::pattern::LowerPattern;
 use crate::model::Model;
 
-/// The stage the analysis is in and what it implies for the assembly.
-#[derive(Debug, Clone, Default)]
+/// The stage the analysis is in and what it implies for the assembly. Saved in the
+/// checkpoint: the reference displacements of the parts born after the first step are
+/// known only from the run that placed them.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StageState {
     /// Index of the step whose stage is set (None before the first).
     pub step: Option<usize>,

@@ -8,6 +8,7 @@
 //! recomputed from the same matrix.
 
 use super::families::Families;
+use super::stages::StageState;
 use super::system::System;
 use crate::materials::point::TimeContext;
 use serde::{Deserialize, Serialize};
@@ -45,6 +46,8 @@ pub struct SystemState {
     pub time: TimeContext,
     /// The element families' states.
     pub families: Families,
+    /// The construction stage reached (None: the model has no stages).
+    pub stages: Option<StageState>,
 }
 
 /// The committed state of a [`System`], borrowed for writing: the fields of
@@ -55,6 +58,7 @@ pub struct SystemStateRef<'a> {
     u_prev: &'a [f64],
     time: TimeContext,
     families: &'a Families,
+    stages: Option<&'a StageState>,
 }
 
 impl System<'_> {
@@ -65,6 +69,7 @@ impl System<'_> {
             u_prev: &self.u_prev,
             time: self.time,
             families: &self.families,
+            stages: self.stages.as_ref(),
         }
     }
 
@@ -76,6 +81,7 @@ impl System<'_> {
             u_prev: self.u_prev.clone(),
             time: self.time,
             families: self.families.clone(),
+            stages: self.stages.clone(),
         }
     }
 
@@ -166,10 +172,43 @@ impl System<'_> {
                 el
             });
         }
+        match (&s.stages, &self.stages) {
+            (Some(st), Some(_)) => {
+                check("staged elements", st.element_active.len(), self.model.elements.len())?;
+                check(
+                    "staged element references",
+                    st.element_ref.len(),
+                    self.model.elements.len(),
+                )?;
+                check(
+                    "staged joint elements",
+                    st.interface_active.len(),
+                    self.model.interfaces.len(),
+                )?;
+                check(
+                    "staged joint references",
+                    st.interface_ref.len(),
+                    self.model.interfaces.len(),
+                )?;
+                check("staged equations", st.held.len(), self.dofs.n_eq)?;
+                check("staged releases", st.release.len(), self.u.len())?;
+            }
+            (None, None) => {}
+            (saved, _) => {
+                return Err(format!(
+                    "the checkpoint {} construction stages, the model {}: the model changed since the checkpoint was written",
+                    if saved.is_some() { "has" } else { "has no" },
+                    if saved.is_some() { "none" } else { "has" },
+                ))
+            }
+        }
         self.u = s.u;
         self.u_prev = s.u_prev;
         self.time = s.time;
         self.families = s.families;
+        if s.stages.is_some() {
+            self.stages = s.stages;
+        }
         Ok(())
     }
 }
@@ -302,6 +341,15 @@ pub(crate) mod layout {
                     time: vec![Some(bar_time)],
                 },
             },
+            stages: Some(StageState {
+                step: Some(1),
+                element_active: vec![true, false],
+                element_ref: vec![None, Some(vec![1.0, 2.0])],
+                interface_active: vec![true],
+                interface_ref: vec![Some(vec![3.0, 4.0])],
+                held: vec![false, true],
+                release: vec![5.0, 6.0],
+            }),
         }
     }
 
@@ -312,6 +360,7 @@ pub(crate) mod layout {
             u_prev: &s.u_prev,
             time: s.time,
             families: &s.families,
+            stages: s.stages.as_ref(),
         }
     }
 

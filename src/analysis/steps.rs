@@ -57,11 +57,6 @@ pub fn run_with(
         limit_points: Vec::new(),
     };
     match options.resume {
-        Some(_) if sys.stages.is_some() => {
-            return Err(AnalysisError::Restore(
-                "resuming a model with construction stages from a checkpoint is not supported yet: run it from the start".into(),
-            ));
-        }
         Some((d, s)) => {
             if d.factors.len() != driver.factors.len() || d.next_step > model.steps.len() {
                 return Err(AnalysisError::Restore(format!(
@@ -277,7 +272,15 @@ impl increments::Stepper for LoadStepper<'_> {
             .start
             .iter()
             .zip(&step.factors)
-            .map(|(a, b)| a + (b - a) * target)
+            // At the step's end its factors exactly (a + (b − a) · 1 can differ from b in
+            // the last bit).
+            .map(|(a, b)| {
+                if target == 1.0 {
+                    *b
+                } else {
+                    a + (b - a) * target
+                }
+            })
             .collect();
         self.f_ext = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.lam);
         ctx.sys.set_thermal(&self.lam);

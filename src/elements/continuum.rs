@@ -199,6 +199,42 @@ pub fn min_jacobian(kind: QuadKind, coords: &[[f64; 2]], integration: Integratio
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Points per side of the grid [`fold`] samples det J on (ξ, η = −1, −0.75, …, 1).
+const FOLD_GRID: usize = 9;
+
+/// Where a Q8 or Q9 element folds inside although det J is positive at its corners and
+/// integration points (a mid-side node moved far from the middle of its edge): the smallest
+/// det J on a 9 × 9 grid over the element and the grid's edges, and its (ξ, η), if it is
+/// not positive. A quadratic element's det J is a polynomial of degree up to 4 in ξ and η
+/// that can dip below zero between the Gauss points; the grid's spacing of 1/8 of the element
+/// finds any fold reaching about a sixteenth of the element across. A Q4's det J is linear
+/// in each of ξ, η (smallest at a corner, which [`min_jacobian`] checks): None.
+pub fn fold(kind: QuadKind, coords: &[[f64; 2]]) -> Option<(f64, f64, f64)> {
+    if kind == QuadKind::Q4 {
+        return None;
+    }
+    let at = |i: usize| -1.0 + 2.0 * i as f64 / (FOLD_GRID - 1) as f64;
+    let mut low = (f64::INFINITY, 0.0, 0.0);
+    for i in 0..FOLD_GRID {
+        for j in 0..FOLD_GRID {
+            let (x, e) = (at(i), at(j));
+            let d = jacobian(&kind.eval(x, e), coords).1;
+            if d.is_nan() || d < low.0 {
+                low = (d, x, e);
+            }
+        }
+    }
+    (low.0.is_nan() || low.0 <= 0.0).then_some(low)
+}
+
+/// The message of a fold found by [`fold`].
+pub fn fold_message(f: (f64, f64, f64)) -> String {
+    format!(
+        "element folds inside: det J = {:.3e} at (ξ, η) = ({:.2}, {:.2}) although positive at its corners and integration points; a mid-side node is too far from the middle of its edge",
+        f.0, f.1, f.2
+    )
+}
+
 /// Element area [m²].
 pub fn area(kind: QuadKind, coords: &[[f64; 2]]) -> f64 {
     gauss_square(3)

@@ -5,7 +5,7 @@
 use super::error::{Ctx, InputError};
 use super::limits::{available_memory, check_size, degenerate, extent};
 use super::schema::MeshIn;
-use crate::elements::continuum::{min_jacobian, Integration};
+use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
 use crate::fem::shape::QuadKind;
 use crate::mesh::gmsh::{parse_msh, GmshElementKind, GmshMesh};
 use crate::mesh::segmental::{Joint, JointFace};
@@ -44,8 +44,8 @@ pub fn build_gmsh(mesh: &MeshIn, ctx: &Ctx, region_names: &[&str]) -> R<GmshBuil
         .ok_or_else(|| ctx.err("mesh.file", "missing: the .msh file to read"))?;
     let base = Path::new(&ctx.file).parent().unwrap_or(Path::new("."));
     let path = base.join(file);
-    let bytes = std::fs::read(&path)
-        .map_err(|e| ctx.err("mesh.file", format!("cannot read {}: {e}", path.display())))?;
+    let bytes = crate::input::limits::read_bounded(&path)
+        .map_err(|e| ctx.err("mesh.file", format!("{}: {e}", path.display())))?;
     let g = parse_msh(&bytes, &path.display().to_string())
         .map_err(|e| ctx.err("mesh.file", e.to_string()))?;
     // Checked for Q4 here; each element's kind is checked again where it is built.
@@ -108,6 +108,13 @@ fn map(
         g.elements.len() as f64,
         available_memory(),
     )?;
+    if let Some((tag, m)) = g
+        .nodes
+        .iter()
+        .find_map(|(t, x)| crate::input::limits::bad_coordinates(*x).map(|m| (t, m)))
+    {
+        return Err(ctx.err("mesh.file", format!("{file}: node {tag}: {m}")));
+    }
     let size = extent(&nodes);
     let mut elements = Vec::new();
     let mut groups = Groups::default();
@@ -162,6 +169,12 @@ fn map(
             let detj = min_jacobian(kind, &coords, integ);
             if detj.is_nan() || detj <= 0.0 {
                 return Err(ctx.err("mesh.file", format!("{file}: element {} is inverted or degenerate (smallest det J = {detj:.3e})", el.tag)));
+            }
+            if let Some(f) = fold(kind, &coords) {
+                return Err(ctx.err(
+                    "mesh.file",
+                    format!("{file}: element {}: {}", el.tag, fold_message(f)),
+                ));
             }
             elements.push(Element {
                 kind,
@@ -231,6 +244,9 @@ fn joints(
     let same =
         |a: usize, b: usize| (nodes[a][0] - nodes[b][0]).hypot(nodes[a][1] - nodes[b][1]) <= tol;
     let mut out = Vec::new();
+    // The joint that first tied each pair of faces (both faces' nodes, sorted): a pair tied
+    // twice would count its contact stiffness twice.
+    let mut tied: std::collections::HashMap<Vec<usize>, usize> = Default::default();
     for (j, pair) in mesh.joints.iter().enumerate() {
         let key = format!("mesh.joints[{j}]");
         let get = |name: &str, k: &str| {
@@ -281,6 +297,13 @@ fn joints(
                     "the two faces share nodes: each segment needs its own nodes at the joint",
                 ));
             }
+            let mut both: Vec<usize> = a.iter().chain(b).copied().collect();
+            both.sort_unstable();
+            if let Some(&first) = tied.get(&both) {
+                let p = nodes[a[0]];
+                return Err(ctx.err(key.clone(), format!("the faces of '{}' and '{}' at {p:?} are already joined by mesh.joints[{first}]: a joint declared twice would count its stiffness twice", pair.a, pair.b)));
+            }
+            tied.insert(both, j);
             faces.push(JointFace {
                 a: face_a,
                 b: b.clone(),

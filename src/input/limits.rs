@@ -24,6 +24,53 @@ pub const MAX_ITERATIONS: usize = 10_000;
 /// Largest `solver.max_cuts` [-]: 2^-52 of an increment is below double precision.
 pub const MAX_CUTS: usize = 52;
 
+/// Largest node coordinate accepted, in absolute value [m]: 1e7 m is the size of the Earth;
+/// farther coordinates are a unit or typing error, and their products (areas, det J)
+/// overflow double precision before anything else could name them.
+pub const MAX_COORDINATE: f64 = 1e7;
+
+/// Why coordinate pair `p` [m] is refused (not finite, or beyond [`MAX_COORDINATE`]), if it
+/// is.
+pub fn bad_coordinates(p: [f64; 2]) -> Option<String> {
+    if !(p[0].is_finite() && p[1].is_finite()) {
+        Some(format!(
+            "coordinates ({}, {}) are not finite numbers",
+            p[0], p[1]
+        ))
+    } else if p[0].abs().max(p[1].abs()) > MAX_COORDINATE {
+        Some(format!(
+            "coordinates ({:e}, {:e}) m lie beyond ±{MAX_COORDINATE:e} m (the size of the Earth): metres intended?",
+            p[0], p[1]
+        ))
+    } else {
+        None
+    }
+}
+
+/// Largest model or mesh file read [bytes] (512 MiB). The largest model the dof limit
+/// allows (5e6 nodes) written out as an explicit mesh or a Gmsh file takes about 250 MB
+/// (about 50 bytes per node and per element); a larger file, or a device such as
+/// /dev/zero, is refused after reading this much instead of filling the memory.
+pub const MAX_INPUT_BYTES: u64 = 512 << 20;
+
+/// The bytes of file `path`, read up to [`MAX_INPUT_BYTES`]; `Err` with a sentence (without
+/// the file name) when it cannot be read or is larger.
+pub fn read_bounded(path: &std::path::Path) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let f = std::fs::File::open(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    let mut bytes = Vec::new();
+    f.take(MAX_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read the file: {e}"))?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(format!(
+            "larger than the limit of {} MiB for an input file (the largest model segfem runs takes about half of it); not a model or mesh file?",
+            MAX_INPUT_BYTES >> 20
+        ));
+    }
+    Ok(bytes)
+}
+
 /// Estimated peak memory per degree of freedom of a run [bytes].
 pub const BYTES_PER_DOF: f64 = 2800.0;
 

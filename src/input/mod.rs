@@ -18,11 +18,18 @@ use std::path::Path;
 /// Read and validate a model file.
 pub fn load(path: &Path) -> Result<Built, InputError> {
     let label = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+    let err = |message: String| InputError {
         file: label.clone(),
         line: None,
         key: String::new(),
-        message: format!("cannot read the file: {e}"),
+        message,
+    };
+    let bytes = limits::read_bounded(path).map_err(err)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        err(format!(
+            "cannot read the file: not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
     })?;
     parse(&text, &label)
 }

@@ -26,8 +26,9 @@ const MAGIC: &str = "segfem checkpoint";
 /// IMPL-EX kink side; 7: the system state is optional (absent in the checkpoint written
 /// before the first step, which is the model's initial state); 8: no Gauss outputs of linear
 /// elastic points (a restart recomputes them from the displacements), and concrete points
-/// keep the softening cut-off's history (`cutoff_max`, `cutoff_max_old`).
-const VERSION: u32 = 8;
+/// keep the softening cut-off's history (`cutoff_max`, `cutoff_max_old`); 9: the
+/// construction stage reached (staged models restart) and the recorder's joint openings.
+const VERSION: u32 = 9;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -43,6 +44,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (6, 17_771_896_231_766_552_362),
     (7, 2_879_888_328_409_885_521),
     (8, 13_423_329_791_089_162_975),
+    (9, 7_976_921_271_131_270_574),
 ];
 
 #[derive(Serialize, Deserialize)]

@@ -5,6 +5,7 @@ pub mod checkpoint;
 pub mod fields;
 pub mod gauss_points;
 pub mod joints;
+pub mod lock;
 pub mod plausibility;
 pub mod prepare;
 pub mod recorder;

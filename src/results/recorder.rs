@@ -48,6 +48,9 @@ pub struct RecorderState {
     pub pvd: Vec<(f64, usize, String)>,
     /// Displacements at the end of the steps some monitor measures from (step, u) [m].
     pub step_end_u: Vec<(usize, Vec<f64>)>,
+    /// Per row: the largest opening of an open joint point [m] and its joint (staged
+    /// models; stages.csv reports it per stage).
+    pub openings: Vec<(f64, Option<usize>)>,
 }
 
 /// Records history and writes outputs into a directory.
@@ -57,8 +60,7 @@ pub struct Recorder<'m> {
     /// Recorded rows.
     pub rows: Vec<Row>,
     /// Per row: the largest opening of an open joint point [m] and its joint (staged models
-    /// only, else (0, None); not a history.csv column and not in the checkpoint, as staged
-    /// runs are not restarted: stages.csv reports it per stage).
+    /// only, else (0, None); not a history.csv column: stages.csv reports it per stage).
     pub openings: Vec<(f64, Option<usize>)>,
     pvd: Vec<(f64, usize, String)>,
     /// Displacements at the end of each step some monitor measures from.
@@ -183,13 +185,19 @@ impl<'m> Recorder<'m> {
             rows: self.rows.clone(),
             pvd: self.pvd.clone(),
             step_end_u,
+            openings: self.openings.clone(),
         }
+    }
+
+    /// Names of the field files results.pvd lists (in the output directory).
+    pub fn field_files(&self) -> impl Iterator<Item = &str> {
+        self.pvd.iter().map(|(_, _, name)| name.as_str())
     }
 
     /// Continue from a saved state (rows and field files recorded before a restart).
     pub fn restore(&mut self, s: RecorderState) {
         self.rows = s.rows;
-        self.openings = vec![(0.0, None); self.rows.len()];
+        self.openings = s.openings;
         self.pvd = s.pvd;
         self.step_end_u = s.step_end_u.into_iter().collect();
         self.history = None;

@@ -158,13 +158,26 @@ pub fn render_csv(stages: &[StageResult]) -> String {
     s
 }
 
-/// The stages before the last one in which a joint opened (construction openings).
-pub fn construction_openings(stages: &[StageResult]) -> impl Iterator<Item = &StageResult> {
-    let n = stages.len();
+/// Smallest joint opening reported as one [m]: 0.01 mm. Creep, shrinkage and round-off
+/// part a closed joint by micrometres (the viaduct's 1.5 µm), which no designer acts on.
+pub const OPENING_THRESHOLD: f64 = 1e-5;
+
+/// Number of construction stages: up to the last stage that places or removes a part; the
+/// stages after it (creep of the finished structure, temperature, traffic) are service.
+pub fn construction_stages(stages: &[StageResult]) -> usize {
     stages
         .iter()
-        .take(n.saturating_sub(1))
-        .filter(|s| s.max_joint_opening > 0.0 && s.joint.is_some())
+        .rposition(|s| !s.activated.is_empty() || !s.removed.is_empty())
+        .map_or(0, |i| i + 1)
+}
+
+/// The construction stages ([`construction_stages`]) in which a joint opened by more than
+/// [`OPENING_THRESHOLD`] (construction openings).
+pub fn construction_openings(stages: &[StageResult]) -> impl Iterator<Item = &StageResult> {
+    stages
+        .iter()
+        .take(construction_stages(stages))
+        .filter(|s| s.max_joint_opening > OPENING_THRESHOLD && s.joint.is_some())
 }
 
 /// A file-name-safe form of a step name: letters, digits, `-` and `_` kept, any other run
@@ -190,6 +203,32 @@ mod tests {
         assert_eq!(file_slug("strike falsework"), "strike-falsework");
         assert_eq!(file_slug(" span 1 / pier (temp) "), "span-1-pier-temp");
         assert_eq!(file_slug("äö"), "");
+    }
+
+    /// Construction ends with the last stage that places or removes a part: an opening in a
+    /// later stage (traffic) is not a construction opening, nor one of a few micrometres.
+    #[test]
+    fn construction_openings_are_those_of_construction_stages_above_the_threshold() {
+        let stage = |step: usize, placed: &[&str], removed: &[&str], opening: f64| StageResult {
+            step,
+            name: format!("s{step}"),
+            activated: placed.iter().map(|s| s.to_string()).collect(),
+            removed: removed.iter().map(|s| s.to_string()).collect(),
+            history_rows: Some((step, step)),
+            max_joint_opening: opening,
+            joint: (opening > 0.0).then(|| "J4".to_string()),
+        };
+        let stages = [
+            stage(1, &["span1"], &[], 2e-5),
+            stage(2, &[], &["falsework"], 1.5e-6),
+            stage(3, &[], &[], 3e-5),
+            stage(4, &["span2"], &[], 0.0),
+            stage(5, &[], &[], 1.5e-6),
+            stage(6, &[], &[], 2e-3),
+        ];
+        assert_eq!(construction_stages(&stages), 4);
+        let steps: Vec<usize> = construction_openings(&stages).map(|s| s.step).collect();
+        assert_eq!(steps, [1, 3]);
     }
 
     #[test]

@@ -522,6 +522,13 @@ pub fn parse_vtu(text: &str, path: &Path) -> Result<Grid, ViewError> {
     if text.contains("<AppendedData") {
         return Err(bad("appended VTK data is not supported"));
     }
+    // A file cut short (a copy interrupted, a disk full) can still hold the points and
+    // cells with the data arrays missing: refused rather than read as a grid without data.
+    if !text.trim_end().ends_with("</VTKFile>") {
+        return Err(bad(
+            "truncated: the file does not end with </VTKFile> (cut short while written or copied?)",
+        ));
+    }
     let header64 = attr(&ha, "header_type") == Some("UInt64");
     let piece_tag = text
         .find("<Piece")
@@ -667,5 +674,11 @@ mod tests {
         assert!(g.is_line(1));
         assert_eq!(g.cell_array("opening").unwrap().values, vec![0.5, 1.5]);
         assert_eq!(g.point_array("displacement").unwrap().components, 3);
+        // Cut anywhere after the cells (the data arrays lost), the file is refused.
+        let cells_end = doc.find("</Cells>").unwrap() + "</Cells>".len();
+        for cut in [cells_end, cells_end + 10, doc.len() - 12] {
+            let e = parse_vtu(&doc[..cut], Path::new("t.vtu")).unwrap_err();
+            assert!(e.to_string().contains("truncated"), "{e}");
+        }
     }
 }

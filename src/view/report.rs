@@ -118,8 +118,23 @@ th{background:#eef2f8}td:first-child,th:first-child{text-align:left}
 figure{margin:12px 0}figure img,figure svg{max-width:100%;height:auto;border:1px solid #ddd}
 figcaption{font-size:14px;color:#555}.note{color:#8a5a00;font-size:14px}.bad{color:#b00}";
 
-/// Key numbers of a history: one table row per factor and monitor column.
-fn key_numbers(h: &Table) -> String {
+/// Unit and scale a report table shows a column of SI unit `unit` in: the design units of
+/// [`super::units::display_unit`] (mm, kN, kN·m, MPa), or SI with `--units si`.
+fn table_unit(unit: &str, units: super::UnitOptions) -> (String, f64) {
+    if units.si {
+        (unit.to_string(), 1.0)
+    } else {
+        let (u, k) = super::units::display_unit(unit);
+        (u.to_string(), k)
+    }
+}
+
+/// Smallest joint opening the events count as an opening [m] (0.01 mm, as the stages'): a
+/// 1.5 µm creep parting was reported as the first opening.
+const OPENING_THRESHOLD: f64 = crate::results::stages::OPENING_THRESHOLD;
+
+/// Key numbers of a history: one table row per factor and monitor column, in design units.
+fn key_numbers(h: &Table, units: super::UnitOptions) -> String {
     let mut s = String::from(
         "<table><tr><th>quantity</th><th>unit</th><th>final</th><th>min</th><th>max</th><th>largest |value|</th><th>at step / increment</th></tr>\n",
     );
@@ -142,15 +157,16 @@ fn key_numbers(h: &Table) -> String {
             (Some(s), Some(i)) => format!("{} / {}", s.values[k], i.values[k]),
             _ => format!("row {}", k + 1),
         };
+        let (unit, f) = table_unit(&c.unit, units);
         let _ = writeln!(
             s,
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             esc(&c.name),
-            esc(&c.unit),
-            num(*c.values.last().expect("not empty")),
-            num(min),
-            num(max),
-            num(big),
+            esc(&unit),
+            num(f * c.values.last().expect("not empty")),
+            num(f * min),
+            num(f * max),
+            num(f * big),
             at
         );
     }
@@ -162,7 +178,7 @@ fn key_numbers(h: &Table) -> String {
 /// that grows most): the first joint opening (first row where a monitor named
 /// `*opening*` becomes positive), the largest opening, the tendon stress increase
 /// (`*tendon_stress*` monitors, last minus first value) and the decompression bracket.
-fn events(h: &Table) -> String {
+fn events(h: &Table, units: super::UnitOptions) -> String {
     let Some(load) = h
         .factors()
         .chain(h.monitors().filter(|c| c.unit == "-"))
@@ -177,39 +193,55 @@ fn events(h: &Table) -> String {
         return String::new();
     };
     let mut items = Vec::new();
+    // A load factor with its load case's name, e.g. `Q` for `factor:Q`.
+    let load_name = load.name.strip_prefix("factor:").unwrap_or(&load.name);
     for c in h.monitors().filter(|c| c.name.contains("opening")) {
-        if let Some(k) = c.values.iter().position(|v| *v > 0.0) {
+        let (unit, f) = table_unit(&c.unit, units);
+        // In metres (the opening monitors' unit) the threshold applies; other units as given.
+        let threshold = if c.unit == "m" {
+            OPENING_THRESHOLD
+        } else {
+            0.0
+        };
+        if let Some(k) = c.values.iter().position(|v| *v > threshold) {
             let before = if k > 0 {
                 format!(" (closed at {})", num(load.values[k - 1]))
             } else {
                 String::new()
             };
             items.push(format!(
-                "first opening ({}): {} = {}{before}",
+                "first opening above {} mm ({}): {} = {}{before}",
+                OPENING_THRESHOLD * 1e3,
                 esc(&c.name),
-                esc(&load.name),
+                esc(load_name),
                 num(load.values[k])
             ));
             let max = c.values.iter().copied().fold(0.0, f64::max);
             items.push(format!(
                 "largest {}: {} {}",
                 esc(&c.name),
-                num(max),
-                esc(&c.unit)
+                num(f * max),
+                esc(&unit)
             ));
         } else {
-            items.push(format!("{}: no opening in this run", esc(&c.name)));
+            items.push(format!(
+                "{}: no opening above {} mm in this run",
+                esc(&c.name),
+                OPENING_THRESHOLD * 1e3
+            ));
         }
     }
     for c in h.monitors().filter(|c| c.name.contains("tendon_stress")) {
         if let (Some(first), Some(last)) = (c.values.iter().find(|v| **v != 0.0), c.values.last()) {
+            let (unit, f) = table_unit(&c.unit, units);
             items.push(format!(
-                "{}: {} → {} {} (increase {})",
+                "{}: {} → {} {} (increase {} {})",
                 esc(&c.name),
-                num(*first),
-                num(*last),
-                esc(&c.unit),
-                num(last - first)
+                num(f * first),
+                num(f * last),
+                esc(&unit),
+                num(f * (last - first)),
+                esc(&unit)
             ));
         }
     }
@@ -386,7 +418,12 @@ fn stages_section(dir: &Path) -> String {
         );
     }
     if !any {
-        s.push_str("<p id=\"stage-openings\">No joint opens during construction (the stages before the last).</p>\n");
+        let n = crate::results::stages::construction_stages(&stages);
+        let _ = writeln!(
+            s,
+            "<p id=\"stage-openings\">No joint opens by more than {} mm during construction (stages 1–{n}, up to the last that places or removes a part; later stages are service).</p>",
+            crate::results::stages::OPENING_THRESHOLD * 1e3
+        );
     }
     if let Some(fig) = StageFigure::new(&stages) {
         match svg_string(&fig) {
@@ -440,9 +477,9 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         html,
         "<h2>Key numbers of the history ({} converged increments)</h2>\n{}",
         h.rows(),
-        key_numbers(&h)
+        key_numbers(&h, opts.units)
     );
-    html.push_str(&events(&h));
+    html.push_str(&events(&h, opts.units));
     // The peak of the load the curve shows (its first y column), by magnitude.
     let load_name = match opts.y.as_ref() {
         Some(y) => y.clone(),
@@ -459,10 +496,12 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         let kinds = super::units::kinds(&opts.dir);
         let kind = kinds.iter().find(|(n, _)| *n == load.name).map(|(_, k)| k);
         let shown = super::units::shown(&load.name, &load.unit, kind, &load.values, opts.units);
-        let what = if load.unit == "-" {
-            "Peak load factor"
-        } else {
-            "Peak load"
+        // Only a load is called one: a deflection or a stress on the curve's y axis is its
+        // largest magnitude ("Peak load: deflection_Q = 122.4 mm" named a deflection a load).
+        let what = match load.unit.as_str() {
+            "-" => "Peak load factor",
+            "N" | "N·m" => "Peak load",
+            _ => "Largest magnitude on the curve",
         };
         let _ = writeln!(
             html,

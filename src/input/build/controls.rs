@@ -1,6 +1,5 @@
 //! `[analysis]` (geometry) and `[solver]` (tolerances and limits of the Newton iterations).
 
-use super::fields::positive;
 use super::R;
 use crate::elements::continuum::Integration;
 use crate::input::error::Ctx;
@@ -36,15 +35,63 @@ pub(super) fn geometry(ctx: &Ctx, analysis: Option<&AnalysisIn>, model: &mut Mod
     Ok(())
 }
 
+/// Range of `solver.force_tolerance` [-]: a relative residual of 1e-14 is at round-off of
+/// the sums (double precision over thousands of terms); 0.1 leaves a tenth of the forces
+/// unbalanced.
+const FORCE_TOLERANCE: (f64, f64) = (1e-14, 0.1);
+/// Range of `solver.energy_tolerance` [-]: a ratio of energies, quadratic in the
+/// correction (1e-2: the last correction a tenth of the first).
+const ENERGY_TOLERANCE: (f64, f64) = (1e-30, 1e-2);
+/// Range of `solver.implex_tolerance` [-], a fraction of f_tm: an error above f_tm is no
+/// control.
+const IMPLEX_TOLERANCE: (f64, f64) = (1e-6, 1.0);
+
+/// `v` if it lies in `range` (inclusive), else an error naming the range and `what` the
+/// tolerance bounds.
+fn in_range(ctx: &Ctx, key: &str, v: f64, range: (f64, f64), what: &str) -> R<f64> {
+    if v >= range.0 && v <= range.1 {
+        Ok(v)
+    } else {
+        Err(ctx.err(
+            key,
+            format!(
+                "must lie between {:e} and {:e} (got {}): the bound {what}; outside it every increment converges at once or none can",
+                range.0,
+                range.1,
+                if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+                    v.to_string()
+                } else {
+                    format!("{v:e}")
+                }
+            ),
+        ))
+    }
+}
+
 /// `[solver]`: override the default convergence tolerances and limits.
 pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) -> R<()> {
     if let Some(sv) = solver {
         let c = &mut model.controls;
+        // Tolerances outside these ranges cannot be meant: above them every increment
+        // "converges" with residuals of the order of the forces (a verdict that means
+        // nothing); below them the residual is under round-off and no increment converges.
         if let Some(v) = sv.force_tolerance {
-            c.force_tolerance = positive(ctx, "solver.force_tolerance", v)?;
+            c.force_tolerance = in_range(
+                ctx,
+                "solver.force_tolerance",
+                v,
+                FORCE_TOLERANCE,
+                "of the residual relative to the forces",
+            )?;
         }
         if let Some(v) = sv.energy_tolerance {
-            c.energy_tolerance = positive(ctx, "solver.energy_tolerance", v)?;
+            c.energy_tolerance = in_range(
+                ctx,
+                "solver.energy_tolerance",
+                v,
+                ENERGY_TOLERANCE,
+                "of the last correction's energy relative to the first's",
+            )?;
         }
         if let Some(v) = sv.max_iterations {
             if v > limits::MAX_ITERATIONS {
@@ -69,7 +116,13 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
             c.max_cuts = v;
         }
         if let Some(v) = sv.implex_tolerance {
-            c.implex_tolerance = Some(positive(ctx, "solver.implex_tolerance", v)?);
+            c.implex_tolerance = Some(in_range(
+                ctx,
+                "solver.implex_tolerance",
+                v,
+                IMPLEX_TOLERANCE,
+                "of the crack stress error relative to f_tm",
+            )?);
         }
         if let Some(v) = sv.increment_tolerance {
             c.increment_tolerance = Some(super::time::error_tolerance(

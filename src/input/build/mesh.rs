@@ -3,7 +3,7 @@
 
 use super::fields::{index_by_name, positive};
 use super::R;
-use crate::elements::continuum::{min_jacobian, Integration};
+use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
 use crate::fem::shape::QuadKind;
 use crate::input::error::Ctx;
 use crate::input::schema::MeshIn;
@@ -222,6 +222,9 @@ fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
         if !(p[0].is_finite() && p[1].is_finite()) {
             return Err(ctx.err(format!("mesh.nodes[{i}]"), "coordinates must be finite"));
         }
+        if let Some(m) = limits::bad_coordinates(*p) {
+            return Err(ctx.err(format!("mesh.nodes[{i}]"), m));
+        }
     }
     let nn = mesh.nodes.len();
     let n_el: usize = mesh.blocks.iter().map(|b| b.elements.len()).sum();
@@ -286,6 +289,9 @@ fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                     &key,
                     format!("element is inverted or degenerate (smallest det J = {detj:.3e}); list nodes counter-clockwise, corners first"),
                 ));
+            }
+            if let Some(f) = fold(kind, &coords) {
+                return Err(ctx.err(&key, fold_message(f)));
             }
             elements.push(Element {
                 kind,
@@ -393,6 +399,12 @@ pub(super) fn check_generated(
         return Err(ctx.err(
             "mesh",
             format!("generated node coordinates overflow ({p:?}): the lengths, depths or origin are too large (metres)"),
+        ));
+    }
+    if let Some(m) = nodes.iter().find_map(|&p| limits::bad_coordinates(p)) {
+        return Err(ctx.err(
+            "mesh",
+            format!("generated node {m}: the lengths, depths or origin are too large"),
         ));
     }
     let size = limits::extent(nodes);

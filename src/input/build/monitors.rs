@@ -9,6 +9,9 @@ use crate::model::{
     Bar, Extreme, LossPart, Model, Monitor, MonitorKind, StressComponent, TendonEl,
 };
 
+/// Columns of history.csv before the monitors, without their units.
+const RESERVED: &[&str] = &["step", "increment", "iterations", "time"];
+
 /// The monitors, resolved against the supports, load cases, tendons, joints, bars and steps.
 pub(super) fn build(ctx: &Ctx, file: &File, model: &mut Model, used: &[bool]) -> R<()> {
     unique_names(
@@ -17,6 +20,20 @@ pub(super) fn build(ctx: &Ctx, file: &File, model: &mut Model, used: &[bool]) ->
         file.monitors.iter().map(|m| m.name.as_str()),
     )?;
     for (i, m) in file.monitors.iter().enumerate() {
+        // The history's own columns (`step`, `increment`, `iterations`, `time [d]`,
+        // `factor:<case> [-]`) read without their units (`time`, as Python and the plots
+        // name them): a monitor of one of these names would head a second column of that
+        // name.
+        let bare = m.name.split(" [").next().unwrap_or("").trim();
+        if RESERVED.contains(&bare) || bare.starts_with("factor:") || m.name.contains('[') {
+            return Err(ctx.err(
+                format!("monitors[{i}].name"),
+                format!(
+                    "'{}' is a column history.csv already has (step, increment, iterations, time [d], factor:<case> [-]) or holds '[' (the column's unit follows in brackets); choose another name",
+                    m.name
+                ),
+            ));
+        }
         let kind = monitor(ctx, i, m, file, model, used)?;
         model.monitors.push(Monitor {
             name: m.name.clone(),

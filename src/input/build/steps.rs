@@ -2,6 +2,10 @@
 //! factors are totals carried from step to step.
 
 use super::fields::{dir, index_by_name, locate_nodes, positive, unique_names};
+
+/// Longest step name accepted [characters]: 4 bytes per character at most, 4 × 50 = 200
+/// bytes, leaves room in a 255-byte file name for the prefix and suffix of field files.
+const MAX_NAME_CHARS: usize = 50;
 use super::time::time_span;
 use super::R;
 use crate::input::error::Ctx;
@@ -15,6 +19,21 @@ pub(super) fn build(ctx: &Ctx, list: &[StepIn], model: &mut Model, used: &[bool]
         return Err(ctx.err("steps", "no steps given: add at least one [[steps]] table"));
     }
     unique_names(ctx, "steps", list.iter().map(|s| s.name.as_str()))?;
+    // The name becomes part of the field files' names in a staged run (limit 255 bytes on
+    // most file systems, with about 40 of prefix and suffix) and a report's headings.
+    if let Some((i, s)) = list
+        .iter()
+        .enumerate()
+        .find(|(_, s)| s.name.chars().count() > MAX_NAME_CHARS)
+    {
+        return Err(ctx.err(
+            format!("steps[{i}].name"),
+            format!(
+                "{} characters, more than {MAX_NAME_CHARS}: the name goes into file names and headings; shorten it",
+                s.name.chars().count()
+            ),
+        ));
+    }
     let linear = model.materials.iter().all(|m| m.law.is_linear());
     let mut factors = vec![0.0; model.load_cases.len()];
     // End of the last time step [d] (None before the first one).

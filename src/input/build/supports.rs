@@ -27,6 +27,8 @@ pub(super) fn build(
             "no supports given: the structure would be a mechanism",
         ));
     }
+    // The support, and value [m], that first prescribed each dof (node, direction).
+    let mut prescribed: HashMap<(usize, usize), (usize, f64)> = HashMap::new();
     for (i, s) in list.iter().enumerate() {
         let key = format!("supports[{i}]");
         for (name, v) in [("ux", s.ux), ("uy", s.uy)] {
@@ -59,6 +61,23 @@ pub(super) fn build(
         }
         if s.ux.is_none() && s.uy.is_none() {
             return Err(ctx.err(&key, "restrains nothing: give ux and/or uy (0.0 = fixed)"));
+        }
+        // Two supports may hold one dof (a falsework under a bearing) only at one value:
+        // otherwise which one acts would depend on their order.
+        for &(n, d, v) in &dofs {
+            let (first, was) = *prescribed.entry((n, d.index())).or_insert((i, v));
+            if first != i && was != v {
+                let c = if d.index() == 0 { "ux" } else { "uy" };
+                let [x, y] = model.nodes[n];
+                return Err(ctx.err(
+                    format!("{key}.{c}"),
+                    format!(
+                        "{c} = {v:.3e} m at node {} ({x}, {y}), which supports[{first}] ('{}') holds at {c} = {was:.3e} m: a displacement takes one prescribed value",
+                        n + 1,
+                        list[first].name
+                    ),
+                ));
+            }
         }
         if let Some(z) = bearing_zone(ctx, &key, s, model, &dofs)? {
             zones.push(z);
