@@ -1064,6 +1064,7 @@ fn reinforced_strip(ft_weak: f64) -> String {
                 r#"[[materials]]
 name = "weak"
 kind = "concrete"
+crack_integration = "implicit"
 creep = "mc90"
 fcm = 45e6
 ftm = {ft_weak}

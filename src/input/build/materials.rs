@@ -743,8 +743,10 @@ fn concrete_overrides(
             }
         };
     }
-    if let Some(v) = &m.crack_integration {
-        p.implex = match v.as_str() {
+    // IMPL-EX by default (docs/theory-concrete.md §5.2, "The default"): with the implicit
+    // update the seed beam and the RC example stall soon after cracking.
+    if let Some(v) = m.crack_integration.as_deref().or(Some("implex")) {
+        p.implex = match v {
             "implicit" => false,
             "implex" => true,
             _ => {

@@ -111,6 +111,7 @@ pub fn panel_toml(p: &Panel, keys: &str, n: usize) -> String {
 name = "c"
 kind = "concrete"
 fcm = {fcm}
+crack_integration = "implicit"
 {keys}{agg}
 [[materials]]
 name = "sx"
