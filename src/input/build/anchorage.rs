@@ -20,6 +20,34 @@ pub const STRAND_AREA: f64 = 140e-6;
 /// pressure under the jacking force near 25–30 MPa.
 pub const PLATE_SIDE_PER_ROOT_STRAND: f64 = 0.085;
 
+/// The `bearing` key of a point load or support at `key`: None for none (or 0), when its
+/// `local_zone` must not be given either (`under` says where the zone would be: "under",
+/// "over"); else the bearing length [m], > 0 and finite.
+pub(super) fn bearing_length(
+    ctx: &crate::input::error::Ctx,
+    key: &str,
+    bearing: Option<f64>,
+    local_zone: Option<bool>,
+    under: &str,
+) -> super::R<Option<f64>> {
+    match bearing {
+        None | Some(0.0) => {
+            if local_zone.is_some() {
+                return Err(ctx.err(
+                    format!("{key}.local_zone"),
+                    format!("only with a bearing (the local zone is the concrete {under} it)"),
+                ));
+            }
+            Ok(None)
+        }
+        Some(b) if b.is_finite() && b > 0.0 => Ok(Some(b)),
+        Some(b) => Err(ctx.err(
+            format!("{key}.bearing"),
+            format!("must be a bearing length ≥ 0 in m (got {b})"),
+        )),
+    }
+}
+
 /// Default anchor plate [m] of a tendon of steel area `area` [m²]: n = ⌈area / 140 mm²⌉
 /// 0.6" strands, side 0.085 m × √n ([`PLATE_SIDE_PER_ROOT_STRAND`]).
 pub fn default_plate(area: f64) -> f64 {

@@ -110,23 +110,9 @@ fn bearing(
     n: usize,
     zones: &mut Vec<LocalZone>,
 ) -> R<Option<Vec<(usize, f64)>>> {
-    let b = match p.bearing {
-        None | Some(0.0) => {
-            if p.local_zone.is_some() {
-                return Err(ctx.err(
-                    format!("{key}.local_zone"),
-                    "only with a bearing (the local zone is the concrete under it)",
-                ));
-            }
-            return Ok(None);
-        }
-        Some(b) if b.is_finite() && b > 0.0 => b,
-        Some(b) => {
-            return Err(ctx.err(
-                format!("{key}.bearing"),
-                format!("must be a bearing length ≥ 0 in m (got {b})"),
-            ))
-        }
+    let Some(b) = super::anchorage::bearing_length(ctx, key, p.bearing, p.local_zone, "under")?
+    else {
+        return Ok(None);
     };
     let f = p.force[0].hypot(p.force[1]);
     if f == 0.0 {

@@ -100,23 +100,9 @@ fn bearing_zone(
     model: &Model,
     dofs: &[(usize, Dir, f64)],
 ) -> R<Option<LocalZone>> {
-    let b = match s.bearing {
-        None | Some(0.0) => {
-            if s.local_zone.is_some() {
-                return Err(ctx.err(
-                    format!("{key}.local_zone"),
-                    "only with a bearing (the local zone is the concrete over it)",
-                ));
-            }
-            return Ok(None);
-        }
-        Some(b) if b.is_finite() && b > 0.0 => b,
-        Some(b) => {
-            return Err(ctx.err(
-                format!("{key}.bearing"),
-                format!("must be a bearing length ≥ 0 in m (got {b})"),
-            ))
-        }
+    let Some(b) = super::anchorage::bearing_length(ctx, key, s.bearing, s.local_zone, "over")?
+    else {
+        return Ok(None);
     };
     if s.line.is_some() || s.group.is_some() {
         return Err(ctx.err(
