@@ -682,3 +682,28 @@ fn sustained_stress_above_linear_creep_warns() {
     assert_eq!(code(&o), 0, "{err}");
     assert!(!err.contains("linear creep range"), "{err}");
 }
+
+/// The report says how sure the path is when an increment error control ran: the plain beam
+/// with `[solver] increment_tolerance` shows the largest kept path error and the pairs
+/// rejected, as summary.json gives them, and the error kept is a fraction (0 < e < 1).
+#[test]
+fn report_states_the_estimated_path_error() {
+    let tmp = TempDir::new("probe-path-error");
+    let text = plain_beam(10, "increment_tolerance = 0.05");
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert!(matches!(code(&o), 0 | 3), "{}", stderr(&o));
+    let t = &summary(&tmp.join("out"))["timings"];
+    let e = t["increment_max_error"]
+        .as_f64()
+        .expect("a path error estimated");
+    assert!(e > 0.0 && e < 1.0, "{t}");
+    let o = segfem(tmp.path(), &["report", "out"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let html = read(&tmp.join("out/report.html"));
+    assert!(
+        html.contains("estimated path error (increment_tolerance)")
+            && html.contains(&format!("largest kept {e:.3}")),
+        "no path-error row"
+    );
+}

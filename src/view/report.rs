@@ -353,6 +353,25 @@ fn summary_section(dir: &Path) -> (String, String) {
     if let Some(w) = v["wall_s"].as_f64() {
         row("wall time [s]", format!("{w:.3}"));
     }
+    // How sure the path is: the error estimates of the increment controls that ran.
+    if let Some(e) = t["increment_max_error"].as_f64() {
+        row(
+            "estimated path error (increment_tolerance)",
+            format!(
+                "largest kept {e:.3} of the displacement change over a pair; {} pairs rejected",
+                t["increments_rejected"].as_u64().unwrap_or(0)
+            ),
+        );
+    }
+    if let Some(e) = t["implex_max_error"].as_f64() {
+        row(
+            "IMPL-EX error (implex_tolerance)",
+            format!(
+                "largest kept {e:.3} f_tm; {} increments cut for it",
+                t["implex_cuts"].as_u64().unwrap_or(0)
+            ),
+        );
+    }
     if let Some(m) = v["peak_memory_bytes"].as_f64() {
         row("peak memory [MiB]", format!("{:.1}", m / 1048576.0));
     }
