@@ -881,3 +881,60 @@ fn the_peak_line_calls_only_a_load_a_load() {
         assert!(line.ends_with(&format!(" {unit}")), "{line}");
     }
 }
+
+/// Issue 40 item 7: of more joints than a page holds, the diagrams draw the most stressed
+/// by rank, never the first few along the model. Twelve joints: J1…J10 with contact
+/// stresses 1, 1.5, …, 5.5 MPa and no opening, J11 the only one that opens (2 mm, no
+/// contact), J12 the largest contact stress (20 MPa). The eight most stressed are J11 and
+/// J12 (each leads its own measure) and the six largest contact stresses of the rest,
+/// J5…J10; four are hidden, which the title and a note say.
+#[test]
+fn joint_diagrams_draw_the_most_stressed_joints() {
+    let profile = |k: usize, open: f64, stress: f64| segfem::view::figures::JointProfile {
+        name: format!("joint J{k}"),
+        points: vec![(0.0, 0.0, stress), (1.0, open, 0.0)],
+    };
+    let mut joints: Vec<segfem::view::figures::JointProfile> = (1..=10)
+        .map(|k| profile(k, 0.0, 1.0 + 0.5 * (k - 1) as f64))
+        .collect();
+    joints.push(profile(11, 2.0, 0.0));
+    joints.push(profile(12, 0.0, 20.0));
+    let mut notes = Vec::new();
+    let fig = view::joint_figure(joints, "test", &mut notes).expect("a figure");
+    let names: Vec<&str> = fig.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "joint J5",
+            "joint J6",
+            "joint J7",
+            "joint J8",
+            "joint J9",
+            "joint J10",
+            "joint J11",
+            "joint J12"
+        ]
+    );
+    assert!(
+        fig.title.contains("8 most stressed of 12 joints"),
+        "{}",
+        fig.title
+    );
+    assert!(fig.title.contains("4 hidden"), "{}", fig.title);
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.starts_with("joint diagrams:") && n.contains("4 hidden")),
+        "{notes:?}"
+    );
+    // It renders.
+    let png = segfem::view::figures::png_bytes(&fig).unwrap();
+    assert!(png.len() > 1000);
+    // Eight or fewer: every joint, no note.
+    let few: Vec<segfem::view::figures::JointProfile> =
+        (1..=3).map(|k| profile(k, 0.0, k as f64)).collect();
+    let mut notes = Vec::new();
+    let fig = view::joint_figure(few, "test", &mut notes).unwrap();
+    assert_eq!(fig.joints.len(), 3);
+    assert!(notes.is_empty() && !fig.title.contains("hidden"));
+}

@@ -446,19 +446,34 @@ macro_rules! model_chart {
     }};
 }
 
+/// Height of a title band [px]: [`TITLE_H`] for one line, 24 px more per further line
+/// (a title's lines are separated by `\n`; a note under the title, such as the joints
+/// hidden, gets its own line rather than running off the edge).
+fn title_h(title: &str) -> u32 {
+    TITLE_H + TITLE_LINE_H * (title.lines().count().max(1) as u32 - 1)
+}
+
+/// Height of each further title line [px].
+const TITLE_LINE_H: u32 = 24;
+
 fn title_area<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
 ) -> Result<DrawingArea<DB, Shift>, String> {
-    let (top, rest) = root.split_vertically(TITLE_H);
+    let (top, rest) = root.split_vertically(title_h(title));
     let (w, _) = top.dim_in_pixel();
-    let style = TextStyle::from((FONT, 20).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
-    top.draw(&Text::new(
-        title.to_string(),
-        (w as i32 / 2, TITLE_H as i32 / 2 + 4),
-        style,
-    ))
-    .map_err(de)?;
+    for (i, line) in title.lines().enumerate() {
+        // The first line as before; further lines smaller, one below the other.
+        let (size, y) = if i == 0 {
+            (20, TITLE_H as i32 / 2 + 4)
+        } else {
+            (16, (TITLE_H + TITLE_LINE_H * i as u32) as i32 - 6)
+        };
+        let style =
+            TextStyle::from((FONT, size).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+        top.draw(&Text::new(line.to_string(), (w as i32 / 2, y), style))
+            .map_err(de)?;
+    }
     Ok(rest)
 }
 
@@ -1069,7 +1084,7 @@ impl Figure for JointFigure {
     fn size(&self) -> (u32, u32) {
         (
             1000,
-            TITLE_H + JOINT_ROW_H * self.joints.len().max(1) as u32,
+            title_h(&self.title) + JOINT_ROW_H * self.joints.len().max(1) as u32,
         )
     }
 
