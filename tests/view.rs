@@ -938,3 +938,97 @@ fn joint_diagrams_draw_the_most_stressed_joints() {
     assert_eq!(fig.joints.len(), 3);
     assert!(notes.is_empty() && !fig.title.contains("hidden"));
 }
+
+/// Issue 40 item 7: the mesh legend fits. Staged copies of a region (`webs@S1`, named
+/// `R@S` by the construction-stage generator) are one entry under the base name, and a
+/// legend too long for one row wraps: every label ends inside the figure.
+#[test]
+fn mesh_legend_groups_staged_copies_and_wraps() {
+    use view::data::{Array, Grid};
+    // n unit Q4 cells in a row, cell k in region k.
+    let grid = |n: usize| {
+        let mut points = Vec::new();
+        for k in 0..=n {
+            points.push([k as f64, 0.0]);
+            points.push([k as f64, 1.0]);
+        }
+        Grid {
+            path: PathBuf::from("mem.vtu"),
+            points,
+            cells: (0..n)
+                .map(|k| vec![2 * k, 2 * k + 2, 2 * k + 3, 2 * k + 1])
+                .collect(),
+            types: vec![9; n],
+            point_data: Vec::new(),
+            cell_data: vec![Array {
+                name: "region".into(),
+                components: 1,
+                values: (0..n).map(|k| k as f64).collect(),
+            }],
+        }
+    };
+    // The viaduct's naming: three base regions, then their copies per segment.
+    let mut names: Vec<String> = vec!["slab".into(), "webs".into(), "deck".into()];
+    for s in 1..=4 {
+        for b in ["slab", "webs", "deck"] {
+            names.push(format!("{b}@S{s}"));
+        }
+    }
+    let g = grid(names.len());
+    let legend = view::figures::region_legend(&g, &names);
+    let labels: Vec<&str> = legend.iter().map(|l| l.1.as_str()).collect();
+    assert_eq!(
+        labels,
+        ["slab (5 regions)", "webs (5 regions)", "deck (5 regions)"]
+    );
+    // One colour per base name: the three colour indices differ.
+    assert!(legend[0].0 != legend[1].0 && legend[1].0 != legend[2].0 && legend[0].0 != legend[2].0);
+
+    // 40 distinct regions with 30-character names on a 40 m model: cannot fit one row.
+    let names: Vec<String> = (0..40)
+        .map(|k| format!("region_with_a_long_name_{k:06}"))
+        .collect();
+    let g = grid(names.len());
+    let fig = view::figures::MeshFigure {
+        grid: &g,
+        regions: names.clone(),
+        title: "t".into(),
+    };
+    // The same model with one legend entry (all staged copies of one region).
+    let one = view::figures::MeshFigure {
+        grid: &g,
+        regions: (0..40).map(|k| format!("a@S{k}")).collect(),
+        title: "t".into(),
+    };
+    let (w, h) = view::figures::Figure::size(&fig);
+    let svg = view::figures::svg_string(&fig).unwrap();
+    // Every label drawn, each ending inside the figure: its x plus its width at 14 px
+    // DejaVu Sans (under 0.62 em a character for these glyphs) within the width.
+    for n in &names {
+        let at = svg
+            .find(&format!(">\n{n}\n<"))
+            .unwrap_or_else(|| panic!("{n} not drawn"));
+        let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+        let x: f64 = tag
+            .split("x=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(
+            x + 0.62 * 14.0 * n.len() as f64 <= w as f64,
+            "{n} at x = {x} passes {w} px"
+        );
+    }
+    // The rows the labels need at least, added below the drawing (28 px a row).
+    let min_rows = (40.0 * (0.55 * 14.0 * 30.0) / w as f64).ceil() as u32;
+    let h_unnamed = view::figures::Figure::size(&one).1;
+    assert!(min_rows >= 2, "the test needs a wrapped legend");
+    assert!(
+        h >= h_unnamed + 28 * (min_rows - 1) - 28,
+        "{h} vs {h_unnamed}, {min_rows} rows"
+    );
+}
