@@ -992,12 +992,14 @@ fn mesh_legend_groups_staged_copies_and_wraps() {
     let fig = view::figures::MeshFigure {
         grid: &g,
         regions: names.clone(),
+        tendons: Vec::new(),
         title: "t".into(),
     };
     // The same model with one legend entry (all staged copies of one region).
     let one = view::figures::MeshFigure {
         grid: &g,
         regions: (0..40).map(|k| format!("a@S{k}")).collect(),
+        tendons: Vec::new(),
         title: "t".into(),
     };
     let (w, h) = view::figures::Figure::size(&fig);
@@ -1031,4 +1033,55 @@ fn mesh_legend_groups_staged_copies_and_wraps() {
         h >= h_unnamed + 28 * (min_rows - 1) - 28,
         "{h} vs {h_unnamed}, {min_rows} rows"
     );
+}
+
+/// Issue 40 item 7: the external tendon is drawn in the mesh figure, as its legend says.
+/// The seed beam (elastic) after prestress: its tendon runs through (0, 0.30), (2.4, 0.10),
+/// (4.8, 0.10), (7.2, 0.30) m (examples/seed-beam-elastic.toml). The spans read from the
+/// results lie on that profile and cover it end to end; the figure draws each span in the
+/// tendon colour and names it in the legend.
+#[test]
+fn mesh_figure_draws_the_external_tendon() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam-elastic.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(2).unwrap().0;
+    let dir = tmp("tendon-drawn");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let (_, output) = view::pick_output(&out, None).unwrap();
+    let spans = output.tendon_spans().unwrap();
+    assert!(!spans.is_empty(), "no tendon spans read");
+    let profile = [[0.0, 0.30], [2.4, 0.10], [4.8, 0.10], [7.2, 0.30]];
+    let on_profile = |p: [f64; 2]| {
+        profile.windows(2).any(|w| {
+            let (a, b) = (w[0], w[1]);
+            let t = (p[0] - a[0]) / (b[0] - a[0]);
+            // 1e-9 m: nodes are placed on the profile up to round-off.
+            (-1e-12..=1.0 + 1e-12).contains(&t) && (a[1] + t * (b[1] - a[1]) - p[1]).abs() < 1e-9
+        })
+    };
+    for s in &spans {
+        assert!(
+            on_profile(s[0]) && on_profile(s[1]),
+            "span {s:?} off the profile"
+        );
+    }
+    // End to end: the span lengths add up to the profile's (round-off only).
+    let len = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
+    let drawn: f64 = spans.iter().map(|s| len(s[0], s[1])).sum();
+    let want: f64 = profile.windows(2).map(|w| len(w[0], w[1])).sum();
+    assert!((drawn - want).abs() < 1e-9, "{drawn} m drawn of {want} m");
+    // The figure: one tendon-coloured line per span, plus the legend's sample.
+    view::plot(&PlotOptions {
+        dir: out.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    let svg = std::fs::read_to_string(out.join("figures/mesh.svg")).unwrap();
+    assert_eq!(svg.matches("stroke=\"#00783C\"").count(), spans.len() + 1);
+    assert!(svg.contains("\ntendons\n") && svg.contains("\njoints\n"));
+    assert!(!svg.contains("joints, tendons"));
 }

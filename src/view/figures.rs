@@ -477,6 +477,10 @@ fn title_area<DB: DrawingBackend>(
     Ok(rest)
 }
 
+/// Colour of tendon spans in the mesh figure (dark green: apart from the red joints and
+/// the pastel regions).
+const TENDON: RGBColor = RGBColor(0, 120, 60);
+
 /// Pastel fill colours for regions.
 const REGION_FILL: [RGBColor; 6] = [
     RGBColor(190, 210, 235),
@@ -500,12 +504,16 @@ fn pts(grid: &Grid, idx: &[usize], disp: Option<&[[f64; 2]]>, scale: f64) -> Vec
 }
 
 /// The undeformed mesh, cells filled by region (a legend names each region's colour); line
-/// cells (joints, tendons) in red.
+/// cells of the grid (joints) in red, tendon spans in dark green over them.
 pub struct MeshFigure<'g> {
     /// Grid.
     pub grid: &'g Grid,
     /// Region names by index (summary.json `regions`); `region k` where missing.
     pub regions: Vec<String>,
+    /// Tendon spans, each from one end (x, y) [m] to the other ([`Output::tendon_spans`]).
+    ///
+    /// [`Output::tendon_spans`]: super::data::Output::tendon_spans
+    pub tendons: Vec<[[f64; 2]; 2]>,
     /// Title.
     pub title: String,
 }
@@ -553,6 +561,15 @@ impl Figure for MeshFigure<'_> {
                 ])
                 .map_err(de)?;
         }
+        // Tendons last, over the cells and joints they cross.
+        chart
+            .draw_series(self.tendons.iter().map(|t| {
+                PathElement::new(
+                    vec![(t[0][0], t[0][1]), (t[1][0], t[1][1])],
+                    TENDON.stroke_width(2),
+                )
+            }))
+            .map_err(de)?;
         // The legend, in a strip below the drawing (never over the mesh), wrapped into as
         // many rows as it needs: a swatch per region group present, and the line cells.
         let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
@@ -593,7 +610,10 @@ impl MeshFigure<'_> {
             .map(|(r, name)| (name, REGION_FILL[r % REGION_FILL.len()], false))
             .collect();
         if (0..g.cells.len()).any(|i| g.is_line(i)) {
-            entries.push(("joints, tendons".into(), RED, true));
+            entries.push(("joints".into(), RED, true));
+        }
+        if !self.tendons.is_empty() {
+            entries.push(("tendons".into(), TENDON, true));
         }
         entries
     }

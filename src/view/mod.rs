@@ -655,6 +655,7 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         &MeshFigure {
             grid: &g,
             regions: units::region_names(&opts.dir),
+            tendons: output.tendon_spans()?,
             title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
         },
         &out_dir,

@@ -581,7 +581,8 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
             let joints = super::output_joint_profiles(&output, &g, &opts.dir)?;
             let from_points = output.joint_points.is_some();
             let has_joints = super::expects_joints(&g, &opts.dir);
-            fields_section(&mut html, &opts.dir, &g, &tag, &mut notes)?;
+            let tendons = output.tendon_spans()?;
+            fields_section(&mut html, &opts.dir, &g, tendons, &tag, &mut notes)?;
             joints_section(&mut html, joints, from_points, has_joints, &tag, &mut notes)?;
         }
         Err(e) if opts.step.is_none() => notes.push(format!("model drawings: skipped ({e})")),
@@ -610,15 +611,21 @@ fn fields_section(
     html: &mut String,
     dir: &Path,
     g: &Grid,
+    tendons: Vec<[[f64; 2]; 2]>,
     tag: &str,
     notes: &mut Vec<String>,
 ) -> Result<(), ViewError> {
     let mesh = MeshFigure {
         grid: g,
         regions: super::units::region_names(dir),
+        tendons,
         title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
     };
-    figure(html, &png_bytes(&mesh)?, "Mesh, cells coloured by region");
+    figure(
+        html,
+        &png_bytes(&mesh)?,
+        "Mesh, cells coloured by region, joints in red, tendons in green",
+    );
     let disp = displacements(g);
     let scale = auto_scale(g, &disp);
     let def = DeformedFigure {
