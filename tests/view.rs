@@ -137,7 +137,8 @@ fn plot_writes_valid_figures_with_the_history_data() {
     let (ix, iy) = (col(&header, "midspan_uy"), col(&header, "Q ["));
     let curves = o.curves.unwrap();
     assert_eq!(curves.x_label, "midspan_uy, down [mm]");
-    assert_eq!(curves.y_label, "Q [-]");
+    // Q: two point loads of 1 kN (examples/box-beam.toml), 2 kN in total per unit factor.
+    assert_eq!(curves.y_label, "Q [× 2 kN total]");
     let expected: Vec<(f64, f64)> = rows.iter().map(|r| (-1e3 * r[ix], r[iy])).collect();
     assert_eq!(curves.series.len(), 1);
     assert_eq!(curves.series[0].points, expected);
@@ -195,7 +196,10 @@ fn several_runs_columns_step_and_field_options() {
     .unwrap();
     let c = o.curves.unwrap();
     assert_eq!(c.series.len(), 4, "2 runs × 2 columns");
-    assert_eq!(c.x_label, "Q [-]");
+    assert_eq!(
+        c.x_label, "Q [× 2 kN total]",
+        "two 1 kN point loads per unit Q"
+    );
     // Two units, two panels: the reaction in kN, the deflection in mm.
     assert_eq!(c.y_labels, vec!["R_left [kN]", "midspan_uy, down [mm]"]);
     assert_eq!(
@@ -1084,4 +1088,56 @@ fn mesh_figure_draws_the_external_tendon() {
     assert_eq!(svg.matches("stroke=\"#00783C\"").count(), spans.len() + 1);
     assert!(svg.contains("\ntendons\n") && svg.contains("\njoints\n"));
     assert!(!svg.contains("joints, tendons"));
+}
+
+/// Issue 40 item 7: a load factor is shown with its load case's unit. The seed beam's Q
+/// case is two point loads of 1 kN (force = [0, -1e3] N at x = 2.4 and 4.8 m,
+/// examples/seed-beam-elastic.toml), so a unit factor is 2 kN in total: the axis reads
+/// "Q [× 2 kN total]" for the factor column and for the load-factor monitor `Q`, and the
+/// report's peak line gives the force reached, 2 kN × the peak factor (56 after the
+/// service step). The self-weight case (gravity) keeps its factor without a unit.
+#[test]
+fn load_factor_axis_carries_its_load_case_unit() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam-elastic.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(2).unwrap().0;
+    let dir = tmp("factor-unit");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let si = view::UnitOptions::default();
+    for y in ["Q", "factor:Q"] {
+        let fig =
+            view::curve_figure(&out, Some("midspan_uy"), &[y.to_string()], &[], None, si).unwrap();
+        let want = format!("{y} [× 2 kN total]");
+        assert_eq!(fig.y_labels, [want], "{y}");
+    }
+    let fig = view::curve_figure(
+        &out,
+        Some("midspan_uy"),
+        &["factor:self_weight".to_string()],
+        &[],
+        None,
+        si,
+    )
+    .unwrap();
+    assert_eq!(fig.y_labels, ["factor:self_weight [-]"]);
+    report::report(&report::ReportOptions {
+        dir: out.clone(),
+        y: Some("Q".into()),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let peak = html
+        .lines()
+        .find(|l| l.contains("id=\"peak\""))
+        .expect("peak line");
+    // 56 × 2 kN = 112 kN, printed as the report prints numbers (4 significant digits).
+    assert!(
+        peak.contains("Q = 56") && peak.contains("× 2 kN total: 112"),
+        "{peak}"
+    );
 }

@@ -245,7 +245,11 @@ pub fn curve_figure(
         .collect::<Result<Vec<_>, _>>()?;
     let kinds = units::kinds(dir);
     let kind_of = |name: &str| kinds.iter().find(|(n, _)| n == name).map(|(_, k)| k);
-    let show = |c: &data::Column| units::shown(&c.name, &c.unit, kind_of(&c.name), &c.values, opts);
+    let factor_units = units::FactorUnits::read(dir);
+    let show = |c: &data::Column| {
+        let s = units::shown(&c.name, &c.unit, kind_of(&c.name), &c.values, opts);
+        factor_units.apply(&c.name, s, opts)
+    };
     let xs_shown = show(xc);
     let ys_shown: Vec<units::Shown> = ycols.iter().map(|c| show(c)).collect();
     let panel_of =
