@@ -151,6 +151,8 @@ pub struct Summary {
     pub peak_memory_bytes: Option<u64>,
     /// Final monitor values (name → value).
     pub final_monitors: Vec<(String, f64)>,
+    /// The load cases: name, whether forces only, resultant at factor 1 [N].
+    pub load_cases: Vec<LoadCaseInfo>,
     /// The monitors as history.csv holds them: name, input kind, component and unit (the
     /// plots choose display units and signs by kind).
     pub monitors: Vec<MonitorInfo>,
@@ -188,6 +190,43 @@ pub struct MonitorInfo {
     pub component: Option<String>,
     /// Unit of the column (SI).
     pub unit: String,
+    /// The load case of a `load_factor` monitor (its name), so a viewer can give the
+    /// factor its load case's unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub case: Option<String>,
+}
+
+/// One load case described for summary.json (`load_cases`): what a unit factor of it is.
+#[derive(Debug, Clone, Serialize)]
+pub struct LoadCaseInfo {
+    /// Load case name (the `factor:<name>` column of history.csv).
+    pub name: String,
+    /// True when the case holds forces only (point and edge loads: no gravity, no
+    /// temperature), so that its factor measures a force.
+    pub forces_only: bool,
+    /// Resultant (x, y) of the case's loads at factor 1 [N] (gravity included).
+    pub resultant: [f64; 2],
+}
+
+/// The load cases of a model described for summary.json.
+pub fn load_case_info(model: &Model) -> Vec<LoadCaseInfo> {
+    model
+        .load_cases
+        .iter()
+        .map(|c| {
+            let f = crate::analysis::loads::load_vector(model, c);
+            let mut r = [0.0; 2];
+            for n in 0..model.nodes.len() {
+                r[0] += f[2 * n];
+                r[1] += f[2 * n + 1];
+            }
+            LoadCaseInfo {
+                name: c.name.clone(),
+                forces_only: c.gravity.is_none() && c.thermal.is_none(),
+                resultant: r,
+            }
+        })
+        .collect()
 }
 
 /// The monitors of a model described for summary.json.
@@ -215,11 +254,18 @@ pub fn monitor_info(model: &Model) -> Vec<MonitorInfo> {
                 | MonitorKind::StressExtreme { component, .. } => Some(stress(component)),
                 _ => None,
             };
+            let case = match &m.kind {
+                MonitorKind::LoadFactor { case } => {
+                    model.load_cases.get(*case).map(|c| c.name.clone())
+                }
+                _ => None,
+            };
             MonitorInfo {
                 name: m.name.clone(),
                 kind: crate::results::recorder::kind_name(&m.kind).into(),
                 component,
                 unit: m.unit().into(),
+                case,
             }
         })
         .collect()
@@ -701,6 +747,7 @@ pub fn run_file_opts(
         peak_memory_bytes: peak_memory(),
         final_monitors,
         monitors: monitor_info(&model),
+        load_cases: load_case_info(&model),
         regions: model.regions.iter().map(|r| r.name.clone()).collect(),
         joints: model.joints.iter().map(|j| j.name.clone()).collect(),
         stages,

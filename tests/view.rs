@@ -137,7 +137,8 @@ fn plot_writes_valid_figures_with_the_history_data() {
     let (ix, iy) = (col(&header, "midspan_uy"), col(&header, "Q ["));
     let curves = o.curves.unwrap();
     assert_eq!(curves.x_label, "midspan_uy, down [mm]");
-    assert_eq!(curves.y_label, "Q [-]");
+    // Q: two point loads of 1 kN (examples/box-beam.toml), 2 kN in total per unit factor.
+    assert_eq!(curves.y_label, "Q [× 2 kN total]");
     let expected: Vec<(f64, f64)> = rows.iter().map(|r| (-1e3 * r[ix], r[iy])).collect();
     assert_eq!(curves.series.len(), 1);
     assert_eq!(curves.series[0].points, expected);
@@ -195,7 +196,10 @@ fn several_runs_columns_step_and_field_options() {
     .unwrap();
     let c = o.curves.unwrap();
     assert_eq!(c.series.len(), 4, "2 runs × 2 columns");
-    assert_eq!(c.x_label, "Q [-]");
+    assert_eq!(
+        c.x_label, "Q [× 2 kN total]",
+        "two 1 kN point loads per unit Q"
+    );
     // Two units, two panels: the reaction in kN, the deflection in mm.
     assert_eq!(c.y_labels, vec!["R_left [kN]", "midspan_uy, down [mm]"]);
     assert_eq!(
@@ -880,4 +884,260 @@ fn the_peak_line_calls_only_a_load_a_load() {
         );
         assert!(line.ends_with(&format!(" {unit}")), "{line}");
     }
+}
+
+/// Issue 40 item 7: of more joints than a page holds, the diagrams draw the most stressed
+/// by rank, never the first few along the model. Twelve joints: J1…J10 with contact
+/// stresses 1, 1.5, …, 5.5 MPa and no opening, J11 the only one that opens (2 mm, no
+/// contact), J12 the largest contact stress (20 MPa). The eight most stressed are J11 and
+/// J12 (each leads its own measure) and the six largest contact stresses of the rest,
+/// J5…J10; four are hidden, which the title and a note say.
+#[test]
+fn joint_diagrams_draw_the_most_stressed_joints() {
+    let profile = |k: usize, open: f64, stress: f64| segfem::view::figures::JointProfile {
+        name: format!("joint J{k}"),
+        points: vec![(0.0, 0.0, stress), (1.0, open, 0.0)],
+    };
+    let mut joints: Vec<segfem::view::figures::JointProfile> = (1..=10)
+        .map(|k| profile(k, 0.0, 1.0 + 0.5 * (k - 1) as f64))
+        .collect();
+    joints.push(profile(11, 2.0, 0.0));
+    joints.push(profile(12, 0.0, 20.0));
+    let mut notes = Vec::new();
+    let fig = view::joint_figure(joints, "test", &mut notes).expect("a figure");
+    let names: Vec<&str> = fig.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "joint J5",
+            "joint J6",
+            "joint J7",
+            "joint J8",
+            "joint J9",
+            "joint J10",
+            "joint J11",
+            "joint J12"
+        ]
+    );
+    assert!(
+        fig.title.contains("8 most stressed of 12 joints"),
+        "{}",
+        fig.title
+    );
+    assert!(fig.title.contains("4 hidden"), "{}", fig.title);
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.starts_with("joint diagrams:") && n.contains("4 hidden")),
+        "{notes:?}"
+    );
+    // It renders.
+    let png = segfem::view::figures::png_bytes(&fig).unwrap();
+    assert!(png.len() > 1000);
+    // Eight or fewer: every joint, no note.
+    let few: Vec<segfem::view::figures::JointProfile> =
+        (1..=3).map(|k| profile(k, 0.0, k as f64)).collect();
+    let mut notes = Vec::new();
+    let fig = view::joint_figure(few, "test", &mut notes).unwrap();
+    assert_eq!(fig.joints.len(), 3);
+    assert!(notes.is_empty() && !fig.title.contains("hidden"));
+}
+
+/// Issue 40 item 7: the mesh legend fits. Staged copies of a region (`webs@S1`, named
+/// `R@S` by the construction-stage generator) are one entry under the base name, and a
+/// legend too long for one row wraps: every label ends inside the figure.
+#[test]
+fn mesh_legend_groups_staged_copies_and_wraps() {
+    use view::data::{Array, Grid};
+    // n unit Q4 cells in a row, cell k in region k.
+    let grid = |n: usize| {
+        let mut points = Vec::new();
+        for k in 0..=n {
+            points.push([k as f64, 0.0]);
+            points.push([k as f64, 1.0]);
+        }
+        Grid {
+            path: PathBuf::from("mem.vtu"),
+            points,
+            cells: (0..n)
+                .map(|k| vec![2 * k, 2 * k + 2, 2 * k + 3, 2 * k + 1])
+                .collect(),
+            types: vec![9; n],
+            point_data: Vec::new(),
+            cell_data: vec![Array {
+                name: "region".into(),
+                components: 1,
+                values: (0..n).map(|k| k as f64).collect(),
+            }],
+        }
+    };
+    // The viaduct's naming: three base regions, then their copies per segment.
+    let mut names: Vec<String> = vec!["slab".into(), "webs".into(), "deck".into()];
+    for s in 1..=4 {
+        for b in ["slab", "webs", "deck"] {
+            names.push(format!("{b}@S{s}"));
+        }
+    }
+    let g = grid(names.len());
+    let legend = view::figures::region_legend(&g, &names);
+    let labels: Vec<&str> = legend.iter().map(|l| l.1.as_str()).collect();
+    assert_eq!(
+        labels,
+        ["slab (5 regions)", "webs (5 regions)", "deck (5 regions)"]
+    );
+    // One colour per base name: the three colour indices differ.
+    assert!(legend[0].0 != legend[1].0 && legend[1].0 != legend[2].0 && legend[0].0 != legend[2].0);
+
+    // 40 distinct regions with 30-character names on a 40 m model: cannot fit one row.
+    let names: Vec<String> = (0..40)
+        .map(|k| format!("region_with_a_long_name_{k:06}"))
+        .collect();
+    let g = grid(names.len());
+    let fig = view::figures::MeshFigure {
+        grid: &g,
+        regions: names.clone(),
+        tendons: Vec::new(),
+        title: "t".into(),
+    };
+    // The same model with one legend entry (all staged copies of one region).
+    let one = view::figures::MeshFigure {
+        grid: &g,
+        regions: (0..40).map(|k| format!("a@S{k}")).collect(),
+        tendons: Vec::new(),
+        title: "t".into(),
+    };
+    let (w, h) = view::figures::Figure::size(&fig);
+    let svg = view::figures::svg_string(&fig).unwrap();
+    // Every label drawn, each ending inside the figure: its x plus its width at 14 px
+    // DejaVu Sans (under 0.62 em a character for these glyphs) within the width.
+    for n in &names {
+        let at = svg
+            .find(&format!(">\n{n}\n<"))
+            .unwrap_or_else(|| panic!("{n} not drawn"));
+        let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+        let x: f64 = tag
+            .split("x=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(
+            x + 0.62 * 14.0 * n.len() as f64 <= w as f64,
+            "{n} at x = {x} passes {w} px"
+        );
+    }
+    // The rows the labels need at least, added below the drawing (28 px a row).
+    let min_rows = (40.0 * (0.55 * 14.0 * 30.0) / w as f64).ceil() as u32;
+    let h_unnamed = view::figures::Figure::size(&one).1;
+    assert!(min_rows >= 2, "the test needs a wrapped legend");
+    assert!(
+        h >= h_unnamed + 28 * (min_rows - 1) - 28,
+        "{h} vs {h_unnamed}, {min_rows} rows"
+    );
+}
+
+/// Issue 40 item 7: the external tendon is drawn in the mesh figure, as its legend says.
+/// The seed beam (elastic) after prestress: its tendon runs through (0, 0.30), (2.4, 0.10),
+/// (4.8, 0.10), (7.2, 0.30) m (examples/seed-beam-elastic.toml). The spans read from the
+/// results lie on that profile and cover it end to end; the figure draws each span in the
+/// tendon colour and names it in the legend.
+#[test]
+fn mesh_figure_draws_the_external_tendon() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam-elastic.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(2).unwrap().0;
+    let dir = tmp("tendon-drawn");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let (_, output) = view::pick_output(&out, None).unwrap();
+    let spans = output.tendon_spans().unwrap();
+    assert!(!spans.is_empty(), "no tendon spans read");
+    let profile = [[0.0, 0.30], [2.4, 0.10], [4.8, 0.10], [7.2, 0.30]];
+    let on_profile = |p: [f64; 2]| {
+        profile.windows(2).any(|w| {
+            let (a, b) = (w[0], w[1]);
+            let t = (p[0] - a[0]) / (b[0] - a[0]);
+            // 1e-9 m: nodes are placed on the profile up to round-off.
+            (-1e-12..=1.0 + 1e-12).contains(&t) && (a[1] + t * (b[1] - a[1]) - p[1]).abs() < 1e-9
+        })
+    };
+    for s in &spans {
+        assert!(
+            on_profile(s[0]) && on_profile(s[1]),
+            "span {s:?} off the profile"
+        );
+    }
+    // End to end: the span lengths add up to the profile's (round-off only).
+    let len = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
+    let drawn: f64 = spans.iter().map(|s| len(s[0], s[1])).sum();
+    let want: f64 = profile.windows(2).map(|w| len(w[0], w[1])).sum();
+    assert!((drawn - want).abs() < 1e-9, "{drawn} m drawn of {want} m");
+    // The figure: one tendon-coloured line per span, plus the legend's sample.
+    view::plot(&PlotOptions {
+        dir: out.clone(),
+        ..Default::default()
+    })
+    .unwrap();
+    let svg = std::fs::read_to_string(out.join("figures/mesh.svg")).unwrap();
+    assert_eq!(svg.matches("stroke=\"#00783C\"").count(), spans.len() + 1);
+    assert!(svg.contains("\ntendons\n") && svg.contains("\njoints\n"));
+    assert!(!svg.contains("joints, tendons"));
+}
+
+/// Issue 40 item 7: a load factor is shown with its load case's unit. The seed beam's Q
+/// case is two point loads of 1 kN (force = [0, -1e3] N at x = 2.4 and 4.8 m,
+/// examples/seed-beam-elastic.toml), so a unit factor is 2 kN in total: the axis reads
+/// "Q [× 2 kN total]" for the factor column and for the load-factor monitor `Q`, and the
+/// report's peak line gives the force reached, 2 kN × the peak factor (56 after the
+/// service step). The self-weight case (gravity) keeps its factor without a unit.
+#[test]
+fn load_factor_axis_carries_its_load_case_unit() {
+    let ex = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed-beam-elastic.toml"),
+    )
+    .unwrap();
+    let cut = ex.match_indices("[[steps]]").nth(2).unwrap().0;
+    let dir = tmp("factor-unit");
+    std::fs::write(dir.join("m.toml"), &ex[..cut]).unwrap();
+    let out = dir.join("out");
+    segfem::run::run_file(&dir.join("m.toml"), &out, &mut |_| {}).unwrap();
+    let si = view::UnitOptions::default();
+    for y in ["Q", "factor:Q"] {
+        let fig =
+            view::curve_figure(&out, Some("midspan_uy"), &[y.to_string()], &[], None, si).unwrap();
+        let want = format!("{y} [× 2 kN total]");
+        assert_eq!(fig.y_labels, [want], "{y}");
+    }
+    let fig = view::curve_figure(
+        &out,
+        Some("midspan_uy"),
+        &["factor:self_weight".to_string()],
+        &[],
+        None,
+        si,
+    )
+    .unwrap();
+    assert_eq!(fig.y_labels, ["factor:self_weight [-]"]);
+    report::report(&report::ReportOptions {
+        dir: out.clone(),
+        y: Some("Q".into()),
+        ..Default::default()
+    })
+    .unwrap();
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let peak = html
+        .lines()
+        .find(|l| l.contains("id=\"peak\""))
+        .expect("peak line");
+    // 56 × 2 kN = 112 kN, printed as the report prints numbers (4 significant digits).
+    assert!(
+        peak.contains("Q = 56") && peak.contains("× 2 kN total: 112"),
+        "{peak}"
+    );
 }

@@ -225,6 +225,28 @@ impl Output {
     }
 }
 
+impl Output {
+    /// The tendon spans of this instant (line cells of part 1 with `cell_kind` 2, as the
+    /// recorder writes them), each as its two end points (x, y) [m] at the undeformed
+    /// position; empty without a line piece or a `cell_kind` array.
+    pub fn tendon_spans(&self) -> Result<Vec<[[f64; 2]; 2]>, ViewError> {
+        let Some(lines) = &self.lines else {
+            return Ok(Vec::new());
+        };
+        let l = Grid::read(lines)?;
+        let Some(kind) = l.cell_array("cell_kind") else {
+            return Ok(Vec::new());
+        };
+        Ok((0..l.cells.len())
+            .filter(|&i| kind.get(i, 0) == 2.0 && l.cells[i].len() >= 2)
+            .map(|i| {
+                let c = &l.cells[i];
+                [l.points[c[0]], l.points[c[c.len() - 1]]]
+            })
+            .collect())
+    }
+}
+
 /// Attributes of an XML start tag (`key="value"` pairs), in order.
 fn attributes(tag: &str) -> Vec<(String, String)> {
     let mut out = Vec::new();

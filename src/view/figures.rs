@@ -446,21 +446,40 @@ macro_rules! model_chart {
     }};
 }
 
+/// Height of a title band [px]: [`TITLE_H`] for one line, 24 px more per further line
+/// (a title's lines are separated by `\n`; a note under the title, such as the joints
+/// hidden, gets its own line rather than running off the edge).
+fn title_h(title: &str) -> u32 {
+    TITLE_H + TITLE_LINE_H * (title.lines().count().max(1) as u32 - 1)
+}
+
+/// Height of each further title line [px].
+const TITLE_LINE_H: u32 = 24;
+
 fn title_area<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
 ) -> Result<DrawingArea<DB, Shift>, String> {
-    let (top, rest) = root.split_vertically(TITLE_H);
+    let (top, rest) = root.split_vertically(title_h(title));
     let (w, _) = top.dim_in_pixel();
-    let style = TextStyle::from((FONT, 20).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
-    top.draw(&Text::new(
-        title.to_string(),
-        (w as i32 / 2, TITLE_H as i32 / 2 + 4),
-        style,
-    ))
-    .map_err(de)?;
+    for (i, line) in title.lines().enumerate() {
+        // The first line as before; further lines smaller, one below the other.
+        let (size, y) = if i == 0 {
+            (20, TITLE_H as i32 / 2 + 4)
+        } else {
+            (16, (TITLE_H + TITLE_LINE_H * i as u32) as i32 - 6)
+        };
+        let style =
+            TextStyle::from((FONT, size).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+        top.draw(&Text::new(line.to_string(), (w as i32 / 2, y), style))
+            .map_err(de)?;
+    }
     Ok(rest)
 }
+
+/// Colour of tendon spans in the mesh figure (dark green: apart from the red joints and
+/// the pastel regions).
+const TENDON: RGBColor = RGBColor(0, 120, 60);
 
 /// Pastel fill colours for regions.
 const REGION_FILL: [RGBColor; 6] = [
@@ -485,12 +504,16 @@ fn pts(grid: &Grid, idx: &[usize], disp: Option<&[[f64; 2]]>, scale: f64) -> Vec
 }
 
 /// The undeformed mesh, cells filled by region (a legend names each region's colour); line
-/// cells (joints, tendons) in red.
+/// cells of the grid (joints) in red, tendon spans in dark green over them.
 pub struct MeshFigure<'g> {
     /// Grid.
     pub grid: &'g Grid,
     /// Region names by index (summary.json `regions`); `region k` where missing.
     pub regions: Vec<String>,
+    /// Tendon spans, each from one end (x, y) [m] to the other ([`Output::tendon_spans`]).
+    ///
+    /// [`Output::tendon_spans`]: super::data::Output::tendon_spans
+    pub tendons: Vec<[[f64; 2]; 2]>,
     /// Title.
     pub title: String,
 }
@@ -498,18 +521,26 @@ pub struct MeshFigure<'g> {
 impl Figure for MeshFigure<'_> {
     fn size(&self) -> (u32, u32) {
         let (lo, hi) = self.grid.bounds();
-        frame(lo, hi, LEGEND_H).size
+        let w = frame(lo, hi, 0).size.0;
+        let rows = legend_rows(&self.legend_entries(), w);
+        frame(lo, hi, LEGEND_H * rows.max(1) as u32).size
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let g = self.grid;
         let (lo, hi) = g.bounds();
-        let f = frame(lo, hi, LEGEND_H);
+        let entries = self.legend_entries();
+        let w = frame(lo, hi, 0).size.0;
+        let layout = legend_layout(&entries, w);
+        let rows = layout.iter().map(|p| p.0 + 1).max().unwrap_or(1);
+        let legend_h = LEGEND_H * rows as u32;
+        let f = frame(lo, hi, legend_h);
         let area = title_area(root, &self.title)?;
         let (_, h) = area.dim_in_pixel();
-        let (area, strip) = area.split_vertically(h.saturating_sub(LEGEND_H));
+        let (area, strip) = area.split_vertically(h.saturating_sub(legend_h));
         let mut chart = model_chart!(&area, f);
         let region = g.cell_array("region");
+        let colour_of = region_colours(&self.regions);
         let edge = RGBColor(90, 90, 90);
         for (i, c) in g.cells.iter().enumerate() {
             let o = pts(g, &cell_outline(g.types[i], c), None, 0.0);
@@ -520,28 +551,30 @@ impl Figure for MeshFigure<'_> {
                 continue;
             }
             let r = region.map_or(0, |a| a.get(i, 0).max(0.0) as usize);
+            let fill = colour_of.get(r).copied().unwrap_or(r);
             let mut closed = o.clone();
             closed.push(o[0]);
             chart
                 .draw_series([
-                    Polygon::new(o, REGION_FILL[r % REGION_FILL.len()].filled()).into_dyn(),
+                    Polygon::new(o, REGION_FILL[fill % REGION_FILL.len()].filled()).into_dyn(),
                     PathElement::new(closed, edge.stroke_width(1)).into_dyn(),
                 ])
                 .map_err(de)?;
         }
-        // The legend, in a strip below the drawing (never over the mesh): a swatch per
-        // region present, and the joint/tendon lines.
-        let mut entries: Vec<(String, RGBColor, bool)> = region_legend(g, &self.regions)
-            .into_iter()
-            .map(|(r, name)| (name, REGION_FILL[r % REGION_FILL.len()], false))
-            .collect();
-        if (0..g.cells.len()).any(|i| g.is_line(i)) {
-            entries.push(("joints, tendons".into(), RED, true));
-        }
+        // Tendons last, over the cells and joints they cross.
+        chart
+            .draw_series(self.tendons.iter().map(|t| {
+                PathElement::new(
+                    vec![(t[0][0], t[0][1]), (t[1][0], t[1][1])],
+                    TENDON.stroke_width(2),
+                )
+            }))
+            .map_err(de)?;
+        // The legend, in a strip below the drawing (never over the mesh), wrapped into as
+        // many rows as it needs: a swatch per region group present, and the line cells.
         let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
-        let mut x = (MARGIN + YLAB) as i32;
-        let y = (LEGEND_H / 2) as i32;
-        for (name, c, line) in entries {
+        for ((name, c, line), (row, x)) in entries.into_iter().zip(layout) {
+            let y = (LEGEND_H / 2 + LEGEND_H * row as u32) as i32;
             if line {
                 strip
                     .draw(&PathElement::new(
@@ -561,16 +594,93 @@ impl Figure for MeshFigure<'_> {
                     .map_err(de)?;
             }
             strip
-                .draw(&Text::new(name.clone(), (x + 24, y), style.clone()))
+                .draw(&Text::new(name, (x + 24, y), style.clone()))
                 .map_err(de)?;
-            x += 24 + 8 * name.chars().count() as i32 + 24;
         }
         Ok(())
     }
 }
 
-/// The legend entries of a mesh figure: (region index, name) for each region some cell
-/// belongs to, in index order (`names[k]`, or `region k` without a name).
+impl MeshFigure<'_> {
+    /// Legend entries: (label, colour, drawn as a line rather than a swatch).
+    fn legend_entries(&self) -> Vec<(String, RGBColor, bool)> {
+        let g = self.grid;
+        let mut entries: Vec<(String, RGBColor, bool)> = region_legend(g, &self.regions)
+            .into_iter()
+            .map(|(r, name)| (name, REGION_FILL[r % REGION_FILL.len()], false))
+            .collect();
+        if (0..g.cells.len()).any(|i| g.is_line(i)) {
+            entries.push(("joints".into(), RED, true));
+        }
+        if !self.tendons.is_empty() {
+            entries.push(("tendons".into(), TENDON, true));
+        }
+        entries
+    }
+}
+
+/// Width of a legend entry [px]: swatch, gap, label (8 px a character at 14 px, a little
+/// more than DejaVu Sans needs, so labels never touch), gap.
+fn legend_entry_w(name: &str) -> i32 {
+    24 + 8 * name.chars().count() as i32 + 24
+}
+
+/// Legend entries placed left to right from the plot's left edge, wrapped to a new row
+/// when the next would pass the figure's right edge `width` [px]: (row, x) per entry.
+fn legend_layout(entries: &[(String, RGBColor, bool)], width: u32) -> Vec<(usize, i32)> {
+    let x0 = (MARGIN + YLAB) as i32;
+    let right = width as i32 - MARGIN as i32;
+    let (mut row, mut x) = (0, x0);
+    entries
+        .iter()
+        .map(|(name, _, _)| {
+            let w = legend_entry_w(name);
+            if x > x0 && x + w - 24 > right {
+                row += 1;
+                x = x0;
+            }
+            let at = (row, x);
+            x += w;
+            at
+        })
+        .collect()
+}
+
+/// Number of legend rows for `entries` in a figure `width` px wide.
+fn legend_rows(entries: &[(String, RGBColor, bool)], width: u32) -> usize {
+    legend_layout(entries, width).last().map_or(1, |p| p.0 + 1)
+}
+
+/// The base name of a region: the part before `@` of a staged copy (`webs@S13` → `webs`;
+/// the construction-stage generator names the copy of region R for segment S `R@S`).
+pub fn region_base(name: &str) -> &str {
+    name.split_once('@').map_or(name, |(b, _)| b)
+}
+
+/// Colour index of each region (by region index): regions that share a base name
+/// ([`region_base`]) share a colour, numbered in the order base names first appear.
+pub fn region_colours(names: &[String]) -> Vec<usize> {
+    let mut bases: Vec<&str> = Vec::new();
+    names
+        .iter()
+        .map(|n| {
+            let b = region_base(n);
+            match bases.iter().position(|x| *x == b) {
+                Some(k) => k,
+                None => {
+                    bases.push(b);
+                    bases.len() - 1
+                }
+            }
+        })
+        .collect()
+}
+
+/// The legend entries of a mesh figure: (colour index, label) for each group of regions
+/// some cell belongs to. Regions that are staged copies of one region (`webs`, `webs@S1`,
+/// `webs@S2`, …) form one group under the base name, labelled `webs (N regions)` when
+/// more than one of them is present; groups in the order their base names first appear.
+/// Regions without a name are `region k`, each its own group.
 pub fn region_legend(g: &Grid, names: &[String]) -> Vec<(usize, String)> {
     let Some(region) = g.cell_array("region") else {
         return Vec::new();
@@ -581,14 +691,30 @@ pub fn region_legend(g: &Grid, names: &[String]) -> Vec<(usize, String)> {
         .collect();
     present.sort_unstable();
     present.dedup();
-    present
+    let colours = region_colours(names);
+    // (colour index, base name, regions present)
+    let mut groups: Vec<(usize, String, usize)> = Vec::new();
+    for r in present {
+        let (colour, base) = match names.get(r) {
+            Some(n) => (colours[r], region_base(n).to_string()),
+            // Unnamed: its own group, coloured by its index as before.
+            None => (r, format!("region {r}")),
+        };
+        match groups.iter_mut().find(|gr| gr.1 == base) {
+            Some(gr) => gr.2 += 1,
+            None => groups.push((colour, base, 1)),
+        }
+    }
+    groups.sort_by_key(|gr| gr.0);
+    groups
         .into_iter()
-        .map(|r| {
-            let name = names
-                .get(r)
-                .cloned()
-                .unwrap_or_else(|| format!("region {r}"));
-            (r, name)
+        .map(|(c, base, n)| {
+            let label = if n > 1 {
+                format!("{base} ({n} regions)")
+            } else {
+                base
+            };
+            (c, label)
         })
         .collect()
 }
@@ -1069,7 +1195,7 @@ impl Figure for JointFigure {
     fn size(&self) -> (u32, u32) {
         (
             1000,
-            TITLE_H + JOINT_ROW_H * self.joints.len().max(1) as u32,
+            title_h(&self.title) + JOINT_ROW_H * self.joints.len().max(1) as u32,
         )
     }
 

@@ -245,7 +245,11 @@ pub fn curve_figure(
         .collect::<Result<Vec<_>, _>>()?;
     let kinds = units::kinds(dir);
     let kind_of = |name: &str| kinds.iter().find(|(n, _)| n == name).map(|(_, k)| k);
-    let show = |c: &data::Column| units::shown(&c.name, &c.unit, kind_of(&c.name), &c.values, opts);
+    let factor_units = units::FactorUnits::read(dir);
+    let show = |c: &data::Column| {
+        let s = units::shown(&c.name, &c.unit, kind_of(&c.name), &c.values, opts);
+        factor_units.apply(&c.name, s, opts)
+    };
     let xs_shown = show(xc);
     let ys_shown: Vec<units::Shown> = ycols.iter().map(|c| show(c)).collect();
     let panel_of =
@@ -655,6 +659,7 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
         &MeshFigure {
             grid: &g,
             regions: units::region_names(&opts.dir),
+            tendons: output.tendon_spans()?,
             title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
         },
         &out_dir,
@@ -742,26 +747,63 @@ pub fn crack_figure<'g>(g: &'g Grid, tag: &str) -> Option<CrackFigure<'g>> {
     })
 }
 
-/// The joint figure, when the grid has joint data (at most [`MAX_JOINTS`], noted).
+/// The joint figure, when the grid has joint data. Up to [`MAX_JOINTS`] joints are all
+/// drawn; of more, the [`MAX_JOINTS`] most stressed by [`joint_rank`] (so the joint with the
+/// largest contact stress and the one with the largest opening are always drawn), in their
+/// order along the model, with a note and a title line saying how many are hidden.
 pub fn joint_figure(
-    mut joints: Vec<JointProfile>,
+    joints: Vec<JointProfile>,
     tag: &str,
     notes: &mut Vec<String>,
 ) -> Option<JointFigure> {
     if joints.is_empty() {
         return None;
     }
-    if joints.len() > MAX_JOINTS {
-        notes.push(format!(
-            "joint diagrams: the first {MAX_JOINTS} of {} joints drawn",
-            joints.len()
-        ));
-        joints.truncate(MAX_JOINTS);
-    }
-    Some(JointFigure {
-        joints,
-        title: format!("Joints: opening and normal stress over the height ({tag})"),
-    })
+    let total = joints.len();
+    let mut title = format!("Joints: opening and normal stress over the height ({tag})");
+    let joints = if total > MAX_JOINTS {
+        let hidden = total - MAX_JOINTS;
+        let note = format!(
+            "the {MAX_JOINTS} most stressed of {total} joints (largest contact stress or opening); {hidden} hidden"
+        );
+        notes.push(format!("joint diagrams: {note}"));
+        title.push_str(&format!("\n{note}"));
+        let mut keep = joint_rank(&joints);
+        keep.truncate(MAX_JOINTS);
+        keep.sort_unstable();
+        let mut joints: Vec<Option<JointProfile>> = joints.into_iter().map(Some).collect();
+        keep.into_iter().filter_map(|i| joints[i].take()).collect()
+    } else {
+        joints
+    };
+    Some(JointFigure { joints, title })
+}
+
+/// Indices of `joints`, most stressed first. A joint's score is the larger of its largest
+/// contact (compressive normal) stress over the largest of all joints and its largest
+/// opening over the largest of all joints: both ranks count alike, so the joint with the
+/// largest contact stress and the one with the largest opening both score 1 and lead.
+/// Ties (e.g. unloaded joints) keep the order along the model.
+pub fn joint_rank(joints: &[JointProfile]) -> Vec<usize> {
+    let peak = |j: &JointProfile, f: fn(&(f64, f64, f64)) -> f64| {
+        j.points
+            .iter()
+            .map(f)
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, f64::max)
+    };
+    let open: Vec<f64> = joints.iter().map(|j| peak(j, |p| p.1)).collect();
+    let stress: Vec<f64> = joints.iter().map(|j| peak(j, |p| p.2)).collect();
+    let max_open = open.iter().copied().fold(0.0, f64::max);
+    let max_stress = stress.iter().copied().fold(0.0, f64::max);
+    let ratio = |v: f64, m: f64| if m > 0.0 { v / m } else { 0.0 };
+    let score: Vec<f64> = (0..joints.len())
+        .map(|i| ratio(open[i], max_open).max(ratio(stress[i], max_stress)))
+        .collect();
+    let mut idx: Vec<usize> = (0..joints.len()).collect();
+    // Stable sort: equal scores keep the order along the model.
+    idx.sort_by(|&a, &b| score[b].total_cmp(&score[a]));
+    idx
 }
 
 /// A magnification written with 3 significant digits.

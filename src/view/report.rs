@@ -515,6 +515,17 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         let kinds = super::units::kinds(&opts.dir);
         let kind = kinds.iter().find(|(n, _)| *n == load.name).map(|(_, k)| k);
         let shown = super::units::shown(&load.name, &load.unit, kind, &load.values, opts.units);
+        // A factor of a load case of forces only: its unit and the force it reaches.
+        let fu = super::units::FactorUnits::read(&opts.dir);
+        let force = fu.force_of(&load.name).map(|f| {
+            let s = fu.apply(&load.name, shown.clone(), opts.units);
+            let (u, scale) = if opts.units.si {
+                ("N", 1.0)
+            } else {
+                super::units::display_unit("N")
+            };
+            format!(" ({}: {} {u})", esc(&s.unit), num(v.abs() * f * scale))
+        });
         // Only a load is called one: a deflection or a stress on the curve's y axis is its
         // largest magnitude ("Peak load: deflection_Q = 122.4 mm" named a deflection a load).
         let what = match load.unit.as_str() {
@@ -527,7 +538,9 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
             "<p id=\"peak\"><b>{what}:</b> {} = {}{}</p>",
             esc(&load.name),
             num(v * shown.factor),
-            if shown.unit.is_empty() || shown.unit == "-" {
+            if let Some(f) = &force {
+                f.clone()
+            } else if shown.unit.is_empty() || shown.unit == "-" {
                 String::new()
             } else {
                 format!(" {}", esc(&shown.unit))
@@ -581,7 +594,8 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
             let joints = super::output_joint_profiles(&output, &g, &opts.dir)?;
             let from_points = output.joint_points.is_some();
             let has_joints = super::expects_joints(&g, &opts.dir);
-            fields_section(&mut html, &opts.dir, &g, &tag, &mut notes)?;
+            let tendons = output.tendon_spans()?;
+            fields_section(&mut html, &opts.dir, &g, tendons, &tag, &mut notes)?;
             joints_section(&mut html, joints, from_points, has_joints, &tag, &mut notes)?;
         }
         Err(e) if opts.step.is_none() => notes.push(format!("model drawings: skipped ({e})")),
@@ -610,15 +624,21 @@ fn fields_section(
     html: &mut String,
     dir: &Path,
     g: &Grid,
+    tendons: Vec<[[f64; 2]; 2]>,
     tag: &str,
     notes: &mut Vec<String>,
 ) -> Result<(), ViewError> {
     let mesh = MeshFigure {
         grid: g,
         regions: super::units::region_names(dir),
+        tendons,
         title: format!("Mesh: {} points, {} cells", g.points.len(), g.cells.len()),
     };
-    figure(html, &png_bytes(&mesh)?, "Mesh, cells coloured by region");
+    figure(
+        html,
+        &png_bytes(&mesh)?,
+        "Mesh, cells coloured by region, joints in red, tendons in green",
+    );
     let disp = displacements(g);
     let scale = auto_scale(g, &disp);
     let def = DeformedFigure {

@@ -144,6 +144,100 @@ pub fn kinds(dir: &Path) -> Vec<(String, Kind)> {
     out
 }
 
+/// What a unit load factor stands for, read from `<dir>/summary.json`: per load case of
+/// forces only (point and edge loads; no gravity, no temperature) with a non-zero
+/// resultant, the magnitude of that resultant at factor 1 [N]; and the load case of each
+/// `load_factor` monitor. Empty for runs older than these lists.
+#[derive(Debug, Clone, Default)]
+pub struct FactorUnits {
+    /// (load case name, |resultant at factor 1| [N]).
+    pub cases: Vec<(String, f64)>,
+    /// (monitor name, load case name) of the `load_factor` monitors.
+    pub monitors: Vec<(String, String)>,
+}
+
+impl FactorUnits {
+    /// Read from `<dir>/summary.json` (`load_cases`, `monitors[].case`).
+    pub fn read(dir: &Path) -> FactorUnits {
+        let v: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or(serde_json::Value::Null);
+        let cases = v["load_cases"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter(|c| c["forces_only"].as_bool() == Some(true))
+                    .filter_map(|c| {
+                        let r = c["resultant"].as_array()?;
+                        let (x, y) = (r.first()?.as_f64()?, r.get(1)?.as_f64()?);
+                        let f = x.hypot(y);
+                        (f > 0.0).then(|| (c["name"].as_str().unwrap_or("").to_string(), f))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let monitors = v["monitors"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|m| {
+                        Some((
+                            m["name"].as_str()?.to_string(),
+                            m["case"].as_str()?.to_string(),
+                        ))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        FactorUnits { cases, monitors }
+    }
+
+    /// The load case whose factor the column `name` holds: `factor:<case>`, or the case
+    /// of a `load_factor` monitor.
+    pub fn case_of<'a>(&'a self, name: &'a str) -> Option<&'a str> {
+        name.strip_prefix("factor:").or_else(|| {
+            self.monitors
+                .iter()
+                .find(|(m, _)| m == name)
+                .map(|(_, c)| c.as_str())
+        })
+    }
+
+    /// The force [N] a unit factor of the column `name` stands for, if its load case is
+    /// one of forces only.
+    pub fn force_of(&self, name: &str) -> Option<f64> {
+        let case = self.case_of(name)?;
+        self.cases.iter().find(|(c, _)| c == case).map(|(_, f)| *f)
+    }
+
+    /// `s` for the column `name` with the unit of its load case: a factor of a case of
+    /// forces only reads `Q [× 2 kN total]` (the resultant at factor 1 in the display unit,
+    /// 4 significant digits); other columns unchanged.
+    pub fn apply(&self, name: &str, s: Shown, opts: UnitOptions) -> Shown {
+        let Some(f) = self.force_of(name) else {
+            return s;
+        };
+        let (unit, scale) = if opts.si {
+            ("N", 1.0)
+        } else {
+            display_unit("N")
+        };
+        let mut v = super::figures::sig4(f * scale);
+        if v.contains('.') && !v.contains('e') {
+            // 2.000 → 2: the resultant is a round number more often than not.
+            v = v.trim_end_matches('0').trim_end_matches('.').to_string();
+        }
+        let unit = format!("× {v} {unit} total");
+        let base = s.label.rsplit_once(" [").map_or(s.label.as_str(), |l| l.0);
+        Shown {
+            factor: s.factor,
+            label: format!("{base} [{unit}]"),
+            unit,
+        }
+    }
+}
+
 /// Region names of a run (summary.json `regions`); empty when absent.
 pub fn region_names(dir: &Path) -> Vec<String> {
     names(dir, "regions")
