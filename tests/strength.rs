@@ -238,4 +238,15 @@ increments = 40
         html.contains("Concrete past its strength (2 checks failed)"),
         "flag text"
     );
+    // The verdict's factor said as the force it stands for: the edge load Q × 0.2 m of
+    // edge = 200 kN per unit factor (issue 40 item 7).
+    let line = format!(
+        "P is a factor of the case's 200.0 kN in all: none reached at {:.1} kN, peak {:.1} kN",
+        u["at_factor"].as_f64().unwrap() * Q * 0.2 / 1e3,
+        u["peak_factor"].as_f64().unwrap() * Q * 0.2 / 1e3
+    );
+    assert!(
+        html.contains(&line),
+        "no force line in the headline: {line}"
+    );
 }

@@ -286,6 +286,23 @@ pub fn headline(dir: &Path, h: &Table) -> String {
         serde_json::from_value::<crate::results::ultimate::Ultimate>(v["ultimate"].clone());
     if let Ok(u) = ultimate {
         let _ = writeln!(s, "<p id=\"ultimate\"><b>{}</b></p>", esc(&u.to_string()));
+        // The verdict's load measure is a factor: said as the force it stands for when its
+        // load case holds forces only (the seed beam's Q: 2 kN in all per unit factor).
+        if let Some(f) =
+            super::units::FactorUnits::read(dir).force_of(&format!("factor:{}", u.load_case))
+        {
+            let (unit, scale) = super::units::display_unit("N");
+            let kn = |x: f64| format!("{:.1} {unit}", x * f.abs() * scale);
+            let _ = writeln!(
+                s,
+                "<p id=\"ultimate-force\">{} is a factor of the case's {} in all: {} at {}, peak {}</p>",
+                esc(&u.load_case),
+                kn(1.0),
+                esc(&u.mode),
+                kn(u.at_factor),
+                kn(u.peak_factor)
+            );
+        }
     }
     // Elastic concrete past its strength: flagged under the verdict, never only in the
     // warnings table.
