@@ -306,55 +306,7 @@ fn by_depth(p: &[[f64; 2]], d: f64) -> f64 {
 /// κ L²/8.
 #[test]
 fn nonlinear_profile_gives_self_equilibrating_eigenstresses() {
-    let bands: String = ["bottom", "web", "top"]
-        .iter()
-        .zip(&I_BANDS)
-        .map(|(r, (y0, y1, _))| {
-            format!(
-                "{{ region = \"{r}\", depth = {}, rows = {} }},",
-                y1 - y0,
-                if *r == "web" { 10 } else { 3 }
-            )
-        })
-        .collect();
-    let regions: String = ["bottom", "web", "top"]
-        .iter()
-        .zip(&I_BANDS)
-        .map(|(r, (_, _, b))| {
-            format!("[[regions]]\nname = \"{r}\"\nmaterial = \"c\"\nthickness = {b}\n\n")
-        })
-        .collect();
-    let text = format!(
-        r#"
-[[materials]]
-name = "c"
-kind = "elastic"
-E = {E}
-nu = 0.2
-thermal_expansion = {ALPHA}
-
-{regions}
-[mesh]
-type = "banded"
-length = 10.0
-nx = 40
-element = "Q8"
-bands = [{bands}]
-
-{PIN_ROLLER}
-
-[[load_cases]]
-name = "T"
-temperature = {{ code_profile = "en1991-1-5-heating" }}
-
-[[steps]]
-name = "heat"
-kind = "linear"
-loads = {{ T = 1.0 }}
-"#
-    )
-    .replace("[4.0, 0.0]", "[10.0, 0.0]");
-    let (model, last) = solve(&text);
+    let (model, last) = i_beam_under("{ code_profile = \"en1991-1-5-heating\" }");
     let h = 0.8;
     let profile = [
         [0.0, 13.0],
