@@ -548,6 +548,9 @@ fn run(
                 if let Some(u) = &s.ultimate {
                     outln!("{u}");
                 }
+                for c in &s.design_checks {
+                    outln!("{}", c.text);
+                }
                 for (n, v) in &s.final_monitors {
                     outln!("  {n} = {v:.6e}");
                 }
