@@ -260,6 +260,7 @@ fn parts(m: &Model) -> Vec<(&'static str, String)> {
         ("geometry", format!("{:?}", m.geometry)),
         ("bars", format!("{:?}", m.bars)),
         ("staging", format!("{:?}", m.staging)),
+        ("checks", format!("{:?}", m.checks)),
     ]
 }
 

@@ -51,6 +51,7 @@ pub struct CheckIn {
     pub combination: Option<String>,
     pub joints: Option<Vec<String>>,
     pub regions: Option<Vec<String>>,
+    pub include_d_regions: Option<bool>,
     pub tendons: Option<Vec<String>>,
     pub tendon: Option<String>,
     pub min_compression: Option<f64>,

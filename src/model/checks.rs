@@ -33,6 +33,9 @@ pub enum CheckKind {
         regions: Vec<(usize, f64)>,
         /// Limit as a fraction of the strength (0.6, 0.45 …).
         factor: f64,
+        /// Elements left out: those of the disturbed regions (within one member depth of an
+        /// anchorage, deviator, active support or point load), unless asked for.
+        excluded: Vec<usize>,
     },
     /// The largest span stress of the listed external tendons against `factor` × f_pk.
     TendonStress {

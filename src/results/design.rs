@@ -246,7 +246,7 @@ fn evaluate(
 ) -> CheckResult {
     let model = sys.model;
     let mut verdict_kind = Verdict::Pass;
-    let (unit, quantity, items): (&str, &str, Vec<CheckItem>) = match &c.kind {
+    let (unit, quantity, items): (&str, String, Vec<CheckItem>) = match &c.kind {
         CheckKind::JointDecompression {
             joints,
             min_compression,
@@ -266,18 +266,26 @@ fn evaluate(
                 .collect();
             (
                 "MPa",
-                "least fibre compression of the uncracked joint section against the required compression; utilisation = M / M_decompression",
+                "least fibre compression of the uncracked joint section against the required compression; utilisation = M / M_decompression".into(),
                 items,
             )
         }
-        CheckKind::ConcreteStress { regions, factor } => {
+        CheckKind::ConcreteStress {
+            regions,
+            factor,
+            excluded,
+        } => {
             let gauss = &sys.families.continuum.gauss.committed;
+            let mut skip = vec![false; model.elements.len()];
+            for &e in excluded {
+                skip[e] = true;
+            }
             let items = regions
                 .iter()
                 .map(|&(r, fck)| {
                     let mut worst = (0.0, usize::MAX);
                     for (e, el) in model.elements.iter().enumerate() {
-                        if el.region != r {
+                        if el.region != r || skip[e] {
                             continue;
                         }
                         for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
@@ -301,11 +309,15 @@ fn evaluate(
                     }
                 })
                 .collect();
-            (
-                "MPa",
-                "largest compression −σ2 at the Gauss points against the limit",
-                items,
-            )
+            let quantity = if excluded.is_empty() {
+                "largest compression −σ2 at the Gauss points against the limit".to_string()
+            } else {
+                format!(
+                    "largest compression −σ2 at the Gauss points against the limit; {} elements of the disturbed regions (within one member depth of anchorages, deviators, supports and point loads) left out",
+                    excluded.len()
+                )
+            };
+            ("MPa", quantity, items)
         }
         CheckKind::TendonStress { tendons, factor } => {
             let items = tendons
@@ -322,7 +334,7 @@ fn evaluate(
                     }
                 })
                 .collect();
-            ("MPa", "largest span stress against the limit", items)
+            ("MPa", "largest span stress against the limit".into(), items)
         }
         CheckKind::UnbondedUltimate {
             tendon,
@@ -356,7 +368,7 @@ fn evaluate(
             }];
             (
                 "MPa",
-                "tendon stress at the step's peak load from the analysis beside the code's estimate at ultimate",
+                "tendon stress at the step's peak load from the analysis beside the code's estimate at ultimate".into(),
                 items,
             )
         }
@@ -392,7 +404,7 @@ fn evaluate(
             }
             (
                 "kN",
-                "shear force across the joint against φ V_j of the keyed joint",
+                "shear force across the joint against φ V_j of the keyed joint".into(),
                 items,
             )
         }
@@ -435,7 +447,7 @@ fn evaluate(
         utilisation: Some(utilisation),
         governing,
         unit: unit.into(),
-        quantity: quantity.into(),
+        quantity,
         items,
         text,
     }

@@ -43,7 +43,7 @@ fn pick<'a>(
 fn allowed(check: &str) -> &'static [&'static str] {
     match check {
         "joint_decompression" => &["joints", "min_compression"],
-        "concrete_stress" => &["regions", "fck"],
+        "concrete_stress" => &["regions", "include_d_regions", "fck"],
         "tendon_stress" => &["tendons"],
         "unbonded_tendon_ultimate" => &["tendon", "x", "support_hinges", "fpe_step", "fck"],
         "shear_keys" => &["joints", "key_area", "fck", "phi"],
@@ -99,9 +99,10 @@ fn one(ctx: &Ctx, i: usize, c: &CheckIn, model: &Model) -> R<DesignCheck> {
         ));
     }
     // Keys of other kinds are refused, so a misplaced key never passes unread.
-    let given: [(&str, bool); 11] = [
+    let given: [(&str, bool); 12] = [
         ("joints", c.joints.is_some()),
         ("regions", c.regions.is_some()),
+        ("include_d_regions", c.include_d_regions.is_some()),
         ("tendons", c.tendons.is_some()),
         ("tendon", c.tendon.is_some()),
         ("min_compression", c.min_compression.is_some()),
@@ -263,9 +264,18 @@ fn one(ctx: &Ctx, i: usize, c: &CheckIn, model: &Model) -> R<DesignCheck> {
                     }
                 }
             };
+            let excluded = if c.include_d_regions.unwrap_or(false) {
+                Vec::new()
+            } else {
+                d_region_elements(model, step)
+            };
             (
                 clause.to_string(),
-                CheckKind::ConcreteStress { regions, factor },
+                CheckKind::ConcreteStress {
+                    regions,
+                    factor,
+                    excluded,
+                },
             )
         }
         "tendon_stress" => {
@@ -463,4 +473,91 @@ fn one(ctx: &Ctx, i: usize, c: &CheckIn, model: &Model) -> R<DesignCheck> {
         clause,
         kind,
     })
+}
+
+/// Elements of the disturbed regions at step `step`: those with a node closer than one
+/// member depth to a concentrated force: a tendon point (anchorage, deviator), a node of
+/// a support active in the step, a point load of a case the step applies. There the
+/// stresses follow the force's spreading, not the section's (Saint-Venant; the D-regions of
+/// Schlaich, Schäfer & Jennewein, PCI J. 32(3), 1987), and are designed by strut-and-tie
+/// and anchorage-zone rules (EN 1992-1-1 6.5, 8.10.3), not by the stress limits.
+fn d_region_elements(model: &Model, step: usize) -> Vec<usize> {
+    let mut used = vec![false; model.nodes.len()];
+    for el in &model.elements {
+        for &n in &el.nodes {
+            used[n] = true;
+        }
+    }
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    for t in &model.tendons {
+        for ties in &t.ties {
+            points.push(ties.iter().fold([0.0, 0.0], |a, &(n, w)| {
+                [a[0] + w * model.nodes[n][0], a[1] + w * model.nodes[n][1]]
+            }));
+        }
+    }
+    for (s, sup) in model.supports.iter().enumerate() {
+        if !model.staging.support(s).active_in(step) {
+            continue;
+        }
+        points.extend(
+            sup.dofs
+                .iter()
+                .filter(|d| used[d.0])
+                .map(|d| model.nodes[d.0]),
+        );
+    }
+    for (c, case) in model.load_cases.iter().enumerate() {
+        if model.steps[step].factors.get(c).is_some_and(|f| *f != 0.0) {
+            points.extend(case.point_forces.iter().map(|(n, _)| model.nodes[*n]));
+        }
+    }
+    points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    points.dedup();
+    // Bounding boxes of the elements.
+    let boxes: Vec<([f64; 2], [f64; 2], [f64; 2])> = model
+        .elements
+        .iter()
+        .map(|el| {
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            let mut c = [0.0; 2];
+            for &n in &el.nodes {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(model.nodes[n][k]);
+                    hi[k] = hi[k].max(model.nodes[n][k]);
+                    c[k] += model.nodes[n][k] / el.nodes.len() as f64;
+                }
+            }
+            (lo, hi, c)
+        })
+        .collect();
+    // The member depth at x: the height of the elements spanning x.
+    let depth_at = |x: f64| {
+        let (lo, hi) = boxes
+            .iter()
+            .filter(|b| b.0[0] <= x && x <= b.1[0])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), b| {
+                (lo.min(b.0[1]), hi.max(b.1[1]))
+            });
+        (hi - lo).max(0.0)
+    };
+    let reach: Vec<f64> = points.iter().map(|p| depth_at(p[0])).collect();
+    // An element reaching into the region (any node closer than the depth) is left out
+    // whole: its Gauss points lie up to half an element nearer the force than its centroid.
+    model
+        .elements
+        .iter()
+        .enumerate()
+        .filter(|(_, el)| {
+            el.nodes.iter().any(|&n| {
+                let q = model.nodes[n];
+                points
+                    .iter()
+                    .zip(&reach)
+                    .any(|(p, r)| (q[0] - p[0]).hypot(q[1] - p[1]) < *r - 1e-9 * r)
+            })
+        })
+        .map(|(e, _)| e)
+        .collect()
 }
