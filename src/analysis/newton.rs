@@ -17,8 +17,9 @@ pub(super) fn norm(v: &[f64]) -> f64 {
 }
 
 /// Newton cycles: six iterations made and the relative residual not halved over the last
-/// three (crack points alternating between loading and unloading); the drivers then hold the
-/// crack branches for the rest of the increment.
+/// three (crack points alternating between loading and unloading, or joint points between
+/// open and closed); the drivers then hold the crack branches and the joints' contact
+/// statuses for the rest of the increment.
 pub(super) fn cycling(history: &[f64]) -> bool {
     let n = history.len();
     n >= 7 && history[n - 1] >= 0.5 * history[n - 4]
@@ -101,6 +102,7 @@ pub(super) fn newton(
         history.push(rel);
         if cycling(&history) {
             sys.freeze_cracks();
+            sys.hold_contacts();
         }
         if c.verbose {
             eprintln!(

@@ -415,6 +415,7 @@ fn newton_controlled(
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
+            ctx.sys.hold_contacts();
         }
         if controls.verbose {
             eprintln!(
@@ -856,6 +857,7 @@ fn arc_increment(
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
+            ctx.sys.hold_contacts();
         }
         if controls.verbose {
             eprintln!(
