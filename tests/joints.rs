@@ -619,6 +619,14 @@ uy = 0.0
     assert!(close(force(&mut sys, -g), 0.0), "held open");
     sys.families.revert();
     assert!(close(force(&mut sys, -g), -full), "released by revert");
+    // Released by the drivers' check once an increment converges on held statuses.
+    assert_eq!(sys.hold_contacts(), n_points);
+    assert!(sys.release_contacts() && !sys.release_contacts());
+    assert!(
+        close(force(&mut sys, -g), -full),
+        "released by release_contacts"
+    );
+    sys.unlatch();
     // Held closed, committed: the next increment decides by λ again.
     sys.hold_contacts();
     sys.families.commit();

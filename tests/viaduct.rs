@@ -576,8 +576,8 @@ fn viaduct_on_concrete_runs_to_tendon_yield_and_l_over_100() {
 /// Arc-size objectivity of the concrete viaduct (issue 38 item 3; heavy: three runs of the
 /// whole example, about 7 s CPU each): with the failure step's `initial_increment` at
 /// 0.125, 0.25 (the example's) and 0.5, the run reaches tendon yield of T1 and the yield
-/// load agrees within 1 % (the task's bound; measured 5.681, 5.667, 5.680 × LM1, a spread of
-/// 0.26 %). Before the joints' contact status was held when Newton cycles, 0.125 stopped
+/// load agrees within 1 % (the task's bound; measured 5.684, 5.677, 5.689 × LM1, a spread of
+/// 0.21 %). Before the joints' contact status was held when Newton cycles, 0.125 stopped
 /// at 5.05 × LM1 with a dry-joint point at J7 opening and closing on alternate iterations.
 #[test]
 fn viaduct_on_concrete_yields_within_1_percent_for_three_arc_sizes_heavy() {

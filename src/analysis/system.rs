@@ -573,6 +573,17 @@ impl<'m> System<'m> {
         self.families.joints.held.clear();
     }
 
+    /// Release the held contact statuses; true if any were held. The drivers call it when
+    /// an increment has converged with them, to check the state against the free law.
+    pub fn release_contacts(&mut self) -> bool {
+        let held = !self.families.joints.held.is_empty();
+        if held {
+            self.last.valid = false;
+            self.families.joints.held.clear();
+        }
+        held
+    }
+
     /// Hold the contact status (closed or open) of every joint point as the last assembly
     /// left it, for the rest of the increment (see [`crate::elements::interface::joint_law`]):
     /// the drivers call it when their iterations cycle (`newton::cycling`), as they freeze
