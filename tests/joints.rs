@@ -555,3 +555,81 @@ fn joint_opens_closes_and_reopens_with_the_slip_reset() {
         }
     });
 }
+
+/// The contact status held when Newton cycles (`System::hold_contacts`, issue 38): two
+/// blocks, the right one moved rigidly by ±g along x (no strain in either block, so the
+/// internal forces on its nodes are the joint's alone). Held closed, the opened joint
+/// transmits the penalty tension K_n g b L; held open, the pressed joint transmits nothing
+/// (residual stiffness 0); released (a cut: `unlatch`, a revert, a commit) the law is
+/// decided by the sign of λ again: 0 open, K_n g b L in compression. A second hold in the
+/// same increment does nothing. Tolerance 1e-9 relative: sums of penalty products.
+#[test]
+fn held_contact_status_transmits_as_held_until_released() {
+    use segfem::analysis::system::System;
+    let supports = r#"
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 0.5]]
+ux = 0.0
+[[supports]]
+name = "pin"
+point = [0.0, 0.0]
+uy = 0.0
+"#;
+    let text = two_blocks(supports, "point_loads = []", 0.7);
+    let m = segfem::input::parse(&text, "two-blocks.toml")
+        .unwrap()
+        .model;
+    // Nodes of the right block: those of elements lying beyond the joint.
+    let mut right = vec![false; m.nodes.len()];
+    for e in &m.elements {
+        let xc = e.nodes.iter().map(|&n| m.nodes[n][0]).sum::<f64>() / e.nodes.len() as f64;
+        if xc > L {
+            e.nodes.iter().for_each(|&n| right[n] = true);
+        }
+    }
+    let g = 1e-6; // [m], 1 MPa of penalty stress at K_n = 1e12 Pa/m
+    let moved = |dx: f64| -> Vec<f64> {
+        (0..m.nodes.len())
+            .flat_map(|n| [if right[n] { dx } else { 0.0 }, 0.0])
+            .collect()
+    };
+    let mut sys = System::new(&m);
+    // Joint force on the right block along x [N].
+    let force = |sys: &mut System, dx: f64| -> f64 {
+        let f = sys.assemble(&moved(dx), false).unwrap().f_int;
+        (0..m.nodes.len())
+            .filter(|&n| right[n])
+            .map(|n| f[2 * n])
+            .sum()
+    };
+    let full = KN * g * B * L;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * full;
+    // Closed at λ = 0, held closed, then pulled open by g: tension K_n g b L.
+    assert!(close(force(&mut sys, 0.0), 0.0));
+    let n_points: usize = sys.families.joints.points.trial.iter().map(Vec::len).sum();
+    assert_eq!(sys.hold_contacts(), n_points);
+    assert!(close(force(&mut sys, g), full), "held closed");
+    assert_eq!(sys.hold_contacts(), 0, "one hold per increment");
+    // A cut releases it: open again, nothing transmitted.
+    sys.unlatch();
+    assert!(close(force(&mut sys, g), 0.0), "released by unlatch");
+    // Open, held open, then pressed by g: nothing transmitted while held.
+    assert_eq!(sys.hold_contacts(), n_points);
+    assert!(close(force(&mut sys, -g), 0.0), "held open");
+    sys.families.revert();
+    assert!(close(force(&mut sys, -g), -full), "released by revert");
+    // Released by the drivers' check once an increment converges on held statuses.
+    assert_eq!(sys.hold_contacts(), n_points);
+    assert!(sys.release_contacts() && !sys.release_contacts());
+    assert!(
+        close(force(&mut sys, -g), -full),
+        "released by release_contacts"
+    );
+    sys.unlatch();
+    // Held closed, committed: the next increment decides by λ again.
+    sys.hold_contacts();
+    sys.families.commit();
+    assert!(sys.families.joints.held.is_empty());
+    assert!(close(force(&mut sys, g), 0.0), "released by commit");
+}

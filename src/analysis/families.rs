@@ -37,7 +37,7 @@ impl Families {
     /// Accept the trial states of every family.
     pub fn commit(&mut self) {
         self.continuum.commit();
-        self.joints.points.commit();
+        self.joints.commit();
         self.tendons.states.commit();
         self.bars.steel.commit();
         self.bars.out.commit();
@@ -49,6 +49,7 @@ impl Families {
         self.continuum.gauss.revert();
         self.continuum.holds = Holds::default();
         self.joints.points.revert();
+        self.joints.held.clear();
         self.tendons.states.revert();
         self.bars.steel.revert();
         self.bars.out.revert();
@@ -176,6 +177,20 @@ pub struct Holds {
 pub struct JointBlock {
     /// Point states.
     pub points: Staged<Vec<Vec<InterfacePointState>>>,
+    /// Contact status (closed) of every point, per joint element, held for the rest of the
+    /// increment once its Newton iterations cycled (`System::hold_contacts`); empty when
+    /// nothing is held. It lasts one increment (released by commit, revert and
+    /// `System::unlatch`), so it is empty between increments and not saved.
+    #[serde(skip)]
+    pub held: Vec<Vec<bool>>,
+}
+
+impl JointBlock {
+    /// Accept the trial states and release the held statuses (they last one increment).
+    pub fn commit(&mut self) {
+        self.points.commit();
+        self.held.clear();
+    }
 }
 
 /// External tendons (one entry per tendon of the model; None until stressed).

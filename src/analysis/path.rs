@@ -8,7 +8,7 @@ use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{
     self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm,
 };
-use super::newton::{cycling, damping, newton, norm, overshot};
+use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
 use super::solver::SparseCholesky;
 use super::system::{Assembled, System};
 use crate::fem::dofs::CONSTRAINED;
@@ -415,6 +415,7 @@ fn newton_controlled(
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
+            ctx.sys.hold_contacts();
         }
         if controls.verbose {
             eprintln!(
@@ -430,6 +431,17 @@ fn newton_controlled(
             let energy_ok = it > 1
                 && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
             if rel <= controls.force_tolerance || energy_ok {
+                if ctx.sys.release_contacts() {
+                    // Converged on held contact statuses: checked under the free law.
+                    let free = controlled_residual(ctx, &u, f_ext, ctl, None)?;
+                    history.push(free.rel);
+                    let tol = controls.force_tolerance;
+                    if !hold_consistent(free.rel, rel, tol, controls.verbose) {
+                        return Err(NewtonFailure::diverged(history, free.rf));
+                    }
+                    ctx.u.copy_from_slice(&u);
+                    return Ok((free.f_int, it));
+                }
                 ctx.u.copy_from_slice(&u);
                 return Ok((f_int, it));
             }
@@ -856,6 +868,7 @@ fn arc_increment(
         history.push(rel);
         if cycling(&history) {
             ctx.sys.freeze_cracks();
+            ctx.sys.hold_contacts();
         }
         if controls.verbose {
             eprintln!(
@@ -870,6 +883,18 @@ fn arc_increment(
         let energy_ok = it > 2
             && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
         if rel <= controls.force_tolerance || energy_ok {
+            let f_int = if ctx.sys.release_contacts() {
+                // Converged on held contact statuses: checked under the free law.
+                let free = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full)?;
+                history.push(free.rel);
+                let tol = controls.force_tolerance;
+                if !hold_consistent(free.rel, rel, tol, controls.verbose) {
+                    return Err(NewtonFailure::diverged(history, free.rf));
+                }
+                free.f_int
+            } else {
+                f_int
+            };
             ctx.u.copy_from_slice(&u);
             return Ok(ArcIncrement {
                 f_int,

@@ -318,6 +318,7 @@ pub(crate) mod layout {
                 },
                 joints: JointBlock {
                     points: Staged::new(vec![vec![joint]]),
+                    held: Vec::new(),
                 },
                 tendons: TendonBlock {
                     u0: vec![vec![[1.0, 2.0], [3.0, 4.0]]],

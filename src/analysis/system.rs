@@ -452,6 +452,7 @@ impl<'m> System<'m> {
             },
             joints: JointBlock {
                 points: Staged::new(iface_committed),
+                held: Vec::new(),
             },
             tendons: TendonBlock {
                 u0: vec![Vec::new(); n_tendons],
@@ -569,6 +570,38 @@ impl<'m> System<'m> {
         let holds = &mut self.families.continuum.holds;
         holds.latched.clear();
         holds.frozen = false;
+        self.families.joints.held.clear();
+    }
+
+    /// Release the held contact statuses; true if any were held. The drivers call it when
+    /// an increment has converged with them, to check the state against the free law.
+    pub fn release_contacts(&mut self) -> bool {
+        let held = !self.families.joints.held.is_empty();
+        if held {
+            self.last.valid = false;
+            self.families.joints.held.clear();
+        }
+        held
+    }
+
+    /// Hold the contact status (closed or open) of every joint point as the last assembly
+    /// left it, for the rest of the increment (see [`crate::elements::interface::joint_law`]):
+    /// the drivers call it when their iterations cycle (`newton::cycling`), as they freeze
+    /// the crack branches, since a dry-joint point at decompression can open and close on
+    /// alternate iterations. At most once per increment. Returns the number of points held.
+    pub fn hold_contacts(&mut self) -> usize {
+        let j = &mut self.families.joints;
+        if !j.held.is_empty() || j.points.trial.is_empty() {
+            return 0;
+        }
+        self.last.valid = false;
+        j.held = j
+            .points
+            .trial
+            .iter()
+            .map(|pts| pts.iter().map(|s| s.closed).collect())
+            .collect();
+        j.held.iter().map(Vec::len).sum()
     }
 
     /// Hold every cracked point on the branch (loading/unloading) of the last assembly for
@@ -700,6 +733,7 @@ impl<'m> System<'m> {
         }
         self.elem_buf2 = other;
         // Joint contact elements.
+        let held = &self.families.joints.held;
         let joints = &mut self.families.joints.points;
         let nd = max_dofs(model.interfaces.iter().map(|i| i.nodes.len()));
         let pieces: Vec<_> = joints.trial.iter_mut().enumerate().collect();
@@ -722,6 +756,7 @@ impl<'m> System<'m> {
                     element: &self.interfaces[i],
                     params: &data.params,
                     thickness: data.thickness,
+                    held: held.get(i).map_or(&[], Vec::as_slice),
                 };
                 let into = slot(fe, ke, ue.len(), tangent);
                 joint

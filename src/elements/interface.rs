@@ -216,6 +216,9 @@ pub struct Joint<'a> {
     pub params: &'a InterfaceParams,
     /// Out-of-plane thickness [m].
     pub thickness: f64,
+    /// Contact status (closed) of every point held for the rest of the increment, or empty
+    /// when none is held ([`joint_law`]).
+    pub held: &'a [bool],
 }
 
 impl super::ElementResponse for Joint<'_> {
@@ -230,9 +233,9 @@ impl super::ElementResponse for Joint<'_> {
         trial: Self::Trial<'_>,
         into: super::Response<'_>,
     ) -> Result<bool, crate::materials::point::UpdateError> {
-        let r = self
-            .element
-            .response_with(self.params, self.thickness, u, committed, true);
+        let r =
+            self.element
+                .response_held(self.params, self.thickness, u, committed, self.held, true);
         into.f.copy_from_slice(&r.f_int);
         if let Some(k) = into.k {
             k.copy_from_slice(&r.k);
@@ -276,8 +279,12 @@ pub struct JointLawResult {
 
 /// Penalty/Coulomb joint law (docs/theory-joints-tendons.md §1) for one point: `lambda` \[m\]
 /// (penetration positive), `g_t` \[m\], committed plastic slip `sp_c` \[m\] and bond flag
-/// `bonded_c`.
+/// `bonded_c`; `held` is the contact status (closed) of a dry point held for the rest of the
+/// increment (`None`: decided by the sign of λ).
 ///
+/// * held (Newton cycled on the point opening and closing, docs/theory-joints-tendons.md
+///   §1 "Held contact status"): the dry point is closed or open as held, whatever the sign of
+///   λ, so the law is one smooth branch for the rest of the increment;
 /// * bonded (epoxy intact): σ_n = K_n λ in compression and tension; if −σ_n > f_t the point
 ///   debonds and is evaluated as dry in the same call;
 /// * dry closed (λ ≥ 0): σ_n = K_n λ, τ_trial = K_t (g_t − s_p); slip if
@@ -290,12 +297,17 @@ pub fn joint_law(
     g_t: f64,
     sp_c: f64,
     bonded_c: bool,
+    held: Option<bool>,
 ) -> JointLawResult {
     let mut bonded = bonded_c;
     if bonded && -p.kn * lambda > p.tensile_strength {
         bonded = false;
     }
-    let closed = lambda >= 0.0;
+    // A bond acts in tension and compression alike: only a dry point's status is held.
+    let closed = match held {
+        Some(h) if !bonded => h,
+        _ => lambda >= 0.0,
+    };
     if bonded || closed {
         let sigma_n = p.kn * lambda;
         // Cohesion belongs to the bond of an epoxy joint, and to the joint itself if dry.
@@ -554,7 +566,29 @@ impl InterfaceElement {
         committed: &[InterfacePointState],
         symmetric_tangent: bool,
     ) -> InterfaceResponse {
+        self.response_held(params, thickness, u, committed, &[], symmetric_tangent)
+    }
+
+    /// As [`Self::response_with`], with the contact status (closed) of every point held as
+    /// `held` says (empty: none held; see [`joint_law`]).
+    ///
+    /// Panics if `held` is neither empty nor one entry per point.
+    pub fn response_held(
+        &self,
+        params: &InterfaceParams,
+        thickness: f64,
+        u: &[f64],
+        committed: &[InterfacePointState],
+        held: &[bool],
+        symmetric_tangent: bool,
+    ) -> InterfaceResponse {
         let nd = self.n_dofs();
+        assert!(
+            held.is_empty() || held.len() == self.points.len(),
+            "interface: {} held statuses for {} points",
+            held.len(),
+            self.points.len()
+        );
         assert_eq!(
             u.len(),
             nd,
@@ -573,9 +607,16 @@ impl InterfaceElement {
         // Rows of B: bt (tangential), bn (normal), each of length nd.
         let mut bt = vec![0.0; nd];
         let mut bn = vec![0.0; nd];
-        for (p, c) in self.points.iter().zip(committed) {
+        for (g, (p, c)) in self.points.iter().zip(committed).enumerate() {
             let (gt, lam) = self.kinematics(p, u);
-            let r = joint_law(params, lam, gt, c.plastic_slip, c.bonded);
+            let r = joint_law(
+                params,
+                lam,
+                gt,
+                c.plastic_slip,
+                c.bonded,
+                held.get(g).copied(),
+            );
             for i in 0..self.n_a {
                 for d in 0..2 {
                     bt[2 * i + d] = -p.n_a[i] * p.tangent[d];
@@ -940,21 +981,56 @@ mod tests {
         }
     }
 
+    /// A held contact status overrides the sign of λ for a dry point (closed: σ_n = K_n λ
+    /// even with λ < 0; open: σ_n = r K_n λ even with λ > 0), a bonded point ignores it, and
+    /// no hold is the plain law to the bit. Exact comparisons: one product each.
+    #[test]
+    fn held_status_overrides_the_sign_of_lambda_on_dry_points_only() {
+        let mut p = InterfaceParams::dry(KN, KT, 0.6);
+        p.residual_ratio = 1e-3;
+        let lam = 1e-6;
+        for (l, held, closed, sigma) in [
+            (-lam, Some(true), true, -KN * lam),
+            (lam, Some(false), false, 1e-3 * KN * lam),
+            (-lam, Some(false), false, -1e-3 * KN * lam),
+            (lam, Some(true), true, KN * lam),
+        ] {
+            let r = joint_law(&p, l, 0.0, 0.0, false, held);
+            assert_eq!(
+                (r.closed, r.sigma_n),
+                (closed, sigma),
+                "λ {l}, held {held:?}"
+            );
+            assert_eq!(r.tangent[1][1], if closed { KN } else { 1e-3 * KN });
+        }
+        // Without a hold the law is unchanged: held at the status λ gives is the same law.
+        for l in [-lam, lam] {
+            assert_eq!(
+                joint_law(&p, l, 2e-7, 1e-7, false, None),
+                joint_law(&p, l, 2e-7, 1e-7, false, Some(l >= 0.0))
+            );
+        }
+        // An intact epoxy bond acts in tension: the hold does not apply.
+        let e = InterfaceParams::epoxy(KN, KT, 0.6, 2e6, 3e6);
+        let r = joint_law(&e, -lam, 0.0, 0.0, true, Some(false));
+        assert!(r.bonded && r.sigma_n == -KN * lam);
+    }
+
     /// Epoxy joint: carries tension up to f_t, then debonds and is dry (no tension, no
     /// cohesion). Tolerance 1e-9 rel (closed-form values).
     #[test]
     fn epoxy_joint_debonds_in_tension() {
         let p = InterfaceParams::epoxy(KN, KT, 0.6, 2e6, 3e6);
-        let r = joint_law(&p, -2e6 / KN, 0.0, 0.0, true);
+        let r = joint_law(&p, -2e6 / KN, 0.0, 0.0, true, None);
         assert!(r.bonded && (r.sigma_n + 2e6).abs() < 1e-9 * 2e6);
-        let r = joint_law(&p, -4e6 / KN, 0.0, 0.0, true);
+        let r = joint_law(&p, -4e6 / KN, 0.0, 0.0, true, None);
         assert!(!r.bonded && r.sigma_n == 0.0 && r.tau == 0.0);
         // Re-closed after debonding: cohesion lost, friction only.
         let g = 1e-3;
-        let r = joint_law(&p, 5e6 / KN, g, 0.0, false);
+        let r = joint_law(&p, 5e6 / KN, g, 0.0, false, None);
         assert!(r.sliding && (r.tau - 0.6 * 5e6).abs() < 1e-9 * 3e6);
         // Bonded: cohesion adds to friction.
-        let r = joint_law(&p, 5e6 / KN, g, 0.0, true);
+        let r = joint_law(&p, 5e6 / KN, g, 0.0, true, None);
         assert!(r.sliding && (r.tau - (0.6 * 5e6 + 2e6)).abs() < 1e-9 * 5e6);
     }
 
