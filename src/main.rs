@@ -667,9 +667,16 @@ fn check(model: PathBuf) -> ExitCode {
                 "  supports:  {}",
                 m.supports
                     .iter()
-                    .map(|s| match s.dofs.len() {
-                        1 => format!("{} (1 dof)", s.name),
-                        n => format!("{} ({n} dofs)", s.name),
+                    .enumerate()
+                    .map(|(i, s)| {
+                        let one_way = m
+                            .staging
+                            .push(i)
+                            .map_or(String::new(), |p| format!(", one-way {}", p.name()));
+                        match s.dofs.len() {
+                            1 => format!("{} (1 dof{one_way})", s.name),
+                            n => format!("{} ({n} dofs{one_way})", s.name),
+                        }
                     })
                     .collect::<Vec<_>>()
                     .join(", ")

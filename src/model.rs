@@ -9,7 +9,7 @@ use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
 use serde::Serialize;
-pub use stages::{Lifetime, Staging};
+pub use stages::{Lifetime, Push, Staging};
 
 /// A continuum element.
 #[derive(Debug, Clone, Serialize)]

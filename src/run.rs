@@ -652,7 +652,20 @@ pub fn run_file_opts(
     // History is written whatever happened: every converged increment is kept.
     rec.write_history()
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("history.csv").display())))?;
-    let stages = stage_results::stage_results(&model, &rec.rows, &rec.openings);
+    let stages = stage_results::stage_results(&model, &rec.rows, &rec.openings, &rec.lifted);
+    // Every lift-off and touch-down of a one-way support, staged model or not.
+    warnings.extend(
+        stage_results::support_events(&model, &rec.rows, &rec.lifted)
+            .into_iter()
+            .map(|(i, e)| format!("step '{}': {e}", model.steps[i].name)),
+    );
+    if timings.support_chatter > 0 {
+        warnings.push(format!(
+            "{} increments kept with one-way support statuses that still changed after {} rounds (a support point lifting off and touching down in turn): smaller increments settle them",
+            timings.support_chatter,
+            crate::analysis::one_way::MAX_ROUNDS
+        ));
+    }
     if !stages.is_empty() {
         let p = out.join("stages.csv");
         write_atomic(&p, stage_results::render_csv(&stages).as_bytes())

@@ -165,7 +165,8 @@ fn joint_opened_by_striking_a_prop_is_flagged_as_a_construction_opening() {
             "first_row",
             "last_row",
             "max_joint_opening [m]",
-            "joint"
+            "joint",
+            "support_events"
         ]
     );
     assert_eq!(rows.len(), 3, "one row per step: {rows:?}");

@@ -172,9 +172,16 @@ fn erection_reactions_follow_the_statics_of_the_stage_sequence() {
     // tendon pulls along its deformed spans while the concrete is small-displacement
     // (docs/input.md), so its 40 MN leave a moment of P times the ≈ 0.3 mm its spans move
     // sideways, ≈ 12 kN·m over the 40 m span: 300 N, 1e-4 of the reaction.
+    // The bearings and falsework push up only (issue 39): stressing span 1 cambers it off
+    // its falsework, so in "place and stress span 1" already it hangs on A1 and P1 as the
+    // simple span (a two-way falsework made A1 pull there with −1.28 MN).
     let r_a1 = w * 42.0 * (40.0 - 20.5) / 40.0;
     let tol1 = 5e-4 * r_a1;
-    for name in ["strike falsework 1", "span 1 creeps"] {
+    for name in [
+        "place and stress span 1",
+        "strike falsework 1",
+        "span 1 creeps",
+    ] {
         let r = &rec[step(&m, name)];
         assert!(
             (r.reactions[a1] - r_a1).abs() < tol1,
@@ -187,6 +194,19 @@ fn erection_reactions_follow_the_statics_of_the_stage_sequence() {
             r.reactions[p1],
             w * 42.0 - r_a1
         );
+    }
+
+    // No bearing or falsework pulls at any step end (a reaction below zero by more than
+    // the equilibrium tolerance above).
+    for (k, r) in rec.iter().enumerate() {
+        for (s, &reaction) in r.reactions.iter().enumerate() {
+            assert!(
+                reaction > -tol(r),
+                "step '{}': support '{}' pulls with {reaction:.0} N",
+                m.steps[k].name,
+                m.supports[s].name
+            );
+        }
     }
 
     // No joint opens once its span is stressed: the tendon is stressed in the step that
@@ -283,6 +303,46 @@ fn generated_viaduct_is_the_explicit_one() {
             g == e,
             "{name} differ between the generated and the explicit viaduct"
         );
+    }
+}
+
+/// `hold_down` makes the named bearings and falsework two-way; the others stay one-way
+/// (pushing up). Naming all seven gives the two-way model of before issue 39: the explicit
+/// example with its `one_way` keys taken out, to the last bit.
+#[test]
+fn hold_down_makes_named_supports_two_way() {
+    use segfem::model::Push;
+    let parse = |text: &str| {
+        segfem::input::parse(text, "viaduct.toml")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .model
+    };
+    let example = include_str!("../examples/viaduct.toml");
+    let with = |names: &str| {
+        assert_eq!(example.matches("segment_length = 3.7").count(), 1);
+        example.replace(
+            "segment_length = 3.7",
+            &format!("hold_down = [{names}]\nsegment_length = 3.7"),
+        )
+    };
+    let m = parse(&with(r#""A1", "falsework 1""#));
+    let push = |name: &str| {
+        let s = m.supports.iter().position(|s| s.name == name).unwrap();
+        m.staging.push(s)
+    };
+    assert_eq!(push("A1"), None);
+    assert_eq!(push("falsework 1"), None);
+    for name in ["P1", "P2", "A2", "falsework 2", "falsework 3"] {
+        assert_eq!(push(name), Some(Push::PlusY), "{name}");
+    }
+    let all = parse(&with(
+        r#""A1", "P1", "P2", "A2", "falsework 1", "falsework 2", "falsework 3""#,
+    ));
+    assert!(!all.staging.has_one_way());
+    let two_way =
+        parse(&include_str!("../examples/viaduct-explicit.toml").replace("one_way = \"+y\"\n", ""));
+    for ((name, g), (_, e)) in parts(&all).iter().zip(parts(&two_way).iter()) {
+        assert!(g == e, "{name} differ");
     }
 }
 

@@ -176,6 +176,14 @@ pub struct Timings {
     /// Limit points or bifurcations passed (the number of negative pivots changed), one
     /// message each.
     pub limit_points: Vec<String>,
+    /// One-way supports: converged attempts solved again because a support point lifted
+    /// off or touched down in them (docs/theory-stages.md, "One-way supports").
+    #[serde(skip_serializing_if = "is_zero")]
+    pub support_switches: usize,
+    /// Increments kept with the support statuses of their last round after
+    /// [`super::one_way::MAX_ROUNDS`] rounds of switching (the statuses chatter).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub support_chatter: usize,
     /// IMPL-EX error control (`[solver] implex_tolerance`): increments retried at half the
     /// size because their IMPL-EX error exceeded the tolerance.
     #[serde(skip_serializing_if = "is_zero")]

@@ -102,6 +102,36 @@ pub struct FailureReport {
     pub joint_points_sliding: usize,
 }
 
+/// The one-way supports off their seats in the last attempt (trial statuses), said so: a
+/// structure that lifts off the supports of a direction is a mechanism.
+fn lifted_supports(sys: &System) -> Option<String> {
+    let st = sys.stages.as_ref()?;
+    let mut per = vec![(0, 0); sys.model.supports.len()];
+    for p in st.one_way.points.iter().filter(|p| p.acting) {
+        per[p.support].1 += 1;
+        per[p.support].0 += usize::from(!p.trial);
+    }
+    let names: Vec<String> = per
+        .iter()
+        .enumerate()
+        .filter(|(_, (off, _))| *off > 0)
+        .map(|(s, &(off, n))| {
+            let name = &sys.model.supports[s].name;
+            if off == n {
+                format!("'{name}'")
+            } else {
+                format!("'{name}' ({off} of {n} points)")
+            }
+        })
+        .collect();
+    (!names.is_empty()).then(|| {
+        format!(
+            "one-way supports lifted off in this attempt: {} (a structure lifted off the supports that held it in a direction is a mechanism)",
+            names.join(", ")
+        )
+    })
+}
+
 /// How many of the largest residual components are reported.
 const N_WORST: usize = 5;
 
@@ -149,6 +179,10 @@ pub(crate) fn report(sys: &System, at: FailedAt, failure: &NewtonFailure) -> Fai
             worst_dofs(sys, residual),
             Vec::new(),
         ),
+    };
+    let reason = match lifted_supports(sys) {
+        Some(l) => format!("{reason}; {l}"),
+        None => reason,
     };
     let nodes: Vec<usize> = worst.iter().map(|w| w.node - 1).collect();
     for (e, el) in model.elements.iter().enumerate() {

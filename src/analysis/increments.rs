@@ -410,6 +410,9 @@ pub(super) trait Stepper {
         target: f64,
     ) -> Result<(Vec<f64>, usize), NewtonFailure>;
 
+    /// The external forces of the last attempt (all dofs) [N].
+    fn external(&self) -> &[f64];
+
     /// Whether the IMPL-EX error control applies to this step's increments.
     fn implex_controlled(&self) -> bool {
         true
@@ -461,11 +464,14 @@ pub(super) fn run(
     ctx: &mut PathContext,
     obs: &mut dyn Observer,
 ) -> Result<(), AnalysisError> {
+    // Rounds of one-way support switches in the current increment.
+    let mut rounds = 0;
     while !ctl.finished() {
         let target = ctl.target();
         let (f_int, iterations) = match stepper.attempt(ctx, obs, ctl, target) {
             Ok(solved) => solved,
             Err(failure) => {
+                rounds = 0;
                 let give_up = ctl.cuts >= ctl.max_cuts;
                 if let Some(e) = stepper.failed(ctx, ctl, target, failure, give_up) {
                     return Err(e);
@@ -474,6 +480,15 @@ pub(super) fn run(
                 continue;
             }
         };
+        // A one-way support lifted off or touched down: the same increment again, from
+        // its start, with the new statuses.
+        if let Some(trial) = super::one_way::check(ctx, &f_int, stepper.external(), &mut rounds) {
+            ctx.timings.iterations += iterations;
+            stepper.discard(ctx);
+            super::one_way::resume(ctx, &trial);
+            ctl.retry = true;
+            continue;
+        }
         let implex = stepper.implex_controlled();
         let verdict = ctl.converged(target, iterations, ctx.u, &ctx.sys.u, |c| {
             implex

@@ -7,6 +7,7 @@ pub mod families;
 mod increments;
 pub mod loads;
 mod newton;
+pub mod one_way;
 pub mod ordering;
 pub mod path;
 mod responses;

@@ -39,6 +39,9 @@ impl PathContext<'_, '_> {
     pub(super) fn back_to_committed(&mut self) {
         self.u.copy_from_slice(&self.sys.u);
         self.sys.unlatch();
+        if let Some(st) = self.sys.stages.as_mut() {
+            st.revert_contacts();
+        }
     }
 
     /// Internal forces, tangent values and the element-force scale (the residual reference
@@ -299,6 +302,10 @@ impl increments::Stepper for DisplacementStepper {
             .then(|| sizing.prev_size.map(|p| (target - sizing.level) / p))
             .flatten();
         newton_controlled(ctx, &self.f_ext, &self.ctl, shift, extrapolate)
+    }
+
+    fn external(&self) -> &[f64] {
+        &self.f_ext
     }
 
     fn discard(&mut self, ctx: &mut PathContext) {
@@ -676,12 +683,13 @@ fn arc_length_step(
     let n_dofs = ctx.sys.model.n_dofs();
     let f_base = external_forces(n_dofs, ctx.cases, &held);
     let q_full = external_forces(n_dofs, ctx.cases, &a.reference);
-    let q_free = ctx.sys.to_free(&q_full);
     let max_cuts = ctx.sys.model.controls.max_cuts;
     let mut lambda = 0.0;
     let mut sizing = ArcSizing::default();
     let mut du_prev: Option<Vec<f64>> = None;
     let mut increment = 0;
+    // Rounds of one-way support switches in the current increment.
+    let mut rounds = 0;
     let start_disp = a
         .target_displacement
         .map(|(n, d, _)| ctx.sys.u[2 * n + d.index()]);
@@ -695,6 +703,8 @@ fn arc_length_step(
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
         ctx.sys.time.extrapolation = sizing.extrapolation();
         let dl_try = sizing.dl;
+        // On the equations free now (one-way supports hold and let go of theirs).
+        let q_free = ctx.sys.to_free(&q_full);
         let loads = (f_base.as_slice(), q_full.as_slice(), q_free.as_slice());
         match arc_increment(ctx, loads, lambda, &mut sizing.dl, a, &du_prev) {
             Ok(inc) if sizing.implex_retry(ctx.sys, ctx.timings) => {
@@ -704,6 +714,15 @@ fn arc_length_step(
                 ctx.back_to_committed();
             }
             Ok(inc) => {
+                // A one-way support lifted off or touched down: the same arc again, from
+                // its start, with the new statuses.
+                let f_try = external_forces_along(&f_base, &q_full, lambda + inc.d_lambda);
+                if let Some(trial) = super::one_way::check(ctx, &inc.f_int, &f_try, &mut rounds) {
+                    ctx.timings.iterations += inc.iterations;
+                    ctx.back_to_committed();
+                    super::one_way::resume(ctx, &trial);
+                    continue;
+                }
                 sizing.accept(dl_try);
                 let mut lam_new = lambda + inc.d_lambda;
                 let mut f_int = inc.f_int;
@@ -752,6 +771,7 @@ fn arc_length_step(
                 }
             }
             Err(f) => {
+                rounds = 0;
                 ctx.back_to_committed();
                 let cuts = sizing.cuts;
                 if !sizing.cut(max_cuts) {

@@ -10,6 +10,7 @@
 //! their rows and columns of the tangent are replaced by a unit diagonal and their residual
 //! by zero, so the equation numbering and sparsity pattern stay those of the whole model.
 
+use super::one_way::OneWay;
 use crate::fem::dofs::CONSTRAINED;
 use crate::fem::pattern::LowerPattern;
 use crate::model::Model;
@@ -37,6 +38,11 @@ pub struct StageState {
     /// linearly over the step: the load (1 − level) · release is added to the external
     /// forces.
     pub release: Vec<f64>,
+    /// Equations held for other reasons than a one-way support's contact (no active
+    /// element, an active two-way staged support); `held` adds the touching contact points.
+    pub base_held: Vec<bool>,
+    /// The contact points of the one-way supports and their statuses.
+    pub one_way: OneWay,
 }
 
 /// Displacements [m] of `nodes` in `u`, interleaved.
@@ -112,7 +118,9 @@ impl StageState {
                 if q == CONSTRAINED {
                     continue;
                 }
-                if l.active_in(step) {
+                // A one-way support's pushing dof is held by its contact status.
+                let one_way = st.push(s).is_some_and(|p| p.dir() == dir);
+                if l.active_in(step) && !one_way {
                     self.held[q] = true;
                 } else if l.until == Some(step) {
                     if let Some(r) = reaction {
@@ -121,7 +129,25 @@ impl StageState {
                 }
             }
         }
+        self.base_held = self.held.clone();
+        self.one_way.enter(model, step, u, eq, &alive);
+        self.held = self.one_way.held(&self.base_held);
         self.step = Some(step);
+    }
+
+    /// Set the held equations from the trial statuses of the one-way supports.
+    pub fn apply_contacts(&mut self) {
+        if !self.one_way.points.is_empty() {
+            self.held = self.one_way.held(&self.base_held);
+        }
+    }
+
+    /// Back to the committed statuses of the one-way supports (a thrown-away attempt).
+    pub fn revert_contacts(&mut self) {
+        if self.one_way.changed() {
+            self.one_way.revert();
+            self.apply_contacts();
+        }
     }
 
     /// Whether a support is removed at the start of step `step` (the reactions must then be

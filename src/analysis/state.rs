@@ -192,6 +192,13 @@ impl System<'_> {
                 )?;
                 check("staged equations", st.held.len(), self.dofs.n_eq)?;
                 check("staged releases", st.release.len(), self.u.len())?;
+                check("staged base equations", st.base_held.len(), self.dofs.n_eq)?;
+                let one_way = self.model.staging.has_one_way();
+                if st.step.is_some() && one_way == st.one_way.points.is_empty() {
+                    return Err(
+                        "the checkpoint and the model differ in their one-way supports: the model changed since the checkpoint was written".into(),
+                    );
+                }
             }
             (None, None) => {}
             (saved, _) => {
@@ -350,6 +357,20 @@ pub(crate) mod layout {
                 interface_ref: vec![Some(vec![3.0, 4.0])],
                 held: vec![false, true],
                 release: vec![5.0, 6.0],
+                base_held: vec![false, false],
+                one_way: crate::analysis::one_way::OneWay {
+                    points: vec![crate::analysis::one_way::ContactPoint {
+                        support: 0,
+                        node: 1,
+                        dof: 3,
+                        eq: 1,
+                        sign: -1.0,
+                        seat: 7.0,
+                        acting: true,
+                        touching: false,
+                        trial: false,
+                    }],
+                },
             }),
         }
     }

@@ -320,6 +320,10 @@ impl increments::Stepper for LoadStepper<'_> {
         )
     }
 
+    fn external(&self) -> &[f64] {
+        &self.f_ext
+    }
+
     fn implex_controlled(&self) -> bool {
         self.step.kind != StepKind::Linear
     }

@@ -313,13 +313,18 @@ pub struct Assembled {
 impl<'m> System<'m> {
     /// Build dof map, pattern and initial states.
     pub fn new(model: &'m Model) -> Self {
-        // Supports activated or removed by a stage are equations, held while they act.
+        // Supports activated or removed by a stage are equations, held while they act; so
+        // are the pushing dofs of one-way supports, held while they touch.
         let constrained: Vec<(usize, f64)> = model
             .supports
             .iter()
             .enumerate()
-            .filter(|(i, _)| !model.staging.support_is_staged(*i))
-            .flat_map(|(_, s)| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+            .flat_map(|(i, s)| {
+                s.dofs
+                    .iter()
+                    .filter(move |(_, d, _)| !model.staging.support_dof_is_equation(i, *d))
+                    .map(|(n, d, v)| (2 * n + d.index(), *v))
+            })
             .collect();
         let dofs = DofMap::new(model.nodes.len(), &constrained);
         // The node lists in family order: the assembler's element numbers are the blocks of
@@ -344,7 +349,8 @@ impl<'m> System<'m> {
             && model.interfaces.is_empty()
             && model.bars.is_empty()
             && model.geometry == Geometry::Linear
-            && !model.staging.is_staged();
+            && !model.staging.is_staged()
+            && !model.staging.has_one_way();
         // The pattern and ordering, and beside them the material-point states (≈ 0.15 s
         // of fresh pages at 5e5 dofs): independent, built at once on the two sides of a
         // rayon join.
@@ -501,14 +507,16 @@ impl<'m> System<'m> {
             bar_gps,
             bar_offset,
             thermal,
-            stages: model.staging.is_staged().then(StageState::default),
+            stages: (model.staging.is_staged() || model.staging.has_one_way())
+                .then(StageState::default),
             elem_buf: (Vec::new(), Vec::new()),
             elem_buf2: (Vec::new(), Vec::new()),
             last: LastAssembly {
                 kept: !linear
                     && model.interfaces.is_empty()
                     && model.tendons.is_empty()
-                    && !model.staging.is_staged(),
+                    && !model.staging.is_staged()
+                    && !model.staging.has_one_way(),
                 ..Default::default()
             },
             blocks,
@@ -1146,13 +1154,19 @@ impl<'m> System<'m> {
         std::mem::swap(&mut self.u, &mut self.u_prev);
         self.u.copy_from_slice(u);
         self.families.commit();
+        if let Some(st) = self.stages.as_mut() {
+            st.one_way.commit();
+        }
     }
 
     /// Add `ratio` × the last converged increment (u − u_prev) to the free dofs of `u` [m]:
     /// the extrapolated start of the next increment ([`crate::model::Predictor`]).
     pub fn extrapolate(&self, u: &mut [f64], ratio: f64) {
+        // Held equations stay where they are (a one-way support touching down in this
+        // increment moved in the last one).
+        let held = |q: usize| self.stages.as_ref().is_some_and(|st| st.held[q]);
         for (d, &q) in self.dofs.eq.iter().enumerate() {
-            if q != CONSTRAINED {
+            if q != CONSTRAINED && !held(q) {
                 u[d] += ratio * (self.u[d] - self.u_prev[d]);
             }
         }

@@ -190,6 +190,7 @@ pub struct SupportIn {
     pub uy: Option<f64>,
     pub bearing: Option<f64>,
     pub local_zone: Option<bool>,
+    pub one_way: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

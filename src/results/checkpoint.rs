@@ -27,8 +27,10 @@ const MAGIC: &str = "segfem checkpoint";
 /// before the first step, which is the model's initial state); 8: no Gauss outputs of linear
 /// elastic points (a restart recomputes them from the displacements), and concrete points
 /// keep the softening cut-off's history (`cutoff_max`, `cutoff_max_old`); 9: the
-/// construction stage reached (staged models restart) and the recorder's joint openings.
-const VERSION: u32 = 9;
+/// construction stage reached (staged models restart) and the recorder's joint openings; 10:
+/// the one-way supports' contact points and statuses, and the recorder's lifted points per
+/// row.
+const VERSION: u32 = 10;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -45,6 +47,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (7, 2_879_888_328_409_885_521),
     (8, 13_423_329_791_089_162_975),
     (9, 7_976_921_271_131_270_574),
+    (10, 5_454_227_443_183_593_876),
 ];
 
 #[derive(Serialize, Deserialize)]

@@ -51,6 +51,9 @@ pub struct RecorderState {
     /// Per row: the largest opening of an open joint point [m] and its joint (staged
     /// models; stages.csv reports it per stage).
     pub openings: Vec<(f64, Option<usize>)>,
+    /// Per row: (points lifted off, points acting) of every support (models with one-way
+    /// supports; empty otherwise).
+    pub lifted: Vec<Vec<(usize, usize)>>,
 }
 
 /// Records history and writes outputs into a directory.
@@ -62,6 +65,10 @@ pub struct Recorder<'m> {
     /// Per row: the largest opening of an open joint point [m] and its joint (staged models
     /// only, else (0, None); not a history.csv column: stages.csv reports it per stage).
     pub openings: Vec<(f64, Option<usize>)>,
+    /// Per row: (points lifted off, points acting) of every support (models with one-way
+    /// supports; empty otherwise): the lift-offs and touch-downs of stages.csv and
+    /// summary.json.
+    pub lifted: Vec<Vec<(usize, usize)>>,
     pvd: Vec<(f64, usize, String)>,
     /// Displacements at the end of each step some monitor measures from.
     step_end_u: std::collections::HashMap<usize, Vec<f64>>,
@@ -152,6 +159,7 @@ impl<'m> Recorder<'m> {
             dir,
             rows: Vec::new(),
             openings: Vec::new(),
+            lifted: Vec::new(),
             pvd: Vec::new(),
             step_end_u: Default::default(),
             write_fields,
@@ -186,6 +194,7 @@ impl<'m> Recorder<'m> {
             pvd: self.pvd.clone(),
             step_end_u,
             openings: self.openings.clone(),
+            lifted: self.lifted.clone(),
         }
     }
 
@@ -198,6 +207,7 @@ impl<'m> Recorder<'m> {
     pub fn restore(&mut self, s: RecorderState) {
         self.rows = s.rows;
         self.openings = s.openings;
+        self.lifted = s.lifted;
         self.pvd = s.pvd;
         self.step_end_u = s.step_end_u.into_iter().collect();
         self.history = None;
@@ -641,6 +651,15 @@ impl Observer for Recorder<'_> {
             control_force: snap.control_force.unwrap_or(f64::NAN),
         });
         self.openings.push((joint_opening, opening_joint));
+        if self.model.staging.has_one_way() {
+            let n = self.model.supports.len();
+            self.lifted.push(
+                snap.system
+                    .stages
+                    .as_ref()
+                    .map_or_else(|| vec![(0, 0); n], |st| st.one_way.lifted_per_support(n)),
+            );
+        }
         // The history first: results.pvd never lists an increment history.csv lacks.
         self.flush_history()?;
         let step = &self.model.steps[snap.step];

@@ -1,7 +1,7 @@
 //! Results per construction stage (docs/input.md, "Output files"): for each step of a staged
 //! model, the parts it places and removes, the rows of history.csv it produced and the
-//! largest joint opening reached during it, written as `stages.csv` and listed in
-//! summary.json. A joint that opens in a stage before the last one opened during
+//! largest joint opening reached during it and the one-way supports that lifted off or
+//! touched down, written as `stages.csv` and listed in summary.json. A joint that opens in a stage before the last one opened during
 //! construction.
 
 use super::joints::summarise;
@@ -28,6 +28,10 @@ pub struct StageResult {
     pub max_joint_opening: f64,
     /// Name of the joint that reached it (None when none opens).
     pub joint: Option<String>,
+    /// One-way supports that lifted off or touched down during the step
+    /// ([`support_events`]).
+    #[serde(default)]
+    pub support_events: Vec<String>,
 }
 
 /// Largest opening [m] among the open (not in contact) points of all acting joints of the
@@ -77,7 +81,9 @@ pub fn stage_results(
     model: &Model,
     rows: &[Row],
     openings: &[(f64, Option<usize>)],
+    lifted: &[Vec<(usize, usize)>],
 ) -> Vec<StageResult> {
+    let mut events = support_events(model, rows, lifted);
     use crate::model::Lifetime;
     if !model.staging.is_staged() {
         return Vec::new();
@@ -118,9 +124,81 @@ pub fn stage_results(
                 history_rows,
                 max_joint_opening,
                 joint: joint.map(|j: usize| model.joints[j].name.clone()),
+                support_events: events
+                    .iter_mut()
+                    .filter(|(step, _)| *step == i)
+                    .map(|(_, e)| std::mem::take(e))
+                    .collect(),
             }
         })
         .collect()
+}
+
+/// The lift-offs and touch-downs of the one-way supports, step by step, from the
+/// (points lifted off, points acting) of every support at each history row (`lifted`,
+/// parallel to `rows`; empty without one-way supports): (step index, text), the text naming
+/// the support and the history rows (1-based, as in history.csv). A support whose points
+/// all lift off "lifts off", one whose points all come back "touches down"; a line support
+/// of which only some points lift off says how many.
+pub fn support_events(
+    model: &Model,
+    rows: &[Row],
+    lifted: &[Vec<(usize, usize)>],
+) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    if lifted.len() != rows.len() {
+        return out;
+    }
+    let none = vec![(0, 0); model.supports.len()];
+    for i in 0..model.steps.len() {
+        let mine: Vec<usize> = (0..rows.len()).filter(|&k| rows[k].step == i).collect();
+        let Some(&first) = mine.first() else { continue };
+        let before = if first == 0 {
+            &none
+        } else {
+            &lifted[first - 1]
+        };
+        for (s, sp) in model.supports.iter().enumerate() {
+            let state = |k: usize| lifted[k].get(s).copied().unwrap_or((0, 0));
+            let start = before.get(s).copied().unwrap_or((0, 0));
+            // Rows of this step where the support's count of lifted points changed while it
+            // acted (a support removed, or not placed yet, has no points acting: it neither
+            // lifts off nor touches down).
+            let mut prev = start.0;
+            let mut changed = Vec::new();
+            for &k in &mine {
+                let (off, acting) = state(k);
+                if acting > 0 && off != prev {
+                    changed.push(k + 1);
+                }
+                if acting > 0 {
+                    prev = off;
+                }
+            }
+            let (Some(&a), Some(&b)) = (changed.first(), changed.last()) else {
+                continue;
+            };
+            let (end, points) = state(*mine.last().expect("not empty"));
+            if points == 0 {
+                continue;
+            }
+            let name = &sp.name;
+            let text = if start.0 == 0 && end == points {
+                format!("{name} lifts off (history row {a})")
+            } else if end == 0 && start.0 > 0 {
+                format!("{name} touches down (history row {b})")
+            } else if end == start.0 {
+                format!("{name}: points lift off and touch down again (history rows {a}–{b})")
+            } else {
+                format!(
+                    "{name}: {end} of {points} points lifted off at the step's end, {} at its start (history rows {a}–{b})",
+                    start.0
+                )
+            };
+            out.push((i, text));
+        }
+    }
+    out
 }
 
 /// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
@@ -137,7 +215,7 @@ fn field(s: &str) -> String {
 /// blank.
 pub fn render_csv(stages: &[StageResult]) -> String {
     let mut s = String::from(
-        "step,name,activated,removed,first_row,last_row,max_joint_opening [m],joint\n",
+        "step,name,activated,removed,first_row,last_row,max_joint_opening [m],joint,support_events\n",
     );
     for st in stages {
         let (a, b) = st
@@ -146,13 +224,14 @@ pub fn render_csv(stages: &[StageResult]) -> String {
                 (a.to_string(), b.to_string())
             });
         s.push_str(&format!(
-            "{},{},{},{},{a},{b},{:e},{}\n",
+            "{},{},{},{},{a},{b},{:e},{},{}\n",
             st.step,
             field(&st.name),
             field(&st.activated.join(";")),
             field(&st.removed.join(";")),
             st.max_joint_opening,
             field(st.joint.as_deref().unwrap_or("")),
+            field(&st.support_events.join(";")),
         ));
     }
     s
@@ -217,6 +296,7 @@ mod tests {
             history_rows: Some((step, step)),
             max_joint_opening: opening,
             joint: (opening > 0.0).then(|| "J4".to_string()),
+            support_events: Vec::new(),
         };
         let stages = [
             stage(1, &["span1"], &[], 2e-5),

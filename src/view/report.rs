@@ -473,7 +473,7 @@ fn stages_section(dir: &Path) -> String {
         return String::new();
     }
     let mut s = String::from(
-        "<h2>Construction stages</h2>\n<table id=\"stages\">\n<tr><th>step</th><th>name</th><th>placed</th><th>removed</th><th>history rows</th><th>largest joint opening [mm]</th><th>joint</th></tr>\n",
+        "<h2>Construction stages</h2>\n<table id=\"stages\">\n<tr><th>step</th><th>name</th><th>placed</th><th>removed</th><th>history rows</th><th>largest joint opening [mm]</th><th>joint</th><th>supports lifted off / touched down</th></tr>\n",
     );
     for st in &stages {
         let rows = st
@@ -481,7 +481,7 @@ fn stages_section(dir: &Path) -> String {
             .map_or("(not run)".to_string(), |(a, b)| format!("{a}–{b}"));
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             st.step,
             esc(&st.name),
             esc(&st.activated.join(", ")),
@@ -489,6 +489,11 @@ fn stages_section(dir: &Path) -> String {
             rows,
             num(st.max_joint_opening * 1e3),
             esc(st.joint.as_deref().unwrap_or("–")),
+            if st.support_events.is_empty() {
+                "–".to_string()
+            } else {
+                esc(&st.support_events.join("; "))
+            },
         );
     }
     s.push_str("</table>\n");

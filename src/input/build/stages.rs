@@ -95,6 +95,8 @@ pub(super) fn build(ctx: &Ctx, list: &[StepIn], model: &mut Model) -> R<()> {
             .into_iter()
             .map(|l| l.unwrap_or(Lifetime::ALWAYS))
             .collect(),
+        // Set with the supports, before the stages.
+        one_way: std::mem::take(&mut model.staging.one_way),
     };
     for (s, sp) in model.supports.iter().enumerate() {
         if model.staging.support_is_staged(s) && sp.dofs.iter().any(|d| d.2 != 0.0) {

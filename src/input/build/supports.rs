@@ -8,7 +8,7 @@ use crate::input::error::Ctx;
 use crate::input::gmsh_mesh;
 use crate::input::locate;
 use crate::input::schema::SupportIn;
-use crate::model::{Dir, Model, Support};
+use crate::model::{Dir, Model, Push, Support};
 use std::collections::HashMap;
 
 /// The `[[supports]]`: restrained dofs at a node, a point, along a line or a gmsh group.
@@ -29,6 +29,9 @@ pub(super) fn build(
     }
     // The support, and value [m], that first prescribed each dof (node, direction).
     let mut prescribed: HashMap<(usize, usize), (usize, f64)> = HashMap::new();
+    // How the support that first held each dof pushes (None: both ways).
+    let mut pushes: HashMap<(usize, usize), Option<Push>> = HashMap::new();
+    let mut one_way = Vec::with_capacity(list.len());
     for (i, s) in list.iter().enumerate() {
         let key = format!("supports[{i}]");
         for (name, v) in [("ux", s.ux), ("uy", s.uy)] {
@@ -79,6 +82,31 @@ pub(super) fn build(
                 ));
             }
         }
+        let push = push(ctx, &key, s)?;
+        for &(n, d, _) in &dofs {
+            let mine = push.filter(|p| p.dir() == d);
+            let was = *pushes.entry((n, d.index())).or_insert(mine);
+            if was != mine {
+                let (first, _) = prescribed[&(n, d.index())];
+                let how = |p: Option<Push>| {
+                    p.map_or("both ways".to_string(), |p| {
+                        format!("one way (one_way = \"{}\")", p.name())
+                    })
+                };
+                let c = if d.index() == 0 { "ux" } else { "uy" };
+                return Err(ctx.err(
+                    format!("{key}.one_way"),
+                    format!(
+                        "holds {c} of node {} {}, which supports[{first}] ('{}') holds {}: a displacement is held one way by every support on it, or both ways by every one",
+                        n + 1,
+                        how(mine),
+                        list[first].name,
+                        how(was)
+                    ),
+                ));
+            }
+        }
+        one_way.push(push);
         if let Some(z) = bearing_zone(ctx, &key, s, model, &dofs)? {
             zones.push(z);
         }
@@ -87,7 +115,42 @@ pub(super) fn build(
             dofs,
         });
     }
+    if one_way.iter().any(Option::is_some) {
+        model.staging.one_way = one_way;
+    }
     Ok(())
+}
+
+/// `supports[i].one_way`: the way a bearing, prop or falsework pushes the structure
+/// ("+x", "-x", "+y", "-y"; None: a two-way support). It must be a direction the support
+/// holds, at zero: a one-way support holds the structure where it stands when it acts.
+fn push(ctx: &Ctx, key: &str, s: &SupportIn) -> R<Option<Push>> {
+    let Some(name) = &s.one_way else {
+        return Ok(None);
+    };
+    let Some(&(p, _)) = Push::ALL.iter().find(|(_, n)| n == name) else {
+        return Err(ctx.err(
+            format!("{key}.one_way"),
+            format!(
+                "unknown direction '{name}' (expected \"+y\", \"-y\", \"+x\" or \"-x\": the way the support pushes the structure)"
+            ),
+        ));
+    };
+    let (c, v) = match p.dir() {
+        Dir::X => ("ux", s.ux),
+        Dir::Y => ("uy", s.uy),
+    };
+    match v {
+        None => Err(ctx.err(
+            format!("{key}.one_way"),
+            format!("\"{name}\" pushes along {c}, which the support does not hold: give {c} = 0.0"),
+        )),
+        Some(v) if v != 0.0 => Err(ctx.err(
+            format!("{key}.{c}"),
+            format!("{c} = {v:e} m on a one-way support: it must be 0.0 (a one-way support holds the structure where it stands; model a settlement as a two-way support)"),
+        )),
+        Some(_) => Ok(Some(p)),
+    }
 }
 
 /// `supports[i].bearing`: a pinned bearing. The support holds its node (a pin at the

@@ -48,6 +48,8 @@ pub struct ViaductIn {
     pub strand: Option<String>,
     pub span_tendons: Option<SpanTendonsIn>,
     pub continuity_tendons: Option<ContinuityTendonsIn>,
+    #[serde(default)]
+    pub hold_down: Vec<String>,
 }
 
 /// One band of the box section, bottom up: a region of out-of-plane `width` [m].
@@ -275,6 +277,27 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
 
     let steps = erection_steps(v, &layout, start, strike);
     let supports = supports(&layout);
+    for (i, name) in v.hold_down.iter().enumerate() {
+        if !supports.iter().any(|s| &s.name == name) {
+            let names: Vec<&str> = supports.iter().map(|s| s.name.as_str()).collect();
+            return Err(ctx.err(
+                format!("viaduct.hold_down[{i}]"),
+                format!(
+                    "no bearing or falsework named '{name}' (the generated ones: {})",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    let supports = supports
+        .into_iter()
+        .map(|mut s| {
+            if v.hold_down.contains(&s.name) {
+                s.one_way = None;
+            }
+            s
+        })
+        .collect();
     let tendons = tendons(v, &layout, depth, file, ctx)?;
     let self_weight = LoadCaseIn {
         name: "self_weight".into(),
@@ -528,7 +551,9 @@ fn section(v: &ViaductIn, ctx: &Ctx) -> R<f64> {
 }
 
 /// Bearings (A1 fixed, the piers and A2 sliding) and one falsework per span, a line under
-/// the soffit from bearing to bearing, bearings excluded.
+/// the soffit from bearing to bearing, bearings excluded. All push up only (`one_way =
+/// "+y"`): a bearing or a falsework carries the girder and lets it lift off; `hold_down`
+/// makes the named ones two-way.
 fn supports(layout: &Layout) -> Vec<SupportIn> {
     let b = &layout.bearings;
     let n = b.len() - 1;
@@ -542,6 +567,7 @@ fn supports(layout: &Layout) -> Vec<SupportIn> {
         uy: Some(0.0),
         bearing: None,
         local_zone: None,
+        one_way: Some("+y".into()),
     };
     let mut list = Vec::new();
     for (i, &x) in b.iter().enumerate() {
