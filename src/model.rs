@@ -2,11 +2,13 @@
 //! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
 
 pub mod element_data;
+pub mod influence;
 pub mod stages;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
+pub use influence::{Combination, Influence};
 use serde::Serialize;
 pub use stages::{Lifetime, Staging};
 
@@ -617,6 +619,8 @@ pub struct Model {
     pub bars: Vec<Bar>,
     /// Construction stages (empty: everything acts from the start).
     pub staging: Staging,
+    /// Influence lines and traffic envelopes (`[[influence]]`).
+    pub influence: Vec<Influence>,
 }
 
 impl Model {

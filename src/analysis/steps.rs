@@ -166,6 +166,15 @@ pub fn run_with(
             system: &sys,
             driver: &driver,
         })?;
+        // Influence lines taken at this step's end (they leave the state as it is; the
+        // next step factorises its own tangent).
+        for table in (0..model.influence.len()).filter(|&t| model.influence[t].after_step == si) {
+            let f_ext = external_forces(model.n_dofs(), &cases, &factors);
+            let lines = super::influence::compute(&mut sys, &mut solver, &f_ext, clock, table)
+                .map_err(|e| (table, e));
+            obs.influence(&lines)?;
+            factored_linear = false;
+        }
         if si + 1 < model.steps.len() {
             if let Some(reason) = obs.stop_requested() {
                 return Err(AnalysisError::Stopped {

@@ -99,6 +99,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         geometry: Default::default(),
         bars: Vec::new(),
         staging: Default::default(),
+        influence: Vec::new(),
     };
     let wall: Vec<(usize, Dir, f64)> = model
         .nodes

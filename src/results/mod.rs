@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod checkpoint;
+pub mod envelopes;
 pub mod fields;
 pub mod gauss_points;
 pub mod joints;

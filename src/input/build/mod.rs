@@ -9,6 +9,7 @@ mod anchorage;
 mod bars;
 mod controls;
 mod fields;
+mod influence;
 mod joints;
 mod loads;
 mod materials;
@@ -86,6 +87,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         geometry: Default::default(),
         bars: Vec::new(),
         staging: Default::default(),
+        influence: Vec::new(),
     };
     units::model_size(w, ctx, locate::model_size(&model));
     if !joints.is_empty() {
@@ -121,6 +123,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     monitors::build(ctx, &file, &mut model, &used)?;
     controls::geometry(ctx, file.analysis.as_ref(), &mut model)?;
     steps::build(ctx, &file.steps, &mut model, &used)?;
+    influence::build(ctx, &file, &mut model, &used)?;
     let start = model
         .steps
         .iter()

@@ -1,0 +1,149 @@
+//! Influence lines by superposition on the tangent stiffness at the end of a step
+//! (`[[influence]]`, docs/theory-traffic.md): the tangent is assembled and factorised once
+//! at the committed state, each path node's unit downward load is one more solve with that
+//! factorisation, and each monitor's change is read from a trial assembly at the committed
+//! displacements plus the solution. Nothing is committed: the state after is the state
+//! before.
+
+use super::solver::SparseCholesky;
+use super::system::System;
+use crate::fem::dofs::CONSTRAINED;
+use crate::materials::point::TimeContext;
+use crate::model::{Influence, MonitorKind};
+
+/// The influence lines of one `[[influence]]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InfluenceLines {
+    /// Index of the table in `Model::influence`.
+    pub table: usize,
+    /// Positions along the path [m] (distance from its start).
+    pub s: Vec<f64>,
+    /// Monitor values at the step's end (the state the lines are taken at), per monitor of
+    /// the table [monitor unit].
+    pub state: Vec<f64>,
+    /// Change of each monitor per newton of downward load at each position [unit/N]:
+    /// `values[monitor][position]`.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// The influence lines of table `table` at the committed state of `sys`, whose external
+/// forces are `f_ext` [N] and clock `clock` [d]. The tangent is factorised with `solver`
+/// (whose factorisation is then this one: the caller refactorises before the next Newton
+/// iteration).
+pub fn compute(
+    sys: &mut System,
+    solver: &mut SparseCholesky,
+    f_ext: &[f64],
+    clock: f64,
+    table: usize,
+) -> Result<InfluenceLines, String> {
+    let model = sys.model;
+    let inf: &Influence = &model.influence[table];
+    // An instantaneous perturbation: no creep, shrinkage or relaxation over it.
+    sys.begin_time_increment(TimeContext::at(clock));
+    let u0 = sys.u.clone();
+    let base = sys
+        .assemble(&u0, true)
+        .map_err(|(e, err)| format!("element {} failed at the committed state: {err:?}", e + 1))?;
+    let k = base.k_values.as_ref().expect("tangent requested");
+    // The solver's count of negative pivots belongs to the path the steps follow.
+    let pivots = solver.negative_pivots;
+    let factored = if sys.linear {
+        solver.factorize(&sys.asm.pattern, k).map(|_| 0)
+    } else {
+        solver.factorize_indefinite(&sys.asm.pattern, k)
+    };
+    solver.negative_pivots = pivots;
+    let negative =
+        factored.map_err(|e| format!("the tangent stiffness cannot be factorised: {e}"))?;
+    if negative > 0 {
+        sys.families.revert();
+        return Err(format!(
+            "the tangent stiffness has {negative} negative pivot(s): the structure is past a limit point, where an influence line means nothing"
+        ));
+    }
+    let state = values(sys, inf, &u0, &base.f_int, f_ext);
+    let mut lines = vec![Vec::with_capacity(inf.path.len()); inf.monitors.len()];
+    let mut f = vec![0.0; model.n_dofs()];
+    let mut u = u0.clone();
+    for &(node, _) in &inf.path {
+        // A unit load down (−y) on the node.
+        let d = 2 * node + 1;
+        f[d] = -1.0;
+        let mut du = sys.to_free(&f);
+        solver.solve_in_place(&mut du);
+        u.copy_from_slice(&u0);
+        for (dof, &q) in sys.dofs.eq.iter().enumerate() {
+            if q != CONSTRAINED {
+                u[dof] += du[q];
+            }
+        }
+        let a = sys.assemble(&u, false).map_err(|(e, err)| {
+            format!(
+                "element {} failed under the unit load at node {}: {err:?}",
+                e + 1,
+                node + 1
+            )
+        })?;
+        let mut fe = f_ext.to_vec();
+        fe[d] -= 1.0;
+        let v = values(sys, inf, &u, &a.f_int, &fe);
+        for ((line, v), s) in lines.iter_mut().zip(v).zip(&state) {
+            line.push(v - s);
+        }
+        f[d] = 0.0;
+    }
+    // Back to the committed state (trial states of the last assembly thrown away).
+    sys.families.revert();
+    Ok(InfluenceLines {
+        table,
+        s: inf.path.iter().map(|p| p.1).collect(),
+        state,
+        values: lines,
+    })
+}
+
+/// The table's monitors from the trial side of the last assembly at displacements `u`
+/// (internal forces `f_int`, external `f_ext`) [monitor units]. Only the kinds linear in
+/// the displacements (`input::build::influence::linear`) reach here.
+fn values(sys: &System, inf: &Influence, u: &[f64], f_int: &[f64], f_ext: &[f64]) -> Vec<f64> {
+    let model = sys.model;
+    let fam = &sys.families;
+    inf.monitors
+        .iter()
+        .map(|&m| match &model.monitors[m].kind {
+            MonitorKind::Displacement { node, dir, .. } => u[2 * node + dir.index()],
+            MonitorKind::Reaction { support, dir } => model.supports[*support]
+                .dofs
+                .iter()
+                .filter(|(_, d, _)| d == dir)
+                .map(|(n, d, _)| {
+                    let k = 2 * n + d.index();
+                    f_int[k] - f_ext[k]
+                })
+                .sum(),
+            MonitorKind::StressAtPoint {
+                component,
+                gauss_point,
+            } => component.of(fam.continuum.gauss.trial[*gauss_point].stress),
+            MonitorKind::TendonStress { tendon, span } => fam.tendons.states.trial[*tendon]
+                .as_ref()
+                .map_or(0.0, |st| st.stresses()[span.unwrap_or(0)]),
+            MonitorKind::TendonForce { tendon, span } => fam.tendons.states.trial[*tendon]
+                .as_ref()
+                .map_or(0.0, |st| st.forces()[span.unwrap_or(0)]),
+            MonitorKind::BarStress { bar, point } | MonitorKind::BarForce { bar, point } => {
+                let area = match model.monitors[m].kind {
+                    MonitorKind::BarForce { .. } => model.bars[*bar].area,
+                    _ => 1.0,
+                };
+                sys.bar_gps
+                    .iter()
+                    .position(|&(b, p)| b == *bar && Some(p) == *point)
+                    .map_or(0.0, |i| area * fam.bars.out.trial[i].stress)
+            }
+            // Refused by the input (not linear in the displacements).
+            _ => f64::NAN,
+        })
+        .collect()
+}

@@ -1,0 +1,364 @@
+//! Influence lines, traffic envelopes and combinations (`[[influence]]`,
+//! docs/theory-traffic.md) on a two-span continuous beam against closed forms, and an
+//! envelope against the same vehicle run position by position as ordinary steps.
+//! Run with `cargo nextest run --release --test influence`.
+
+mod common;
+
+use common::TempDir;
+use segfem::analysis::influence::InfluenceLines;
+use segfem::analysis::steps::{self, Observer, Snapshot};
+
+/// Span [m], depth [m], thickness [m], E [Pa], ν of the beam.
+const L: f64 = 10.0;
+const H: f64 = 0.25;
+const T: f64 = 0.2;
+const E: f64 = 30e9;
+const NU: f64 = 0.2;
+
+/// Two equal spans, 0–L–2L, Q8 3 × 3 Gauss, 0.25 m × 0.125 m elements; each support holds
+/// the vertical displacement of the whole depth of its section (a knife edge at the beam's
+/// axis, as beam theory has it: no local indentation under a point support), the left end
+/// also horizontally at mid-depth. `extra` is appended (monitors, steps, influence).
+fn two_spans(extra: &str) -> String {
+    format!(
+        r#"title = "two-span beam"
+[[materials]]
+name = "c"
+kind = "elastic"
+E = {E:e}
+nu = {NU}
+
+[[regions]]
+name = "web"
+material = "c"
+thickness = {T}
+
+[mesh]
+type = "banded"
+length = {len}
+origin = [0.0, 0.0]
+nx = 80
+element = "Q8"
+integration = "full"
+bands = [{{ region = "web", depth = {H}, rows = 2 }}]
+
+[[supports]]
+name = "A"
+line = [[0.0, 0.0], [0.0, {H}]]
+uy = 0.0
+
+[[supports]]
+name = "fix"
+point = [0.0, {half}]
+ux = 0.0
+
+[[supports]]
+name = "B"
+line = [[{L}, 0.0], [{L}, {H}]]
+uy = 0.0
+
+[[supports]]
+name = "C"
+line = [[{len}, 0.0], [{len}, {H}]]
+uy = 0.0
+
+[[monitors]]
+name = "R_A"
+kind = "reaction"
+support = "A"
+component = "y"
+
+[[monitors]]
+name = "R_B"
+kind = "reaction"
+support = "B"
+component = "y"
+
+[[monitors]]
+name = "sx_top"
+kind = "stress"
+component = "sx"
+point = [9.625, {H}]
+
+{extra}
+"#,
+        len = 2.0 * L,
+        half = 0.5 * H,
+    )
+}
+
+/// Beam constants: EI [N·m²] and the shear stiffness κGA [N] (κ = 5/6, rectangle).
+fn stiffness() -> (f64, f64) {
+    let ei = E * T * H.powi(3) / 12.0;
+    let kga = 5.0 / 6.0 * E / (2.0 * (1.0 + NU)) * T * H;
+    (ei, kga)
+}
+
+/// Middle-support reaction of two equal spans for a unit downward load at `a` ∈ [0, 2L]
+/// (upward positive), Timoshenko beam: the flexibility method on the simply supported 2L
+/// beam, its deflection at midspan under the load at a ≤ L being a(3L² − a²)/(12 EI)
+/// (bending: P a (3ℓ² − 4a²)/(48 EI) with ℓ = 2L) + a/(2 κGA) (shear: the virtual unit
+/// load's shear ±½), over the midspan flexibility L³/(6 EI) + L/(2 κGA). Without the shear
+/// terms: ξ(3 − ξ²)/2, ξ = a/L.
+fn r_b(a: f64) -> f64 {
+    let (ei, kga) = stiffness();
+    let a = if a > L { 2.0 * L - a } else { a };
+    (a * (3.0 * L * L - a * a) / (12.0 * ei) + a / (2.0 * kga))
+        / (L.powi(3) / (6.0 * ei) + L / (2.0 * kga))
+}
+
+/// End reaction at A (moments about C): R_A·2L + R_B·L = 2L − a.
+fn r_a(a: f64) -> f64 {
+    (2.0 * L - a - r_b(a) * L) / (2.0 * L)
+}
+
+/// Bending moment (sagging positive) at x ≤ L under the unit load at a.
+fn moment(x: f64, a: f64) -> f64 {
+    r_a(a) * x - (x - a).max(0.0)
+}
+
+/// Keeps the influence lines the analysis reports.
+struct Keep(Vec<InfluenceLines>);
+
+impl Observer for Keep {
+    fn increment(&mut self, _: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn influence(
+        &mut self,
+        lines: &Result<InfluenceLines, (usize, String)>,
+    ) -> std::io::Result<()> {
+        self.0.push(lines.clone().expect("influence lines taken"));
+        Ok(())
+    }
+}
+
+/// The influence lines of the reaction at the middle and end supports and of the top-fibre
+/// stress by the middle support, against the closed forms above at every node of the deck.
+///
+/// The support moment: σx at the top Gauss point of the element 9.5–9.75 m (x = 9.625 m,
+/// 1.5 h from the middle support, where plane sections hold; y = h/2 + (h/4)(1 + √0.6),
+/// the top row of a 3 × 3 rule in the upper of two rows) is −M(x) (y − h/2)/I with
+/// M(x) = R_A x − (x − a)⁺ of the same closed form — over the support M_B = −(Lξ/4)(1 − ξ²)
+/// for a load in span 1 (ξ = a/L), and the line at 9.625 m is that of M_B moved by the
+/// shear over 0.375 m.
+///
+/// Tolerances: reactions 5e-4 of the peak ordinate (1 for R_B; measured 9e-5): plane
+/// stress against a Timoshenko beam differs by the local shear distribution at the knife
+/// edges and the loaded nodes (the shear terms alone move R_B by 0.5 %, so the tolerance
+/// tells them apart); stress 5e-3 of its peak (measured 1.8e-3), for loads more than a depth
+/// from the section: the beam's linear σx against the plane-stress one near the support's
+/// knife edge. A load right over the section adds its own bearing stress there (1.6 % of
+/// the peak at 9.625 m): not a beam quantity, left out.
+#[test]
+fn reaction_and_support_moment_influence_lines() {
+    let text = two_spans(
+        r#"
+[[steps]]
+name = "nothing"
+kind = "linear"
+
+[[influence]]
+name = "deck"
+after_step = "nothing"
+line = [[0.0, 0.25], [20.0, 0.25]]
+"#,
+    );
+    let built = segfem::input::parse(&text, "two-span").expect("valid model");
+    let model = built.model;
+    let mut keep = Keep(Vec::new());
+    steps::run(&model, &mut keep).expect("runs");
+    assert_eq!(keep.0.len(), 1);
+    let l = &keep.0[0];
+    // Top nodes of a Q8 mesh with 0.25 m elements: 0.125 m apart, 161 of them.
+    assert_eq!(l.s.len(), 161);
+    let (ei, _) = stiffness();
+    let i = ei / E;
+    let y = H / 2.0 + H / 4.0 * (1.0 + 0.6f64.sqrt()) - H / 2.0;
+    let peak_sigma = (0..=160)
+        .map(|k| (moment(9.625, k as f64 * 0.125) * y / i).abs())
+        .fold(0.0, f64::max);
+    let (mut worst_a, mut worst_b, mut worst_s) = (0.0f64, 0.0f64, 0.0f64);
+    for (k, &s) in l.s.iter().enumerate() {
+        assert!((s - k as f64 * 0.125).abs() < 1e-9);
+        worst_a = worst_a.max((l.values[0][k] - r_a(s)).abs());
+        worst_b = worst_b.max((l.values[1][k] - r_b(s)).abs());
+        let sigma = if s <= L {
+            -moment(9.625, s) * y / i
+        } else {
+            // A load in span 2: the moment at x in span 1 is R_A x.
+            -r_a(s) * 9.625 * y / i
+        };
+        // A load within a depth of the section spreads its own bearing stresses over the
+        // Gauss point (St-Venant): beam theory holds from a depth away.
+        if (s - 9.625).abs() > H {
+            worst_s = worst_s.max((l.values[2][k] - sigma).abs() / peak_sigma);
+        }
+    }
+    eprintln!("worst errors: R_A {worst_a:.2e}, R_B {worst_b:.2e}, sx {worst_s:.2e} of peak");
+    assert!(worst_a < 5e-4, "R_A off by {worst_a:e}");
+    assert!(worst_b < 5e-4, "R_B off by {worst_b:e}");
+    assert!(worst_s < 5e-3, "sx off by {worst_s:e} of its peak");
+    // Spot values of the Euler–Bernoulli form the task states: a load at midspan 1 puts
+    // ξ(3 − ξ²)/2 = 0.6875 on B, and over B itself all of it.
+    assert!((l.values[1][40] - 0.6875).abs() < 5e-3);
+    assert!((l.values[1][80] - 1.0).abs() < 1e-6);
+    // The state the lines were taken at carries no load.
+    assert!(l.state.iter().all(|v| v.abs() < 1e-6));
+}
+
+/// The envelope of a user vehicle (two 100 kN axles 1 m apart, and a 10 kN/m lane load)
+/// equals the extreme over the same vehicle run at every node position as ordinary steps;
+/// the lane part equals a run with the line load over the whole deck (R_B > 0 everywhere,
+/// so the lane load is unfavourable on all of it), whose closed form is 1.25 q L (Euler–
+/// Bernoulli; shear adds 0.3 %). Every combination is the factors times the parts.
+///
+/// Tolerances: vehicle 1e-9 relative (the same linear stiffness solved two ways: rounding
+/// only); lane 2e-4 (trapezoid rule on the nodal line against the Q8 edge's consistent
+/// loads, a difference of h²/12 ∫η'' ≈ 3e-5 of the integral); closed form 1 % (shear).
+#[test]
+fn envelope_equals_the_extreme_over_explicit_positions() {
+    // Positions of the first axle: every deck node with both axles on the deck.
+    let positions: Vec<f64> = (0..=152).map(|k| k as f64 * 0.125).collect();
+    let mut extra = String::new();
+    for (k, p) in positions.iter().enumerate() {
+        extra += &format!(
+            "[[load_cases]]\nname = \"p{k}\"\npoint_loads = [{{ point = [{p}, {H}], force = [0.0, -100e3] }}, {{ point = [{}, {H}], force = [0.0, -100e3] }}]\n\n",
+            p + 1.0
+        );
+    }
+    extra += &format!(
+        "[[load_cases]]\nname = \"lane\"\nline_loads = [{{ line = [[0.0, {H}], [20.0, {H}]], q = [0.0, -10e3] }}]\n\n"
+    );
+    extra += "[[steps]]\nname = \"unloaded\"\nkind = \"linear\"\n\n";
+    for k in 0..positions.len() {
+        let off = if k > 0 {
+            format!(", p{} = 0.0", k - 1)
+        } else {
+            String::new()
+        };
+        extra += &format!(
+            "[[steps]]\nname = \"s{k}\"\nkind = \"linear\"\nloads = {{ p{k} = 1.0{off} }}\n\n"
+        );
+    }
+    extra +=
+        "[[steps]]\nname = \"lane\"\nkind = \"linear\"\nloads = { p152 = 0.0, lane = 1.0 }\n\n";
+    extra += r#"
+[[influence]]
+name = "deck"
+after_step = "unloaded"
+line = [[0.0, 0.25], [20.0, 0.25]]
+monitors = ["R_A", "R_B"]
+
+[[influence.traffic]]
+name = "pair"
+model = "vehicle"
+loads = [100e3, 100e3]
+spacings = [1.0]
+lane_load = 10e3
+
+[[influence.combinations]]
+name = "ULS"
+kind = "uls"
+
+[[influence.combinations]]
+name = "mine"
+kind = "user"
+state = 1.0
+vehicle = 0.5
+lane = 2.0
+"#;
+    let dir = TempDir::new("influence-envelope");
+    let file = dir.join("m.toml");
+    std::fs::write(&file, two_spans(&extra)).expect("write model");
+    let out = dir.join("out");
+    let summary = segfem::run::run_file(&file, &out, &mut |_| {}).expect("runs");
+    // Explicit values from history.csv: the last increment of each position's step.
+    let history = std::fs::read_to_string(out.join("history.csv")).expect("history");
+    let mut rows = history.lines();
+    let head: Vec<&str> = rows.next().expect("header").split(',').collect();
+    let col = |name: &str| {
+        head.iter()
+            .position(|h| h.split(" [").next() == Some(name))
+            .expect("column")
+    };
+    let (c_step, c_a, c_b) = (col("step"), col("R_A"), col("R_B"));
+    let mut last: std::collections::BTreeMap<usize, (f64, f64)> = Default::default();
+    for r in rows {
+        let v: Vec<&str> = r.split(',').collect();
+        let step: usize = v[c_step].parse().expect("step");
+        last.insert(
+            step,
+            (v[c_a].parse().expect("R_A"), v[c_b].parse().expect("R_B")),
+        );
+    }
+    // Steps are numbered from 1 in history.csv: 1 unloaded, 2..=154 positions, 155 lane.
+    let explicit: Vec<(f64, f64)> = (2..=154).map(|s| last[&s]).collect();
+    let max_b = explicit.iter().map(|e| e.1).fold(f64::MIN, f64::max);
+    let min_a = explicit.iter().map(|e| e.0).fold(f64::MAX, f64::min);
+    let max_a = explicit.iter().map(|e| e.0).fold(f64::MIN, f64::max);
+    let lane_b = last[&155].1;
+    let inf = &summary.influence[0];
+    assert!(inf.error.is_none(), "{:?}", inf.error);
+    let env = |m: &str| {
+        inf.envelopes
+            .iter()
+            .find(|e| e.monitor == m)
+            .expect("envelope")
+    };
+    let (a, b) = (env("R_A"), env("R_B"));
+    let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+    eprintln!(
+        "R_B max {:.6e} (explicit {max_b:.6e}), R_A min {:.6e} ({min_a:.6e}), max {:.6e} ({max_a:.6e}); lane {:.6e} ({lane_b:.6e})",
+        b.max.vehicle, a.min.vehicle, a.max.vehicle, b.max.lane
+    );
+    assert!(rel(b.max.vehicle, max_b) < 1e-9);
+    assert!(rel(a.min.vehicle, min_a) < 1e-9);
+    assert!(rel(a.max.vehicle, max_a) < 1e-9);
+    // The governing position of R_B's maximum: the axles astride B, 0.5 m each side (the
+    // line is flat at its peak over B and concave, so two equal axles do best at equal
+    // ordinates).
+    let x = &b.max.axles_x;
+    assert!(
+        x.len() == 2 && (x[0] + x[1] - 2.0 * L).abs() < 1e-9,
+        "{x:?}"
+    );
+    // R_B's line is ≥ 0: no unfavourable stretch for its minimum, and the lane on all.
+    assert_eq!(b.min.value, 0.0);
+    assert!(rel(b.max.lane, lane_b) < 2e-4);
+    assert!(rel(b.max.lane, 1.25 * 10e3 * L) < 1e-2);
+    // Combinations: ULS = 1.35 (state + vehicle + lane), the user's 1·state + 0.5·vehicle
+    // + 2·lane; the state is the unloaded beam (0).
+    let comb = |c: &str, m: &str| {
+        inf.combinations
+            .iter()
+            .find(|r| r.combination == c && r.monitor == m)
+            .expect("combination")
+    };
+    assert!(rel(comb("ULS", "R_B").max, 1.35 * (b.max.vehicle + b.max.lane)) < 1e-12);
+    assert!(
+        rel(
+            comb("mine", "R_B").max,
+            0.5 * b.max.vehicle + 2.0 * b.max.lane
+        ) < 1e-12
+    );
+    assert!(
+        rel(
+            comb("mine", "R_A").min,
+            0.5 * a.min.vehicle + 2.0 * a.min.lane
+        ) < 1e-12
+    );
+    // The files are there, whole.
+    for f in &inf.files {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    assert_eq!(
+        inf.files,
+        [
+            "influence_deck.csv",
+            "envelopes_deck.csv",
+            "combinations_deck.csv"
+        ]
+    );
+}
