@@ -8,7 +8,7 @@ pub mod stages;
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
-pub use influence::{Combination, Influence};
+pub use influence::{Combination, Influence, Placement};
 use serde::Serialize;
 pub use stages::{Lifetime, Staging};
 

@@ -274,6 +274,8 @@ pub struct Extreme {
     pub vehicle_name: String,
     /// Positions of its axles along the path [m] (empty when the traffic is absent).
     pub axles: Vec<f64>,
+    /// Their loads, factors included [N] (downward).
+    pub axle_loads: Vec<f64>,
 }
 
 /// The most favourable to the largest (`max`) and smallest (`min`) value of the traffic's
@@ -301,15 +303,18 @@ pub fn envelope(t: &Traffic, s: &[f64], eta: &[f64]) -> (Extreme, Extreme) {
                             .map(|&(dk, pk)| pk * eta_at(s, eta, p + dk))
                             .sum::<f64>();
                     let at = || w.axles.iter().map(|a| p + a.0).collect::<Vec<_>>();
+                    let loads = || w.axles.iter().map(|a| t.vehicle_factor * a.1).collect();
                     if e > best.1 {
                         best.1 = e;
                         max.vehicle_name = w.name.clone();
                         max.axles = at();
+                        max.axle_loads = loads();
                     }
                     if e < best.0 {
                         best.0 = e;
                         min.vehicle_name = w.name.clone();
                         min.axles = at();
+                        min.axle_loads = loads();
                     }
                 }
             }
@@ -323,6 +328,20 @@ pub fn envelope(t: &Traffic, s: &[f64], eta: &[f64]) -> (Extreme, Extreme) {
     min.lane = t.lane_load * neg;
     min.value = min.vehicle + min.lane;
     (min, max)
+}
+
+/// The stretch of the path piece from 0 to `h` [m] (values `a` at 0 and `b` at `h`) where
+/// the line has the sign wanted (`positive`; zero values excluded), as (from, to) [m].
+pub fn unfavourable_stretch(a: f64, b: f64, h: f64, positive: bool) -> Option<(f64, f64)> {
+    let (a, b) = if positive { (a, b) } else { (-a, -b) };
+    if a <= 0.0 && b <= 0.0 {
+        None
+    } else if a >= 0.0 && b >= 0.0 {
+        Some((0.0, h))
+    } else {
+        let z = h * a / (a - b);
+        Some(if a > 0.0 { (0.0, z) } else { (z, h) })
+    }
 }
 
 #[cfg(test)]

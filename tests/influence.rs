@@ -212,7 +212,9 @@ line = [[0.0, 0.25], [20.0, 0.25]]
 /// equals the extreme over the same vehicle run at every node position as ordinary steps;
 /// the lane part equals a run with the line load over the whole deck (R_B > 0 everywhere,
 /// so the lane load is unfavourable on all of it), whose closed form is 1.25 q L (Euler–
-/// Bernoulli; shear adds 0.3 %). Every combination is the factors times the parts.
+/// Bernoulli; shear adds 0.3 %). Every combination is the factors times the parts, and a
+/// load case placed at the governing position (`[[influence.place]]`) and run as a step
+/// gives the envelope's total.
 ///
 /// Tolerances: vehicle 1e-9 relative (the same linear stiffness solved two ways: rounding
 /// only); lane 2e-4 (trapezoid rule on the nodal line against the Q8 edge's consistent
@@ -244,6 +246,24 @@ fn envelope_equals_the_extreme_over_explicit_positions() {
     }
     extra +=
         "[[steps]]\nname = \"lane\"\nkind = \"linear\"\nloads = { p152 = 0.0, lane = 1.0 }\n\n";
+    // The governing positions placed by the lines, run as ordinary steps.
+    extra += r#"
+[[load_cases]]
+name = "worst_B"
+
+[[load_cases]]
+name = "worst_A"
+
+[[steps]]
+name = "worst_B"
+kind = "linear"
+loads = { lane = 0.0, worst_B = 1.0 }
+
+[[steps]]
+name = "worst_A"
+kind = "linear"
+loads = { worst_B = 0.0, worst_A = 1.0 }
+"#;
     extra += r#"
 [[influence]]
 name = "deck"
@@ -257,6 +277,16 @@ model = "vehicle"
 loads = [100e3, 100e3]
 spacings = [1.0]
 lane_load = 10e3
+
+[[influence.place]]
+case = "worst_B"
+monitor = "R_B"
+extreme = "max"
+
+[[influence.place]]
+case = "worst_A"
+monitor = "R_A"
+extreme = "min"
 
 [[influence.combinations]]
 name = "ULS"
@@ -293,12 +323,14 @@ lane = 2.0
             (v[c_a].parse().expect("R_A"), v[c_b].parse().expect("R_B")),
         );
     }
-    // Steps are numbered from 1 in history.csv: 1 unloaded, 2..=154 positions, 155 lane.
+    // Steps are numbered from 1 in history.csv: 1 unloaded, 2..=154 positions, 155 lane,
+    // 156 and 157 the placed cases.
     let explicit: Vec<(f64, f64)> = (2..=154).map(|s| last[&s]).collect();
     let max_b = explicit.iter().map(|e| e.1).fold(f64::MIN, f64::max);
     let min_a = explicit.iter().map(|e| e.0).fold(f64::MAX, f64::min);
     let max_a = explicit.iter().map(|e| e.0).fold(f64::MIN, f64::max);
     let lane_b = last[&155].1;
+    let (placed_b, placed_a) = (last[&156].1, last[&157].0);
     let inf = &summary.influence[0];
     assert!(inf.error.is_none(), "{:?}", inf.error);
     let env = |m: &str| {
@@ -323,6 +355,18 @@ lane = 2.0
     assert!(
         x.len() == 2 && (x[0] + x[1] - 2.0 * L).abs() < 1e-9,
         "{x:?}"
+    );
+    // The placed cases, run as steps on the same stiffness, give the envelopes' totals
+    // (vehicle and lane on the unfavourable stretches) to rounding.
+    assert!(
+        rel(placed_b, b.max.value) < 1e-9,
+        "{placed_b} {}",
+        b.max.value
+    );
+    assert!(
+        rel(placed_a, a.min.value) < 1e-9,
+        "{placed_a} {}",
+        a.min.value
     );
     // R_B's line is ≥ 0: no unfavourable stretch for its minimum, and the lane on all.
     assert_eq!(b.min.value, 0.0);

@@ -9,7 +9,8 @@ use super::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::materials::point::TimeContext;
-use crate::model::{Influence, MonitorKind};
+use crate::model::{Influence, Model, MonitorKind, Placement};
+use crate::traffic::{envelope, unfavourable_stretch};
 
 /// The influence lines of one `[[influence]]` table.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,4 +147,42 @@ fn values(sys: &System, inf: &Influence, u: &[f64], f_int: &[f64], f_ext: &[f64]
             _ => f64::NAN,
         })
         .collect()
+}
+
+/// The load vector [N] (all dofs) of placement `p` of the table of `lines`: the governing
+/// vehicle's axles at their positions and the lane load on the stretches where the line
+/// has the extreme's sign, as downward nodal forces on the path nodes, shared between the
+/// two nodes around each load by the lever rule — the distribution the influence line
+/// interpolates, so that on the tangent the case gives the envelope's value.
+pub fn placed_load(model: &Model, lines: &InfluenceLines, p: &Placement) -> Vec<f64> {
+    let inf = &model.influence[lines.table];
+    let (s, eta) = (&lines.s, &lines.values[p.monitor]);
+    let t = &inf.traffic[p.traffic];
+    let (min, max) = envelope(t, s, eta);
+    let e = if p.max { max } else { min };
+    let mut f = vec![0.0; model.n_dofs()];
+    let node = |i: usize| 2 * inf.path[i].0 + 1;
+    for (&x, &load) in e.axles.iter().zip(&e.axle_loads) {
+        // Axles off the path carry nothing onto the structure.
+        if x < s[0] || x > s[s.len() - 1] {
+            continue;
+        }
+        let i = s.partition_point(|&v| v <= x).clamp(1, s.len() - 1);
+        let h = s[i] - s[i - 1];
+        let r = if h > 0.0 { (x - s[i - 1]) / h } else { 0.0 };
+        f[node(i - 1)] -= load * (1.0 - r);
+        f[node(i)] -= load * r;
+    }
+    for i in 1..s.len() {
+        let h = s[i] - s[i - 1];
+        let Some((a, b)) = unfavourable_stretch(eta[i - 1], eta[i], h, p.max) else {
+            continue;
+        };
+        // A uniform load q over (a, b) of the piece: lever-rule shares q ∫ (1 − u/h) du and
+        // q ∫ u/h du.
+        let right = t.lane_load * (b * b - a * a) / (2.0 * h);
+        f[node(i - 1)] -= t.lane_load * (b - a) - right;
+        f[node(i)] -= right;
+    }
+    f
 }

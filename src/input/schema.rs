@@ -353,6 +353,17 @@ pub struct InfluenceIn {
     pub traffic: Vec<TrafficIn>,
     #[serde(default)]
     pub combinations: Vec<CombinationIn>,
+    #[serde(default)]
+    pub place: Vec<PlaceIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaceIn {
+    pub case: String,
+    pub traffic: Option<String>,
+    pub monitor: String,
+    pub extreme: String,
 }
 
 #[derive(Debug, Deserialize)]

@@ -23,6 +23,23 @@ pub struct Influence {
     pub traffic: Vec<crate::traffic::Traffic>,
     /// Load combinations of the state at the step's end and the traffic envelopes.
     pub combinations: Vec<Combination>,
+    /// Load cases given the loads of a governing traffic position.
+    pub place: Vec<Placement>,
+}
+
+/// A load case that receives, once the lines are taken, the loads of the traffic position
+/// that gives a monitor's extreme (`[[influence.place]]`): the governing vehicle's axles
+/// and the lane load on the unfavourable stretches, as nodal forces on the path.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Placement {
+    /// Index of the load case (empty in the model file).
+    pub case: usize,
+    /// Index of the traffic model in `Influence::traffic`.
+    pub traffic: usize,
+    /// Index of the monitor in `Influence::monitors`.
+    pub monitor: usize,
+    /// The largest (true) or the smallest value.
+    pub max: bool,
 }
 
 impl Influence {

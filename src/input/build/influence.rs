@@ -7,8 +7,8 @@ use super::fields::{index_by_name, positive, unique_names};
 use super::R;
 use crate::input::error::Ctx;
 use crate::input::locate;
-use crate::input::schema::{CombinationIn, File, InfluenceIn, TrafficIn};
-use crate::model::{Combination, Influence, Model, MonitorKind, StressComponent};
+use crate::input::schema::{CombinationIn, File, InfluenceIn, PlaceIn, TrafficIn};
+use crate::model::{Combination, Influence, Model, MonitorKind, Placement, StressComponent};
 use crate::traffic::{self, Traffic};
 
 /// The influence tables, resolved against the steps and monitors.
@@ -18,8 +18,20 @@ pub(super) fn build(ctx: &Ctx, file: &File, model: &mut Model, used: &[bool]) ->
         "influence",
         file.influence.iter().map(|t| t.name.as_str()),
     )?;
+    let mut placed = vec![false; model.load_cases.len()];
     for (i, t) in file.influence.iter().enumerate() {
         let inf = table(ctx, i, t, model, used)?;
+        for (j, p) in inf.place.iter().enumerate() {
+            if std::mem::replace(&mut placed[p.case], true) {
+                return Err(ctx.err(
+                    format!("influence[{i}].place[{j}].case"),
+                    format!(
+                        "load case '{}' is placed twice: one placement per load case",
+                        model.load_cases[p.case].name
+                    ),
+                ));
+            }
+        }
         model.influence.push(inf);
     }
     Ok(())
@@ -112,6 +124,15 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
         .enumerate()
         .map(|(j, c)| combination(ctx, &format!("{key}.combinations[{j}]"), c, &traffic))
         .collect::<R<Vec<_>>>()?;
+    let place = t
+        .place
+        .iter()
+        .enumerate()
+        .map(|(j, p)| {
+            let k = format!("{key}.place[{j}]");
+            placement(ctx, &k, p, model, &monitors, &traffic, after_step)
+        })
+        .collect::<R<Vec<_>>>()?;
     Ok(Influence {
         name: t.name.clone(),
         after_step,
@@ -121,6 +142,7 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
         monitors,
         traffic,
         combinations,
+        place,
     })
 }
 
@@ -187,6 +209,101 @@ pub(crate) fn linear(model: &Model, kind: &MonitorKind) -> bool {
         }
         _ => false,
     }
+}
+
+/// A placement (`influence[i].place[j]`): an empty load case, unused up to the step the
+/// lines are taken after, a traffic model, one of the table's monitors and an extreme.
+fn placement(
+    ctx: &Ctx,
+    key: &str,
+    p: &PlaceIn,
+    model: &Model,
+    monitors: &[usize],
+    traffic: &[Traffic],
+    after_step: usize,
+) -> R<Placement> {
+    let case = index_by_name(
+        ctx,
+        &format!("{key}.case"),
+        "load case",
+        model.load_cases.iter().map(|c| c.name.as_str()),
+        &p.case,
+    )?;
+    let c = &model.load_cases[case];
+    if !c.point_forces.is_empty()
+        || !c.edge_loads.is_empty()
+        || c.gravity.is_some()
+        || c.thermal.is_some()
+    {
+        return Err(ctx.err(
+            format!("{key}.case"),
+            format!(
+                "load case '{}' has loads of its own: a placed case is declared empty (`[[load_cases]]` with its name only) and takes the traffic's loads",
+                c.name
+            ),
+        ));
+    }
+    if let Some(s) = model.steps[..=after_step]
+        .iter()
+        .find(|s| s.factors[case] != 0.0)
+    {
+        return Err(ctx.err(
+            format!("{key}.case"),
+            format!(
+                "load case '{}' acts in step '{}', before its loads are placed at the end of step '{}': use it in later steps only",
+                c.name, s.name, model.steps[after_step].name
+            ),
+        ));
+    }
+    let t = match &p.traffic {
+        Some(n) => index_by_name(
+            ctx,
+            &format!("{key}.traffic"),
+            "traffic model",
+            traffic.iter().map(|t| t.name.as_str()),
+            n,
+        )?,
+        None if traffic.len() == 1 => 0,
+        None => {
+            return Err(ctx.err(
+                format!("{key}.traffic"),
+                "missing: name the traffic model to place (the table has none or several)",
+            ))
+        }
+    };
+    let monitor = monitors
+        .iter()
+        .position(|&m| model.monitors[m].name == p.monitor)
+        .ok_or_else(|| {
+            ctx.err(
+                format!("{key}.monitor"),
+                format!(
+                    "'{}' is not one of the table's monitors ({})",
+                    p.monitor,
+                    monitors
+                        .iter()
+                        .map(|&m| model.monitors[m].name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })?;
+    let max = match p.extreme.as_str() {
+        "max" => true,
+        "min" => false,
+        o => {
+            return Err(ctx.err(
+                format!("{key}.extreme"),
+                format!("unknown extreme '{o}' (expected max or min)"),
+            ))
+        }
+    };
+    Ok(Placement {
+        case,
+        traffic: t,
+        monitor,
+        max,
+    })
 }
 
 /// A traffic model (`influence[i].traffic[j]`).
