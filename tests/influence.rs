@@ -406,3 +406,172 @@ lane = 2.0
         ]
     );
 }
+
+/// The lines are those of the structure at the step asked: before and after the middle
+/// support is removed (a construction stage). After, the beam is simply supported over 2L
+/// and R_A = 1 − a/(2L), R_C = a/(2L) by statics, exact whatever the beam theory; before,
+/// the two-span line of R_A above.
+///
+/// Tolerances: after, 1e-8 (statically determinate: equilibrium of the FE forces, so only
+/// the solve's rounding, ~1e-16 × the condition number of a slender beam's stiffness, about
+/// 1e8; measured 3.5e-9); before, 5e-4 (as in `reaction_and_support_moment_influence_lines`).
+#[test]
+fn influence_lines_follow_the_construction_stage() {
+    let text = two_spans(
+        r#"
+[[monitors]]
+name = "R_C"
+kind = "reaction"
+support = "C"
+component = "y"
+
+[[steps]]
+name = "two spans"
+kind = "linear"
+
+[[steps]]
+name = "B removed"
+kind = "linear"
+remove = ["B"]
+
+[[influence]]
+name = "before"
+after_step = "two spans"
+line = [[0.0, 0.25], [20.0, 0.25]]
+monitors = ["R_A", "R_C"]
+
+[[influence]]
+name = "after"
+after_step = "B removed"
+line = [[0.0, 0.25], [20.0, 0.25]]
+monitors = ["R_A", "R_C"]
+"#,
+    );
+    let model = segfem::input::parse(&text, "two-span")
+        .expect("valid model")
+        .model;
+    let mut keep = Keep(Vec::new());
+    steps::run(&model, &mut keep).expect("runs");
+    assert_eq!(keep.0.len(), 2);
+    let (before, after) = (&keep.0[0], &keep.0[1]);
+    let (mut worst_before, mut worst_after) = (0.0f64, 0.0f64);
+    for (k, &a) in after.s.iter().enumerate() {
+        worst_after = worst_after
+            .max((after.values[0][k] - (1.0 - a / (2.0 * L))).abs())
+            .max((after.values[1][k] - a / (2.0 * L)).abs());
+        worst_before = worst_before.max((before.values[0][k] - r_a(a)).abs());
+    }
+    eprintln!("before: {worst_before:.2e}, after: {worst_after:.2e}");
+    assert!(
+        worst_after < 1e-8,
+        "simply supported: off by {worst_after:e}"
+    );
+    assert!(worst_before < 5e-4, "two spans: off by {worst_before:e}");
+}
+
+/// On a nonlinear state the lines are those of the tangent: the seed beam (elastic
+/// concrete, dry joints, external tendon, nonlinear geometry) at Q = 140 kN, its middle
+/// joint open, gets one more kilonewton at a load point as an ordinary step; the midspan
+/// deflection's change is 1000 × the influence ordinate there. The open joint makes the
+/// beam softer than at the end of prestressing, which the lines must show.
+///
+/// Tolerance 2 %: the step's secant against the tangent over 1 kN at 140 kN (the response
+/// curves as the joint opens further) and the Newton tolerance of the two converged states
+/// (force 1e-4 of the loads, against a change of 1/140 of them). Measured 0.8 %; the
+/// prestressed beam's line is 26 times stiffer there.
+#[test]
+fn on_an_open_joint_the_line_is_the_tangent() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text =
+        std::fs::read_to_string(root.join("examples/seed-beam-elastic.toml")).expect("example");
+    // Up to the ultimate step; the arc length to failure left out.
+    let cut = text.find("# On to failure").expect("failure step");
+    let text = format!(
+        r#"{}
+[[load_cases]]
+name = "dQ"
+point_loads = [{{ point = [2.4, 0.6], force = [0.0, -1e3] }}]
+
+[[steps]]
+name = "one more kN"
+kind = "load"
+loads = {{ self_weight = 1.0, Q = 140.0, dQ = 1.0 }}
+
+[[influence]]
+name = "prestressed"
+after_step = "prestress"
+line = [[0.0, 0.6], [7.2, 0.6]]
+monitors = ["midspan_uy"]
+
+[[influence]]
+name = "open"
+after_step = "ultimate"
+line = [[0.0, 0.6], [7.2, 0.6]]
+monitors = ["midspan_uy"]
+"#,
+        &text[..cut]
+    );
+    let model = segfem::input::parse(&text, "seed")
+        .expect("valid model")
+        .model;
+    struct Both {
+        lines: Vec<InfluenceLines>,
+        ends: Vec<f64>,
+        node: usize,
+    }
+    impl Observer for Both {
+        fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+            if s.end_of_step {
+                self.ends.push(s.system.u[2 * self.node + 1]);
+            }
+            Ok(())
+        }
+        fn influence(
+            &mut self,
+            lines: &Result<InfluenceLines, (usize, String)>,
+        ) -> std::io::Result<()> {
+            self.lines
+                .push(lines.clone().expect("influence lines taken"));
+            Ok(())
+        }
+    }
+    let node = match model.monitors.iter().find(|m| m.name == "midspan_uy") {
+        Some(segfem::model::Monitor {
+            kind: segfem::model::MonitorKind::Displacement { node, .. },
+            ..
+        }) => *node,
+        _ => panic!("midspan_uy is a displacement monitor"),
+    };
+    let mut obs = Both {
+        lines: Vec::new(),
+        ends: Vec::new(),
+        node,
+    };
+    steps::run(&model, &mut obs).expect("runs");
+    let eta_at = |l: &InfluenceLines| {
+        let k =
+            l.s.iter()
+                .position(|&s| (s - 2.4).abs() < 1e-9)
+                .expect("a path node at 2.4 m");
+        l.values[0][k]
+    };
+    let (stiff, open) = (eta_at(&obs.lines[0]), eta_at(&obs.lines[1]));
+    // Steps: prestress, service, ultimate, one more kN.
+    let n = obs.ends.len();
+    let step = obs.ends[n - 1] - obs.ends[n - 2];
+    eprintln!(
+        "per kN: step {:.4e} m, open tangent {:.4e} m, prestressed {:.4e} m",
+        step,
+        1e3 * open,
+        1e3 * stiff
+    );
+    assert!(
+        (1e3 * open - step).abs() < 0.02 * step.abs(),
+        "tangent {} against the step {step}",
+        1e3 * open
+    );
+    assert!(
+        open / stiff > 1.5,
+        "open {open} against prestressed {stiff}"
+    );
+}
