@@ -19,6 +19,10 @@ pub struct InfluenceLines {
     pub table: usize,
     /// Positions along the path [m] (distance from its start).
     pub s: Vec<f64>,
+    /// Name and unit of each line: the table's monitors, then (with `joints`) each joint's
+    /// contact stress at its top and bottom points, "<joint> top"/"<joint> bottom" [Pa,
+    /// compression positive].
+    pub names: Vec<(String, String)>,
     /// Monitor values at the step's end (the state the lines are taken at), per monitor of
     /// the table [monitor unit].
     pub state: Vec<f64>,
@@ -63,8 +67,13 @@ pub fn compute(
             "the tangent stiffness has {negative} negative pivot(s): the structure is past a limit point, where an influence line means nothing"
         ));
     }
-    let state = values(sys, inf, &u0, &base.f_int, f_ext);
-    let mut lines = vec![Vec::with_capacity(inf.path.len()); inf.monitors.len()];
+    let fibres = if inf.joints {
+        joint_fibres(sys)
+    } else {
+        Vec::new()
+    };
+    let state = values(sys, inf, &fibres, &u0, &base.f_int, f_ext);
+    let mut lines = vec![Vec::with_capacity(inf.path.len()); state.len()];
     let mut f = vec![0.0; model.n_dofs()];
     let mut u = u0.clone();
     for &(node, _) in &inf.path {
@@ -88,7 +97,7 @@ pub fn compute(
         })?;
         let mut fe = f_ext.to_vec();
         fe[d] -= 1.0;
-        let v = values(sys, inf, &u, &a.f_int, &fe);
+        let v = values(sys, inf, &fibres, &u, &a.f_int, &fe);
         for ((line, v), s) in lines.iter_mut().zip(v).zip(&state) {
             line.push(v - s);
         }
@@ -96,20 +105,65 @@ pub fn compute(
     }
     // Back to the committed state (trial states of the last assembly thrown away).
     sys.families.revert();
+    let mut names: Vec<(String, String)> = inf
+        .monitors
+        .iter()
+        .map(|&m| {
+            (
+                model.monitors[m].name.clone(),
+                model.monitors[m].unit().to_string(),
+            )
+        })
+        .collect();
+    names.extend(fibres.iter().map(|f| (f.0.clone(), "Pa".to_string())));
     Ok(InfluenceLines {
         table,
         s: inf.path.iter().map(|p| p.1).collect(),
+        names,
         state,
         values: lines,
     })
 }
 
-/// The table's monitors from the trial side of the last assembly at displacements `u`
-/// (internal forces `f_int`, external `f_ext`) [monitor units]. Only the kinds linear in
-/// the displacements (`input::build::influence::linear`) reach here.
-fn values(sys: &System, inf: &Influence, u: &[f64], f_int: &[f64], f_ext: &[f64]) -> Vec<f64> {
+/// The top and bottom integration points of every joint: (name, interface element, point).
+fn joint_fibres(sys: &System) -> Vec<(String, usize, usize)> {
+    let mut out = Vec::new();
+    for j in &sys.model.joints {
+        let points = j.interfaces.iter().flat_map(|&i| {
+            sys.interfaces[i]
+                .points()
+                .iter()
+                .enumerate()
+                .map(move |(k, _)| (i, k))
+        });
+        let y = |&(i, k): &(usize, usize)| sys.families.joints.points.committed[i][k].position[1];
+        let top = points.clone().max_by(|a, b| y(a).total_cmp(&y(b)));
+        let bottom = points.min_by(|a, b| y(a).total_cmp(&y(b)));
+        if let (Some(t), Some(b)) = (top, bottom) {
+            out.push((format!("{} top", j.name), t.0, t.1));
+            out.push((format!("{} bottom", j.name), b.0, b.1));
+        }
+    }
+    out
+}
+
+/// The table's monitors, then the joint fibres' contact stresses, from the trial side of
+/// the last assembly at displacements `u` (internal forces `f_int`, external `f_ext`)
+/// [monitor units; Pa]. Only the kinds linear in the displacements
+/// (`input::build::influence::linear`) reach here.
+fn values(
+    sys: &System,
+    inf: &Influence,
+    fibres: &[(String, usize, usize)],
+    u: &[f64],
+    f_int: &[f64],
+    f_ext: &[f64],
+) -> Vec<f64> {
     let model = sys.model;
     let fam = &sys.families;
+    let joints = fibres
+        .iter()
+        .map(|&(_, i, k)| fam.joints.points.trial[i][k].normal_stress);
     inf.monitors
         .iter()
         .map(|&m| match &model.monitors[m].kind {
@@ -146,6 +200,7 @@ fn values(sys: &System, inf: &Influence, u: &[f64], f_int: &[f64], f_ext: &[f64]
             // Refused by the input (not linear in the displacements).
             _ => f64::NAN,
         })
+        .chain(joints)
         .collect()
 }
 

@@ -349,6 +349,7 @@ pub struct InfluenceIn {
     pub after_step: Option<String>,
     pub line: Option<[[f64; 2]; 2]>,
     pub monitors: Option<Vec<String>>,
+    pub joints: Option<bool>,
     #[serde(default)]
     pub traffic: Vec<TrafficIn>,
     #[serde(default)]

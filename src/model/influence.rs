@@ -18,6 +18,8 @@ pub struct Influence {
     pub path: Vec<(usize, f64)>,
     /// Indices of the monitors whose influence lines are computed.
     pub monitors: Vec<usize>,
+    /// Also the lines of every joint's contact stress at its top and bottom points.
+    pub joints: bool,
     /// Traffic models enveloped over the lines.
     #[serde(skip)]
     pub traffic: Vec<crate::traffic::Traffic>,

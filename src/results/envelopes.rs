@@ -107,11 +107,10 @@ pub fn write(
         out.error = lines.as_ref().err().map(|e| e.1.clone());
         return Ok(out);
     };
-    let mon = |k: usize| &model.monitors[inf.monitors[k]];
-    // Influence lines: position, point, then each monitor per newton.
+    // Influence lines: position, point, then each line per newton.
     let mut csv = String::from("s [m],x [m],y [m]");
-    for k in 0..inf.monitors.len() {
-        let _ = write!(csv, ",{} [{}/N]", mon(k).name, mon(k).unit());
+    for (name, unit) in &l.names {
+        let _ = write!(csv, ",{name} [{unit}/N]");
     }
     csv.push('\n');
     for (i, &s) in l.s.iter().enumerate() {
@@ -139,8 +138,8 @@ pub fn write(
         for t in &inf.traffic {
             let (min, max) = envelope(t, &l.s, line);
             out.envelopes.push(EnvelopeRow {
-                monitor: mon(k).name.clone(),
-                unit: mon(k).unit().into(),
+                monitor: l.names[k].0.clone(),
+                unit: l.names[k].1.clone(),
                 traffic: t.name.clone(),
                 state: l.state[k],
                 min: place(min),
@@ -185,7 +184,7 @@ pub fn write(
     }
     let n_traffic = inf.traffic.len();
     for c in &inf.combinations {
-        for k in 0..inf.monitors.len() {
+        for k in 0..l.values.len() {
             let e = &out.envelopes[k * n_traffic + c.traffic];
             let at = |x: &ExtremeOut| c.state * e.state + c.vehicle * x.vehicle + c.lane * x.lane;
             out.combinations.push(CombinationRow {

@@ -101,7 +101,18 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
             ),
         ));
     }
-    let monitors = monitors(ctx, &key, t, model)?;
+    let joints = t.joints.unwrap_or(false);
+    if joints && model.joints.is_empty() {
+        return Err(ctx.err(format!("{key}.joints"), "the model has no joints"));
+    }
+    let monitors = if joints && t.monitors.is_none() {
+        // The joints' lines alone are enough: the monitors with a line, if any.
+        (0..model.monitors.len())
+            .filter(|&m| linear(model, &model.monitors[m].kind))
+            .collect()
+    } else {
+        monitors(ctx, &key, t, model)?
+    };
     unique_names(
         ctx,
         &format!("{key}.traffic"),
@@ -140,6 +151,7 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
         along,
         path,
         monitors,
+        joints,
         traffic,
         combinations,
         place,
