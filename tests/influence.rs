@@ -405,6 +405,16 @@ lane = 2.0
             "combinations_deck.csv"
         ]
     );
+    // The report shows the envelopes (R_B's maximum in kN) and the combinations.
+    let o = common::segfem(dir.path(), &["report", "out"]);
+    assert_eq!(common::code(&o), 0, "{}", common::stderr(&o));
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report");
+    assert!(html.contains("Influence lines 'deck' (after step 'unloaded')"));
+    assert!(
+        html.contains(&format!("{:.1}", b.max.value / 1e3)),
+        "R_B max in kN"
+    );
+    assert!(html.contains("<td>ULS</td><td>R_B</td>"));
 }
 
 /// The lines are those of the structure at the step asked: before and after the middle

@@ -8,12 +8,12 @@ use super::atomic::write_atomic;
 use crate::analysis::influence::InfluenceLines;
 use crate::model::Model;
 use crate::traffic::{envelope, Extreme};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// One `[[influence]]` table's results (summary.json `influence`).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct InfluenceSummary {
     /// Table name.
     pub name: String,
@@ -24,7 +24,7 @@ pub struct InfluenceSummary {
     /// Files written (none when `error` is set).
     pub files: Vec<String>,
     /// Why the lines could not be taken (then nothing else is given).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
     /// How each traffic model was reduced to the plane-stress girder.
     pub traffic: Vec<String>,
@@ -35,7 +35,7 @@ pub struct InfluenceSummary {
 }
 
 /// One extreme of a traffic model's effect on a monitor.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct ExtremeOut {
     /// Total [monitor unit].
     pub value: f64,
@@ -51,7 +51,7 @@ pub struct ExtremeOut {
 }
 
 /// The envelope of one monitor under one traffic model.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EnvelopeRow {
     /// Monitor name.
     pub monitor: String,
@@ -68,7 +68,7 @@ pub struct EnvelopeRow {
 }
 
 /// One combination of one monitor.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct CombinationRow {
     /// Combination name.
     pub combination: String,
