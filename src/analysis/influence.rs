@@ -42,6 +42,21 @@ pub fn compute(
     clock: f64,
     table: usize,
 ) -> Result<InfluenceLines, String> {
+    let lines = lines_of(sys, solver, f_ext, clock, table);
+    // Back to the committed state (trial states of the last assembly thrown away), also
+    // when the lines could not be taken.
+    sys.families.revert();
+    lines
+}
+
+/// The work of [`compute`], leaving trial states behind.
+fn lines_of(
+    sys: &mut System,
+    solver: &mut SparseCholesky,
+    f_ext: &[f64],
+    clock: f64,
+    table: usize,
+) -> Result<InfluenceLines, String> {
     let model = sys.model;
     let inf: &Influence = &model.influence[table];
     // An instantaneous perturbation: no creep, shrinkage or relaxation over it.
@@ -62,7 +77,6 @@ pub fn compute(
     let negative =
         factored.map_err(|e| format!("the tangent stiffness cannot be factorised: {e}"))?;
     if negative > 0 {
-        sys.families.revert();
         return Err(format!(
             "the tangent stiffness has {negative} negative pivot(s): the structure is past a limit point, where an influence line means nothing"
         ));
@@ -103,8 +117,6 @@ pub fn compute(
         }
         f[d] = 0.0;
     }
-    // Back to the committed state (trial states of the last assembly thrown away).
-    sys.families.revert();
     let mut names: Vec<(String, String)> = inf
         .monitors
         .iter()
