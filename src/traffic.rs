@@ -183,6 +183,53 @@ pub fn hl93(name: &str, w: f64, im: f64) -> Traffic {
     }
 }
 
+/// AASHTO LRFD 3.6.1.3.1: the smallest distance between the lead axle of one truck and the
+/// rear axle of the other in the two-truck load for negative moment and interior reactions [m].
+pub const HL93_TWO_TRUCK_GAP: f64 = 15.0;
+/// AASHTO LRFD 3.6.1.3.1: the factor on the two trucks and the lane load [-].
+pub const HL93_TWO_TRUCK_FACTOR: f64 = 0.9;
+/// Step of the searched gap between the two trucks [m].
+pub const HL93_GAP_STEP: f64 = 0.5;
+
+/// AASHTO LRFD 3.6.1.3.1 for negative moment between points of contraflexure and interior
+/// pier reactions: 90 % of two design trucks (145 kN axles 4.3 m apart) with at least
+/// 15 m from the lead axle of one to the rear axle of the other (gaps searched from 15 m to
+/// the path's length `path_length` [m] in 0.5 m steps), × (1 + IM), with 90 % of the lane
+/// load, all × k·m(k) as [`hl93`]. The designer reads it for those effects only (the code
+/// does not ask it elsewhere).
+pub fn hl93_two_trucks(name: &str, w: f64, im: f64, path_length: f64) -> Traffic {
+    let one = hl93(name, w, im);
+    let km = one.lane_load / HL93_LANE;
+    let truck = [
+        (0.0, HL93_TRUCK[0]),
+        (4.3, HL93_TRUCK[1]),
+        (8.6, HL93_TRUCK[2]),
+    ];
+    let longest = (path_length - HL93_TWO_TRUCK_GAP).max(0.0);
+    let n = (longest / HL93_GAP_STEP).floor() as usize;
+    let vehicles = (0..=n)
+        .map(|i| {
+            let gap = HL93_TWO_TRUCK_GAP + i as f64 * HL93_GAP_STEP;
+            let mut axles = truck.to_vec();
+            axles.extend(truck.iter().map(|&(d, p)| (8.6 + gap + d, p)));
+            Vehicle {
+                name: format!("two trucks {gap:.1} m apart"),
+                axles,
+            }
+        })
+        .collect();
+    Traffic {
+        name: name.into(),
+        vehicles,
+        vehicle_factor: HL93_TWO_TRUCK_FACTOR * (1.0 + im) * km,
+        lane_load: HL93_TWO_TRUCK_FACTOR * HL93_LANE * km,
+        note: format!(
+            "AASHTO LRFD HL-93 two trucks (3.6.1.3.1: negative moment, interior reactions), w = {w} m: {km:.2} lanes; 90 % of two trucks (4.3/4.3 m) at least 15 m apart × (1 + {im}), 90 % lane {:.2} kN/m",
+            HL93_TWO_TRUCK_FACTOR * HL93_LANE * km / 1e3
+        ),
+    }
+}
+
 /// A user vehicle: axle `loads` [N] at `spacings` [m] (one fewer), × (1 + `impact`), with
 /// a line load `lane_load` [N/m] where unfavourable, all × `lanes`.
 pub fn user_vehicle(
@@ -427,6 +474,47 @@ mod tests {
         let (_, max) = envelope(&t, &s, &eta);
         assert!((max.vehicle - 1320e3).abs() < 1e-6, "{}", max.vehicle);
         assert!((max.lane - 27e3 * l * l / 8.0).abs() < 1e-6);
+    }
+
+    /// The two-truck load: six axles, 2 × 325 kN, at the smallest gap 15 m from the rear
+    /// axle of the truck in front to the lead axle of the one behind; 0.9 × (1 + IM) × k·m(k)
+    /// on the axles and 0.9 × 9.3 kN/m × k·m(k); on one lane (m = 1.2) and a 40 m path,
+    /// gaps 15–40 m in 0.5 m steps: 51 pairs.
+    /// Over a pier of two equal 20 m spans (η of the reaction peaked at the pier), the two
+    /// trucks straddle it: the envelope exceeds one truck's.
+    #[test]
+    fn hl93_two_trucks_for_negative_moment() {
+        let t = hl93_two_trucks("2T", 3.6, HL93_IM, 40.0);
+        assert_eq!(t.vehicles.len(), 51);
+        let v = &t.vehicles[0];
+        assert_eq!(v.axles.len(), 6);
+        assert!((v.total() - 650e3).abs() < 1e-6);
+        // Lead axle of the second truck 15 m behind the rear axle of the first.
+        assert!((v.axles[3].0 - v.axles[2].0 - 15.0).abs() < 1e-12);
+        assert!((t.vehicle_factor - 0.9 * 1.33 * 1.2).abs() < 1e-12);
+        assert!((t.lane_load - 0.9 * 9.3e3 * 1.2).abs() < 1e-9);
+        // Middle reaction of two 20 m spans, Euler–Bernoulli: ξ(3 − ξ²)/2 each side.
+        let s: Vec<f64> = (0..=400).map(|i| i as f64 * 0.1).collect();
+        let eta: Vec<f64> = s
+            .iter()
+            .map(|&x| {
+                let xi = if x <= 20.0 {
+                    x / 20.0
+                } else {
+                    (40.0 - x) / 20.0
+                };
+                xi * (3.0 - xi * xi) / 2.0
+            })
+            .collect();
+        let (_, two) = envelope(&t, &s, &eta);
+        let (_, one) = envelope(&hl93("1T", 3.6, HL93_IM), &s, &eta);
+        assert!(two.vehicle > one.vehicle, "{} {}", two.vehicle, one.vehicle);
+        // Astride the pier: one truck on each span.
+        assert!(
+            two.axles[0] < 20.0 && two.axles[5] > 20.0,
+            "{:?}",
+            two.axles
+        );
     }
 
     /// Signed areas of a line crossing zero: η from −1 to 3 over 4 m: zero at 1 m,

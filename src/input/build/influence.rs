@@ -122,7 +122,10 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
         .traffic
         .iter()
         .enumerate()
-        .map(|(j, x)| traffic_model(ctx, &format!("{key}.traffic[{j}]"), x))
+        .map(|(j, x)| {
+            let length = path[path.len() - 1].1 - path[0].1;
+            traffic_model(ctx, &format!("{key}.traffic[{j}]"), x, length)
+        })
         .collect::<R<Vec<_>>>()?;
     unique_names(
         ctx,
@@ -318,8 +321,8 @@ fn placement(
     })
 }
 
-/// A traffic model (`influence[i].traffic[j]`).
-fn traffic_model(ctx: &Ctx, key: &str, x: &TrafficIn) -> R<Traffic> {
+/// A traffic model (`influence[i].traffic[j]`) on a path `length` [m] long.
+fn traffic_model(ctx: &Ctx, key: &str, x: &TrafficIn, length: f64) -> R<Traffic> {
     let given = |name: &str, v: bool| -> R<()> {
         if v {
             Err(ctx.err(
@@ -372,11 +375,16 @@ fn traffic_model(ctx: &Ctx, key: &str, x: &TrafficIn) -> R<Traffic> {
                 factors("alpha_q", x.alpha_q)?,
             ))
         }
-        "hl93" => {
+        "hl93" | "hl93_two_trucks" => {
             given("alpha_Q", x.alpha_big_q.is_some() || x.alpha_q.is_some())?;
             given("loads", vehicle_keys)?;
             given("lanes", x.lanes.is_some())?;
-            Ok(traffic::hl93(&x.name, width()?, impact(traffic::HL93_IM)?))
+            let (w, im) = (width()?, impact(traffic::HL93_IM)?);
+            Ok(if x.model == "hl93" {
+                traffic::hl93(&x.name, w, im)
+            } else {
+                traffic::hl93_two_trucks(&x.name, w, im, length)
+            })
         }
         "vehicle" => {
             given("carriageway_width", x.carriageway_width.is_some())?;
@@ -385,7 +393,7 @@ fn traffic_model(ctx: &Ctx, key: &str, x: &TrafficIn) -> R<Traffic> {
         }
         o => Err(ctx.err(
             format!("{key}.model"),
-            format!("unknown traffic model '{o}' (expected lm1, hl93 or vehicle)"),
+            format!("unknown traffic model '{o}' (expected lm1, hl93, hl93_two_trucks or vehicle)"),
         )),
     }
 }
