@@ -81,11 +81,14 @@ fn lines_of(
             "the tangent stiffness has {negative} negative pivot(s): the structure is past a limit point, where an influence line means nothing"
         ));
     }
-    let fibres = if inf.joints {
+    let mut fibres = if inf.joints {
         joint_fibres(sys)
     } else {
         Vec::new()
     };
+    if inf.fibres {
+        fibres.extend(section_fibres(sys));
+    }
     let state = values(sys, inf, &fibres, &u0, &base.f_int, f_ext);
     let mut lines = vec![Vec::with_capacity(inf.path.len()); state.len()];
     let mut f = vec![0.0; model.n_dofs()];
@@ -159,6 +162,52 @@ fn joint_fibres(sys: &System) -> Vec<(String, usize, usize)> {
     out
 }
 
+/// The top and bottom Gauss points of every column of Gauss points (points sharing their x
+/// within 1e-9 × the model's extent; columns of one point left out): ("sx top x=…", MAX,
+/// Gauss point), in the order of x.
+fn section_fibres(sys: &System) -> Vec<(String, usize, usize)> {
+    use crate::elements::continuum::rule_points;
+    use crate::fem::shape::map_point;
+    /// A column: its x, the top and bottom (y, Gauss point), and its number of points.
+    type Column = (f64, (f64, usize), (f64, usize), usize);
+    let model = sys.model;
+    let extent = model
+        .nodes
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()))
+        .max(1.0);
+    let tol = 1e-9 * extent;
+    let mut columns: std::collections::BTreeMap<i64, Column> = Default::default();
+    for (e, el) in model.elements.iter().enumerate() {
+        let coords = model.element_coords(el);
+        for (j, &(xi, eta, _)) in rule_points(el.kind, el.integration).iter().enumerate() {
+            let p = map_point(&el.kind.eval(xi, eta), &coords);
+            let g = sys.gp_offset[e] + j;
+            let c = columns.entry((p[0] / tol).round() as i64).or_insert((
+                p[0],
+                (p[1], g),
+                (p[1], g),
+                0,
+            ));
+            if p[1] > c.1 .0 {
+                c.1 = (p[1], g);
+            }
+            if p[1] < c.2 .0 {
+                c.2 = (p[1], g);
+            }
+            c.3 += 1;
+        }
+    }
+    let mut out = Vec::new();
+    for (x, top, bottom, n) in columns.into_values() {
+        if n > 1 {
+            out.push((format!("sx top x={x:.3}"), usize::MAX, top.1));
+            out.push((format!("sx bottom x={x:.3}"), usize::MAX, bottom.1));
+        }
+    }
+    out
+}
+
 /// The table's monitors, then the joint fibres' contact stresses, from the trial side of
 /// the last assembly at displacements `u` (internal forces `f_int`, external `f_ext`)
 /// [monitor units; Pa]. Only the kinds linear in the displacements
@@ -173,9 +222,15 @@ fn values(
 ) -> Vec<f64> {
     let model = sys.model;
     let fam = &sys.families;
-    let joints = fibres
-        .iter()
-        .map(|&(_, i, k)| fam.joints.points.trial[i][k].normal_stress);
+    // Joint points (interface element, point) or, with `usize::MAX` for the element,
+    // continuum Gauss points (σx).
+    let joints = fibres.iter().map(|&(_, i, k)| {
+        if i == usize::MAX {
+            fam.continuum.gauss.trial[k].stress[0]
+        } else {
+            fam.joints.points.trial[i][k].normal_stress
+        }
+    });
     inf.monitors
         .iter()
         .map(|&m| match &model.monitors[m].kind {

@@ -350,6 +350,7 @@ pub struct InfluenceIn {
     pub line: Option<[[f64; 2]; 2]>,
     pub monitors: Option<Vec<String>>,
     pub joints: Option<bool>,
+    pub fibres: Option<bool>,
     #[serde(default)]
     pub traffic: Vec<TrafficIn>,
     #[serde(default)]

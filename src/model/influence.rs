@@ -20,6 +20,9 @@ pub struct Influence {
     pub monitors: Vec<usize>,
     /// Also the lines of every joint's contact stress at its top and bottom points.
     pub joints: bool,
+    /// Also the lines of σx at the top and bottom Gauss points of every column of Gauss
+    /// points (the extreme fibres along the girder).
+    pub fibres: bool,
     /// Traffic models enveloped over the lines.
     #[serde(skip)]
     pub traffic: Vec<crate::traffic::Traffic>,

@@ -105,8 +105,9 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
     if joints && model.joints.is_empty() {
         return Err(ctx.err(format!("{key}.joints"), "the model has no joints"));
     }
-    let monitors = if joints && t.monitors.is_none() {
-        // The joints' lines alone are enough: the monitors with a line, if any.
+    let fibres = t.fibres.unwrap_or(false);
+    let monitors = if (joints || fibres) && t.monitors.is_none() {
+        // The joints' or fibres' lines alone are enough: the monitors with a line, if any.
         (0..model.monitors.len())
             .filter(|&m| linear(model, &model.monitors[m].kind))
             .collect()
@@ -155,6 +156,7 @@ fn table(ctx: &Ctx, i: usize, t: &InfluenceIn, model: &Model, used: &[bool]) -> 
         path,
         monitors,
         joints,
+        fibres,
         traffic,
         combinations,
         place,
