@@ -19,4 +19,5 @@ pub mod model;
 pub mod prestress;
 pub mod results;
 pub mod run;
+pub mod traffic;
 pub mod view;

@@ -561,6 +561,11 @@ fn run(
                 for (n, v) in &s.final_monitors {
                     outln!("  {n} = {v:.6e}");
                 }
+                // The governing traffic positions, so that a later step can put the
+                // vehicle there (docs/input.md, `[[influence]]`).
+                for line in segfem::results::envelopes::headlines(&s.influence) {
+                    outln!("{line}");
+                }
                 outln!("results in {}", out.display());
             }
             ExitCode::SUCCESS

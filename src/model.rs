@@ -3,11 +3,13 @@
 
 pub mod checks;
 pub mod element_data;
+pub mod influence;
 pub mod stages;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
 pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
+pub use influence::{Combination, Influence, Placement};
 use serde::Serialize;
 pub use stages::{Lifetime, Push, Staging};
 
@@ -620,6 +622,8 @@ pub struct Model {
     pub staging: Staging,
     /// Design checks read from the results (`[[checks]]`; empty: none).
     pub checks: Vec<checks::DesignCheck>,
+    /// Influence lines and traffic envelopes (`[[influence]]`).
+    pub influence: Vec<Influence>,
 }
 
 impl Model {

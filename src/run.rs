@@ -178,6 +178,10 @@ pub struct Summary {
     /// item checked (docs/theory-design.md).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub design_checks: Vec<crate::results::design::CheckResult>,
+    /// Influence lines, traffic envelopes and combinations (`[[influence]]`; absent
+    /// without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub influence: Vec<crate::results::envelopes::InfluenceSummary>,
     /// Warnings met in the input and in the results.
     pub warnings: Vec<String>,
 }
@@ -283,6 +287,14 @@ pub fn is_run_file(name: &str) -> bool {
         name,
         "history.csv" | "stages.csv" | "results.pvd" | "summary.json" | "report.html"
     ) || name == crate::results::checkpoint::FILE
+    {
+        return true;
+    }
+    // Influence tables' files: influence_, envelopes_, combinations_<name>.csv.
+    if name.ends_with(".csv")
+        && ["influence_", "envelopes_", "combinations_"]
+            .iter()
+            .any(|p| name.starts_with(p))
     {
         return true;
     }
@@ -394,6 +406,10 @@ struct Progress<'a, 'm> {
     timings: Option<Timings>,
     /// The last checkpoint, still being written (waited for before the next and at the end).
     checkpoint: Option<checkpoint::Pending>,
+    /// Influence tables written so far.
+    influence: Vec<crate::results::envelopes::InfluenceSummary>,
+    /// The model (influence tables).
+    model: &'m Model,
 }
 
 impl Observer for Progress<'_, '_> {
@@ -431,6 +447,16 @@ impl Observer for Progress<'_, '_> {
 
     fn step_failed(&mut self, report: &FailureReport) {
         self.failures.push(report.clone());
+    }
+
+    fn influence(
+        &mut self,
+        lines: &Result<crate::analysis::influence::InfluenceLines, (usize, String)>,
+    ) -> std::io::Result<()> {
+        let model = self.model;
+        let written = crate::results::envelopes::write(&self.dir, model, lines)?;
+        self.influence.push(written);
+        Ok(())
     }
 
     fn step_stopped(&mut self, system: &System, timings: &Timings) -> std::io::Result<()> {
@@ -600,6 +626,8 @@ pub fn run_file_opts(
         caller_stop: opts.caller_stop.clone(),
         timings: None,
         checkpoint: None,
+        influence: Vec::new(),
+        model: &model,
     };
     let result = steps::run_with(
         &model,
@@ -642,6 +670,7 @@ pub fn run_file_opts(
     let plausibility = obs.plausible.findings();
     let sustained = obs.sustained.warning(&model);
     let mut failures = obs.failures;
+    let influence = obs.influence;
     let (timings, error) = match result {
         Ok(t) => (t, None),
         Err(e) => (obs.timings.unwrap_or_default(), Some(e)),
@@ -776,6 +805,7 @@ pub fn run_file_opts(
         plausibility,
         strength_exceeded,
         design_checks,
+        influence,
         warnings,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

@@ -97,6 +97,7 @@ fn model_from_mesh(
         bars: Vec::new(),
         staging: Default::default(),
         checks: Vec::new(),
+        influence: Vec::new(),
     }
 }
 

@@ -50,6 +50,15 @@ pub trait Observer {
     /// Called when a step failed and the run goes on with the next one. Default: nothing.
     fn step_failed(&mut self, _report: &FailureReport) {}
 
+    /// Called with the influence lines of an `[[influence]]` table after the step it is
+    /// taken at (or why they could not be taken). Default: nothing.
+    fn influence(
+        &mut self,
+        _lines: &Result<super::influence::InfluenceLines, (usize, String)>,
+    ) -> std::io::Result<()> {
+        Ok(())
+    }
+
     /// Called when a step ends early (an increment failed after all cuts, a stop was asked,
     /// an error), with the system at its last converged state and the timings so far.
     /// Default: nothing.

@@ -5,6 +5,7 @@ mod driver;
 pub mod failure;
 pub mod families;
 mod increments;
+pub mod influence;
 pub mod loads;
 mod newton;
 pub mod one_way;

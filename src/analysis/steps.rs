@@ -92,10 +92,26 @@ pub fn run_with(
         u[d] = v;
     }
     let mut factored_linear = false;
+    // Load cases given their loads by influence lines (`[[influence.place]]`).
+    let mut placed: Vec<(usize, Vec<f64>)> = Vec::new();
+    if let Some(inf) = model
+        .influence
+        .iter()
+        .find(|i| !i.place.is_empty() && i.after_step < driver.next_step)
+    {
+        return Err(AnalysisError::Restore(format!(
+            "influence '{}' placed load case '{}' after step '{}', which the checkpoint has done; restart from a checkpoint before it",
+            inf.name, model.load_cases[inf.place[0].case].name, model.steps[inf.after_step].name
+        )));
+    }
     for si in driver.next_step..model.steps.len() {
         let step = &model.steps[si];
         if sys.stages.is_some() {
             enter_stage(&mut sys, si, clock, &mut cases, &factors)?;
+            // Load cases placed by influence lines keep their loads across stages.
+            for (c, f) in &placed {
+                cases[*c].copy_from_slice(f);
+            }
         }
         sys.stress_tendons(si);
         // Thermal strains of the factors held at the start of the step (path steps keep
@@ -166,6 +182,35 @@ pub fn run_with(
             system: &sys,
             driver: &driver,
         })?;
+        // Influence lines taken at this step's end (they leave the state as it is; the
+        // next step factorises its own tangent).
+        for table in (0..model.influence.len()).filter(|&t| model.influence[t].after_step == si) {
+            let f_ext = external_forces(model.n_dofs(), &cases, &factors);
+            let lines = super::influence::compute(&mut sys, &mut solver, &f_ext, clock, table)
+                .map_err(|e| (table, e));
+            obs.influence(&lines)?;
+            factored_linear = false;
+            let inf = &model.influence[table];
+            match &lines {
+                Ok(l) => {
+                    for p in &inf.place {
+                        let f = super::influence::placed_load(model, l, p);
+                        cases[p.case].copy_from_slice(&f);
+                        placed.push((p.case, f));
+                    }
+                }
+                // A later step would run a placed case without its loads.
+                Err((_, e)) if !inf.place.is_empty() => {
+                    timings.solver = solver.stats.clone();
+                    obs.step_stopped(&sys, &timings)?;
+                    return Err(AnalysisError::Mechanism(format!(
+                        "influence '{}' after step '{}': {e}; load case '{}' takes its loads from these lines",
+                        inf.name, step.name, model.load_cases[inf.place[0].case].name
+                    )));
+                }
+                Err(_) => {}
+            }
+        }
         if si + 1 < model.steps.len() {
             if let Some(reason) = obs.stop_requested() {
                 return Err(AnalysisError::Stopped {

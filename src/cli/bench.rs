@@ -100,6 +100,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         bars: Vec::new(),
         staging: Default::default(),
         checks: Vec::new(),
+        influence: Vec::new(),
     };
     let wall: Vec<(usize, Dir, f64)> = model
         .nodes

@@ -36,6 +36,9 @@ pub struct File {
     /// Design checks read from the results.
     #[serde(default)]
     pub checks: Vec<CheckIn>,
+    /// Influence lines, traffic envelopes and combinations.
+    #[serde(default)]
+    pub influence: Vec<InfluenceIn>,
     /// Generator of a span-by-span segmental viaduct (expanded before validation).
     pub viaduct: Option<super::generators::viaduct::ViaductIn>,
 }
@@ -364,4 +367,57 @@ pub struct SolverIn {
 #[serde(deny_unknown_fields)]
 pub struct AnalysisIn {
     pub geometry: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InfluenceIn {
+    pub name: String,
+    pub after_step: Option<String>,
+    pub line: Option<[[f64; 2]; 2]>,
+    pub monitors: Option<Vec<String>>,
+    pub joints: Option<bool>,
+    pub fibres: Option<bool>,
+    #[serde(default)]
+    pub traffic: Vec<TrafficIn>,
+    #[serde(default)]
+    pub combinations: Vec<CombinationIn>,
+    #[serde(default)]
+    pub place: Vec<PlaceIn>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaceIn {
+    pub case: String,
+    pub traffic: Option<String>,
+    pub monitor: String,
+    pub extreme: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrafficIn {
+    pub name: String,
+    pub model: String,
+    pub carriageway_width: Option<f64>,
+    #[serde(rename = "alpha_Q")]
+    pub alpha_big_q: Option<[f64; 3]>,
+    pub alpha_q: Option<[f64; 3]>,
+    pub impact: Option<f64>,
+    pub loads: Option<Vec<f64>>,
+    pub spacings: Option<Vec<f64>>,
+    pub lane_load: Option<f64>,
+    pub lanes: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CombinationIn {
+    pub name: String,
+    pub kind: String,
+    pub traffic: Option<String>,
+    pub state: Option<f64>,
+    pub vehicle: Option<f64>,
+    pub lane: Option<f64>,
 }

@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod checkpoint;
 pub mod design;
+pub mod envelopes;
 pub mod fields;
 pub mod gauss_points;
 pub mod joints;

@@ -539,6 +539,95 @@ fn stages_section(dir: &Path) -> String {
     s
 }
 
+/// The influence tables of the run (summary.json `influence`): per table the traffic
+/// models as reduced to the girder, the envelopes with their governing axles and the
+/// combinations, in the report's units. Empty for a run without them.
+fn influence_section(dir: &Path, units: super::UnitOptions) -> String {
+    use crate::results::envelopes::{ExtremeOut, InfluenceSummary};
+    let Some(v) = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+    else {
+        return String::new();
+    };
+    let Ok(tables) = serde_json::from_value::<Vec<InfluenceSummary>>(v["influence"].clone()) else {
+        return String::new();
+    };
+    let mut s = String::new();
+    for t in &tables {
+        let _ = writeln!(
+            s,
+            "<h2>Influence lines '{}' (after step '{}')</h2>",
+            esc(&t.name),
+            esc(&t.after_step)
+        );
+        if let Some(e) = &t.error {
+            let _ = writeln!(s, "<p class=\"bad\">Not taken: {}</p>", esc(e));
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "<p>{} load positions; files {}.</p>",
+            t.positions,
+            esc(&t.files.join(", "))
+        );
+        for n in &t.traffic {
+            let _ = writeln!(s, "<p class=\"note\">{}</p>", esc(n));
+        }
+        let at = |x: &ExtremeOut| {
+            if x.axles_x.is_empty() {
+                "–".to_string()
+            } else {
+                esc(&format!(
+                    "{} at x = {} m",
+                    x.vehicle_name,
+                    x.axles_x
+                        .iter()
+                        .map(|v| format!("{v:.2}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            }
+        };
+        if !t.envelopes.is_empty() {
+            s.push_str("<table class=\"envelopes\">\n<tr><th>monitor</th><th>traffic</th><th>unit</th><th>state</th><th>min</th><th>governing</th><th>max</th><th>governing</th></tr>\n");
+            for e in &t.envelopes {
+                let (u, k) = table_unit(&e.unit, units);
+                let _ = writeln!(
+                    s,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    esc(&e.monitor),
+                    esc(&e.traffic),
+                    esc(&u),
+                    num(e.state * k),
+                    num(e.min.value * k),
+                    at(&e.min),
+                    num(e.max.value * k),
+                    at(&e.max)
+                );
+            }
+            s.push_str("</table>\n");
+        }
+        if !t.combinations.is_empty() {
+            s.push_str("<table class=\"combinations\">\n<tr><th>combination</th><th>monitor</th><th>unit</th><th>min</th><th>max</th></tr>\n");
+            for c in &t.combinations {
+                let (u, k) = table_unit(&c.unit, units);
+                let _ = writeln!(
+                    s,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    esc(&c.combination),
+                    esc(&c.monitor),
+                    esc(&u),
+                    num(c.min * k),
+                    num(c.max * k)
+                );
+            }
+            s.push_str("</table>\n");
+        }
+    }
+    s
+}
+
 /// `segfem report`: write the HTML page; returns its path and the notes on skipped parts.
 pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError> {
     let h = read_history(&opts.dir)?;
@@ -567,6 +656,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
     );
     html.push_str(&stages_section(&opts.dir));
     html.push_str(&design_section(&opts.dir));
+    html.push_str(&influence_section(&opts.dir, opts.units));
     let _ = write!(
         html,
         "<h2>Key numbers of the history ({} converged increments)</h2>\n{}",

@@ -10,6 +10,7 @@ mod bars;
 mod checks;
 mod controls;
 mod fields;
+mod influence;
 mod joints;
 mod loads;
 mod materials;
@@ -88,6 +89,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         bars: Vec::new(),
         staging: Default::default(),
         checks: Vec::new(),
+        influence: Vec::new(),
     };
     units::model_size(w, ctx, locate::model_size(&model));
     if !joints.is_empty() {
@@ -123,6 +125,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     monitors::build(ctx, &file, &mut model, &used)?;
     controls::geometry(ctx, file.analysis.as_ref(), &mut model)?;
     steps::build(ctx, &file.steps, &mut model, &used)?;
+    influence::build(ctx, &file, &mut model, &used)?;
     let start = model
         .steps
         .iter()
