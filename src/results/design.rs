@@ -245,169 +245,21 @@ fn evaluate(
     peak: Option<(f64, f64)>,
 ) -> CheckResult {
     let model = sys.model;
-    let mut verdict_kind = Verdict::Pass;
-    let (unit, quantity, items): (&str, String, Vec<CheckItem>) = match &c.kind {
-        CheckKind::JointDecompression {
-            joints,
-            min_compression,
-        } => {
-            let items = joints
-                .iter()
-                .map(|&j| {
-                    let sec = joint_section(sys, j);
-                    CheckItem {
-                        item: format!("joint {}", model.joints[j].name),
-                        demand: sec.least_fibre() / MPA,
-                        limit: min_compression / MPA,
-                        utilisation: sec.decompression_utilisation(*min_compression),
-                        at: String::new(),
-                    }
-                })
-                .collect();
-            (
-                "MPa",
-                "least fibre compression of the uncracked joint section against the required compression; utilisation = M / M_decompression".into(),
-                items,
-            )
-        }
-        CheckKind::ConcreteStress {
-            regions,
-            factor,
-            excluded,
-        } => {
-            let gauss = &sys.families.continuum.gauss.committed;
-            let mut skip = vec![false; model.elements.len()];
-            for &e in excluded {
-                skip[e] = true;
-            }
-            let items = regions
-                .iter()
-                .map(|&(r, fck)| {
-                    let mut worst = (0.0, usize::MAX);
-                    for (e, el) in model.elements.iter().enumerate() {
-                        if el.region != r || skip[e] {
-                            continue;
-                        }
-                        for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
-                            let (_, s2) = principal(&g.stress);
-                            if -s2 > worst.0 {
-                                worst = (-s2, e);
-                            }
-                        }
-                    }
-                    let limit = factor * fck;
-                    CheckItem {
-                        item: format!("region '{}'", model.regions[r].name),
-                        demand: worst.0 / MPA,
-                        limit: limit / MPA,
-                        utilisation: worst.0 / limit,
-                        at: if worst.1 == usize::MAX {
-                            String::new()
-                        } else {
-                            place(model, worst.1)
-                        },
-                    }
-                })
-                .collect();
-            let quantity = if excluded.is_empty() {
-                "largest compression −σ2 at the Gauss points against the limit".to_string()
-            } else {
-                format!(
-                    "largest compression −σ2 at the Gauss points against the limit; {} elements of the disturbed regions (within one member depth of anchorages, deviators, supports and point loads) left out",
-                    excluded.len()
-                )
-            };
-            ("MPa", quantity, items)
-        }
-        CheckKind::TendonStress { tendons, factor } => {
-            let items = tendons
-                .iter()
-                .map(|&t| {
-                    let s = tendon_stress(sys, t);
-                    let limit = factor * model.tendons[t].fptk;
-                    CheckItem {
-                        item: format!("tendon {}", model.tendons[t].name),
-                        demand: s / MPA,
-                        limit: limit / MPA,
-                        utilisation: s / limit,
-                        at: String::new(),
-                    }
-                })
-                .collect();
-            ("MPa", "largest span stress against the limit".into(), items)
-        }
-        CheckKind::UnbondedUltimate {
-            tendon,
-            x,
-            support_hinges,
-            fc,
-            ..
-        } => {
-            verdict_kind = Verdict::Info;
-            let name = &model.tendons[*tendon].name;
-            let (Some(fpe), Some((_, s_peak))) = (fpe, peak) else {
-                return not_evaluated(
-                    model,
-                    c,
-                    "the step giving the effective prestress (fpe_step) did not end in this run",
-                );
-            };
-            let code = match c.code {
-                Code::En => fpe + EN_UNBONDED_INCREASE,
-                Code::Aashto => match aashto_fps(model, *tendon, *x, *support_hinges, *fc, fpe) {
-                    Ok(v) => v,
-                    Err(why) => return not_evaluated(model, c, &why),
-                },
-            };
-            let items = vec![CheckItem {
-                item: format!("tendon {name}"),
-                demand: s_peak / MPA,
-                limit: code / MPA,
-                utilisation: s_peak / code,
-                at: format!("fpe = {:.1} MPa", fpe / MPA),
-            }];
-            (
-                "MPa",
-                "tendon stress at the step's peak load from the analysis beside the code's estimate at ultimate".into(),
-                items,
-            )
-        }
-        CheckKind::ShearKeys {
-            joints,
-            key_area,
-            fc,
-            phi,
-        } => {
-            let mut items = Vec::new();
-            for &j in joints {
-                let sec = joint_section(sys, j);
-                let asm = sec.area - key_area;
-                if asm < 0.0 {
-                    return not_evaluated(
-                        model,
-                        c,
-                        &format!(
-                            "key_area {key_area} m² exceeds the area of joint {} ({:.4} m²)",
-                            model.joints[j].name, sec.area
-                        ),
-                    );
-                }
-                let cap =
-                    phi * formulas::aashto_shear_key_capacity(*key_area, asm, *fc, sec.mean());
-                items.push(CheckItem {
-                    item: format!("joint {}", model.joints[j].name),
-                    demand: sec.v.abs() / 1e3,
-                    limit: cap / 1e3,
-                    utilisation: sec.v.abs() / cap,
-                    at: format!("σn = {:.2} MPa", sec.mean() / MPA),
-                });
-            }
-            (
-                "kN",
-                "shear force across the joint against φ V_j of the keyed joint".into(),
-                items,
-            )
-        }
+    let items = match &c.kind {
+        CheckKind::JointDecompression { .. } => decompression_items(sys, c),
+        CheckKind::ConcreteStress { .. } => concrete_items(sys, c),
+        CheckKind::TendonStress { .. } => tendon_items(sys, c),
+        CheckKind::UnbondedUltimate { .. } => unbonded_items(sys, c, fpe, peak),
+        CheckKind::ShearKeys { .. } => shear_key_items(sys, c),
+    };
+    let (unit, quantity, items) = match items {
+        Ok(v) => v,
+        Err(why) => return not_evaluated(model, c, &why),
+    };
+    let verdict_kind = if matches!(c.kind, CheckKind::UnbondedUltimate { .. }) {
+        Verdict::Info
+    } else {
+        Verdict::Pass
     };
     let worst = items
         .iter()
@@ -451,6 +303,198 @@ fn evaluate(
         items,
         text,
     }
+}
+
+/// A check's unit, what it reads and its items; Err: why it cannot be evaluated.
+type Items = Result<(&'static str, String, Vec<CheckItem>), String>;
+
+/// The items of a `JointDecompression` check (Err: why it cannot be evaluated).
+fn decompression_items(sys: &System, c: &DesignCheck) -> Items {
+    let model = sys.model;
+    let CheckKind::JointDecompression {
+        joints,
+        min_compression,
+    } = &c.kind
+    else {
+        unreachable!("called for its own kind")
+    };
+    let items = joints
+        .iter()
+        .map(|&j| {
+            let sec = joint_section(sys, j);
+            CheckItem {
+                item: format!("joint {}", model.joints[j].name),
+                demand: sec.least_fibre() / MPA,
+                limit: min_compression / MPA,
+                utilisation: sec.decompression_utilisation(*min_compression),
+                at: String::new(),
+            }
+        })
+        .collect();
+    Ok((
+        "MPa",
+        "least fibre compression of the uncracked joint section against the required compression; utilisation = M / M_decompression".into(),
+        items,
+    ))
+}
+
+/// The items of a `ConcreteStress` check (Err: why it cannot be evaluated).
+fn concrete_items(sys: &System, c: &DesignCheck) -> Items {
+    let model = sys.model;
+    let CheckKind::ConcreteStress {
+        regions,
+        factor,
+        excluded,
+    } = &c.kind
+    else {
+        unreachable!("called for its own kind")
+    };
+    let gauss = &sys.families.continuum.gauss.committed;
+    let mut skip = vec![false; model.elements.len()];
+    for &e in excluded {
+        skip[e] = true;
+    }
+    let items = regions
+        .iter()
+        .map(|&(r, fck)| {
+            let mut worst = (0.0, usize::MAX);
+            for (e, el) in model.elements.iter().enumerate() {
+                if el.region != r || skip[e] {
+                    continue;
+                }
+                for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
+                    let (_, s2) = principal(&g.stress);
+                    if -s2 > worst.0 {
+                        worst = (-s2, e);
+                    }
+                }
+            }
+            let limit = factor * fck;
+            CheckItem {
+                item: format!("region '{}'", model.regions[r].name),
+                demand: worst.0 / MPA,
+                limit: limit / MPA,
+                utilisation: worst.0 / limit,
+                at: if worst.1 == usize::MAX {
+                    String::new()
+                } else {
+                    place(model, worst.1)
+                },
+            }
+        })
+        .collect();
+    let quantity = if excluded.is_empty() {
+        "largest compression −σ2 at the Gauss points against the limit".to_string()
+    } else {
+        format!(
+            "largest compression −σ2 at the Gauss points against the limit; {} elements of the disturbed regions (within one member depth of anchorages, deviators, supports and point loads) left out",
+            excluded.len()
+        )
+    };
+    Ok(("MPa", quantity, items))
+}
+
+/// The items of a `TendonStress` check (Err: why it cannot be evaluated).
+fn tendon_items(sys: &System, c: &DesignCheck) -> Items {
+    let model = sys.model;
+    let CheckKind::TendonStress { tendons, factor } = &c.kind else {
+        unreachable!("called for its own kind")
+    };
+    let items = tendons
+        .iter()
+        .map(|&t| {
+            let s = tendon_stress(sys, t);
+            let limit = factor * model.tendons[t].fptk;
+            CheckItem {
+                item: format!("tendon {}", model.tendons[t].name),
+                demand: s / MPA,
+                limit: limit / MPA,
+                utilisation: s / limit,
+                at: String::new(),
+            }
+        })
+        .collect();
+    Ok(("MPa", "largest span stress against the limit".into(), items))
+}
+
+/// The items of a `UnbondedUltimate` check (Err: why it cannot be evaluated).
+fn unbonded_items(
+    sys: &System,
+    c: &DesignCheck,
+    fpe: Option<f64>,
+    peak: Option<(f64, f64)>,
+) -> Items {
+    let model = sys.model;
+    let CheckKind::UnbondedUltimate {
+        tendon,
+        x,
+        support_hinges,
+        fc,
+        ..
+    } = &c.kind
+    else {
+        unreachable!("called for its own kind")
+    };
+    let name = &model.tendons[*tendon].name;
+    let (Some(fpe), Some((_, s_peak))) = (fpe, peak) else {
+        return Err(
+            "the step giving the effective prestress (fpe_step) did not end in this run".into(),
+        );
+    };
+    let code = match c.code {
+        Code::En => fpe + EN_UNBONDED_INCREASE,
+        Code::Aashto => aashto_fps(model, *tendon, *x, *support_hinges, *fc, fpe)?,
+    };
+    let items = vec![CheckItem {
+        item: format!("tendon {name}"),
+        demand: s_peak / MPA,
+        limit: code / MPA,
+        utilisation: s_peak / code,
+        at: format!("fpe = {:.1} MPa", fpe / MPA),
+    }];
+    Ok((
+        "MPa",
+        "tendon stress at the step's peak load from the analysis beside the code's estimate at ultimate".into(),
+        items,
+    ))
+}
+
+/// The items of a `ShearKeys` check (Err: why it cannot be evaluated).
+fn shear_key_items(sys: &System, c: &DesignCheck) -> Items {
+    let model = sys.model;
+    let CheckKind::ShearKeys {
+        joints,
+        key_area,
+        fc,
+        phi,
+    } = &c.kind
+    else {
+        unreachable!("called for its own kind")
+    };
+    let mut items = Vec::new();
+    for &j in joints {
+        let sec = joint_section(sys, j);
+        let asm = sec.area - key_area;
+        if asm < 0.0 {
+            return Err(format!(
+                "key_area {key_area} m² exceeds the area of joint {} ({:.4} m²)",
+                model.joints[j].name, sec.area
+            ));
+        }
+        let cap = phi * formulas::aashto_shear_key_capacity(*key_area, asm, *fc, sec.mean());
+        items.push(CheckItem {
+            item: format!("joint {}", model.joints[j].name),
+            demand: sec.v.abs() / 1e3,
+            limit: cap / 1e3,
+            utilisation: sec.v.abs() / cap,
+            at: format!("σn = {:.2} MPa", sec.mean() / MPA),
+        });
+    }
+    Ok((
+        "kN",
+        "shear force across the joint against φ V_j of the keyed joint".into(),
+        items,
+    ))
 }
 
 fn fmt_u(u: f64) -> String {
