@@ -164,3 +164,42 @@ fn seed_beam_failure_with_error_control_does_not_depend_on_the_increment_count()
         );
     }
 }
+
+/// Measurement (not a check): a shear beam of docs/validation.md ("Shear beams"):
+/// `SEGFEM_BEAM` (OA1, B1), `SEGFEM_ROWS` (10), `SEGFEM_INC_MM` (plate increment, 0.2),
+/// `SEGFEM_PUSH_MM` (20), `SEGFEM_OPTION` (the bench's model option, "fixed, seed β"),
+/// `SEGFEM_TOL` (none: off); prints its peak.
+#[test]
+#[ignore = "measurement, run by hand"]
+fn measure_shear_beam() {
+    use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam_solver};
+    let var = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
+    let id = var("SEGFEM_BEAM", "OA1");
+    let rows: usize = var("SEGFEM_ROWS", "10").parse().unwrap();
+    let inc: f64 = var("SEGFEM_INC_MM", "0.2").parse().unwrap();
+    let push: f64 = var("SEGFEM_PUSH_MM", "20").parse().unwrap();
+    let option = var("SEGFEM_OPTION", "fixed, seed β");
+    let tol = std::env::var("SEGFEM_TOL").ok();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
+    let beam = read_beams(&path)
+        .unwrap()
+        .into_iter()
+        .find(|b| b.id == id)
+        .unwrap();
+    let keys = options().into_iter().find(|o| o.0 == option).unwrap().1;
+    let solver = tol
+        .as_ref()
+        .map_or(String::new(), |t| format!("increment_tolerance = {t}\n"));
+    let cpu0 = std::time::Instant::now();
+    let r = run_beam_solver(&beam, keys, rows, -push * 1e-3, inc * 1e-3, &solver).unwrap();
+    eprintln!(
+        "MEASURE {id} {rows} rows, {inc} mm, tol {tol:?}, {option}: peak {:.1} kN (test {:.0} kN, {:+.1} %), end {:.2} of peak, {:?}, {} increments, {:.1} s",
+        r.p_peak / 1e3,
+        beam.test.0 / 1e3,
+        100.0 * (r.p_peak / beam.test.0 - 1.0),
+        r.end_ratio,
+        r.ultimate.as_ref().map(|u| u.mode.clone()),
+        r.increments,
+        cpu0.elapsed().as_secs_f64()
+    );
+}
