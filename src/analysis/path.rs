@@ -695,9 +695,9 @@ fn arc_length_step(
         let mut dl_try = sizing.attempt_length();
         let loads = (f_base.as_slice(), q_full.as_slice(), q_free.as_slice());
         let solved = arc_increment(ctx, loads, lambda, &mut dl_try, a, &du_prev);
-        if solved.is_ok() {
-            sizing.set_first(dl_try);
-        }
+        // The first attempt sets the arc length, converged or not (a failed first arc is
+        // cut from it).
+        sizing.set_first(dl_try);
         match solved {
             Ok(inc) if sizing.implex_retry(ctx.sys, ctx.timings) => {
                 // The IMPL-EX error is above the tolerance: the arc retried at half its
