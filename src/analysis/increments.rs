@@ -35,7 +35,8 @@ pub(super) fn external_forces_along(base: &[f64], reference: &[f64], lambda: f64
 }
 
 /// Phase of an error-controlled pair of increments (`substep_tolerance` of a time step,
-/// `[solver] increment_tolerance` of load and displacement steps; docs/theory-time.md §9).
+/// `[solver] increment_tolerance` of load, displacement and arc-length steps;
+/// docs/theory-time.md §9, docs/theory.md).
 /// The pair over the levels [a, b] of the step is solved once as one increment (the probe,
 /// not kept) and then as its two halves; the halves are kept if
 /// max|u_probe − u| ≤ tol · max|u − u_a| (step doubling: the difference estimates the
