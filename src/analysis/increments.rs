@@ -516,6 +516,9 @@ pub(super) fn run(
             Verdict::Accepted { pair_error } => {
                 if let Some(e) = pair_error {
                     ctx.timings.increment_max_error = ctx.timings.increment_max_error.max(e);
+                    if ctl.tolerance.is_some_and(|tol| e > tol) {
+                        ctx.timings.increments_over_tolerance += 1;
+                    }
                 }
                 stepper.accept(ctx, obs, ctl, f_int, iterations)?;
             }

@@ -745,6 +745,9 @@ fn arc_length_step(
                         if let Some(e) = pair_error {
                             ctx.timings.increment_max_error =
                                 ctx.timings.increment_max_error.max(e);
+                            if tolerance.is_some_and(|tol| e > tol) {
+                                ctx.timings.increments_over_tolerance += 1;
+                            }
                         }
                     }
                 }
