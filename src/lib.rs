@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod design;
 pub mod elements;
 pub mod fem;
 pub mod input;

@@ -109,6 +109,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/viaduct.toml"),
     ),
     (
+        "viaduct-concrete",
+        "the viaduct on cracking, crushing, creeping concrete (kind = \"concrete\", creep = \"mc90\"): stages, 30 years, gradient, traffic to tendon yield",
+        include_str!("../examples/viaduct-concrete.toml"),
+    ),
+    (
         "viaduct-explicit",
         "the same viaduct written out table by table: the regions, mesh, supports, tendons and steps its [viaduct] section generates",
         include_str!("../examples/viaduct-explicit.toml"),
@@ -202,7 +207,8 @@ enum Command {
         /// beam example to failure, refined by each --refine; 5 ≈ 5e4 equations),
         /// "viaduct" (the three-span viaduct example: all stages, 30 years, gradient and
         /// traffic to failure, refined by each --refine; last column: deflection under the
-        /// tandem) or
+        /// tandem), "viaduct-concrete" (the same on cracking, creeping concrete, to tendon
+        /// yield) or
         /// "material-point" (concrete material-point updates per second) or "panels" (the
         /// membrane-panel series of validation/panels/panels.csv, or of --model, under each
         /// concrete model option: test/predicted ratios, mean, COV) or "beams" (the
@@ -372,6 +378,7 @@ fn main() -> ExitCode {
             "seed-failure" => bench_seed_failure(refine, false),
             "rc" => bench_rc(refine),
             "viaduct" => bench_seed(refine, cli::bench::viaduct_case),
+            "viaduct-concrete" => bench_seed(refine, cli::bench::viaduct_concrete_case),
             "material-point" => bench_material_point(),
             "seed-failure-concrete" => bench_seed_failure(refine, true),
             "panels" => bench_panels(model.as_deref()),
@@ -389,7 +396,7 @@ fn main() -> ExitCode {
                 bench_beams(model.as_deref(), &set)
             }
             o => {
-                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, long_term_concrete, seed-failure, seed-failure-concrete, rc, viaduct, material-point, panels or beams)");
+                eprintln!("error: --case: unknown case '{o}' (linear, seed, long_term, long_term_concrete, seed-failure, seed-failure-concrete, rc, viaduct, viaduct-concrete, material-point, panels or beams)");
                 ExitCode::from(2)
             }
         },
@@ -547,6 +554,9 @@ fn run(
                 // The verdict is the headline: what failed and at what load.
                 if let Some(u) = &s.ultimate {
                     outln!("{u}");
+                }
+                for c in &s.design_checks {
+                    outln!("{}", c.text);
                 }
                 for (n, v) in &s.final_monitors {
                     outln!("  {n} = {v:.6e}");

@@ -1,6 +1,7 @@
 //! The validated model as plain data: what input produces and the analysis consumes, so that
 //! the analysis never depends on how a model was read. Units SI (m, N, Pa, kg).
 
+pub mod checks;
 pub mod element_data;
 pub mod stages;
 
@@ -618,6 +619,8 @@ pub struct Model {
     pub bars: Vec<Bar>,
     /// Construction stages (empty: everything acts from the start).
     pub staging: Staging,
+    /// Design checks read from the results (`[[checks]]`; empty: none).
+    pub checks: Vec<checks::DesignCheck>,
 }
 
 impl Model {

@@ -174,6 +174,10 @@ pub struct Summary {
     /// contact), first met first (docs/running.md, "Concrete past its strength"); each also
     /// in `warnings`.
     pub strength_exceeded: Vec<crate::results::strength::StrengthFinding>,
+    /// Design checks (`[[checks]]`), in model order: verdict, utilisation, clause and every
+    /// item checked (docs/theory-design.md).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub design_checks: Vec<crate::results::design::CheckResult>,
     /// Warnings met in the input and in the results.
     pub warnings: Vec<String>,
 }
@@ -375,6 +379,7 @@ pub fn size_of(model: &Model, equations: usize) -> Size {
 struct Progress<'a, 'm> {
     rec: Recorder<'m>,
     watch: UltimateWatch,
+    design: crate::results::design::DesignWatch,
     plausible: Plausibility,
     sustained: SustainedStress,
     on_increment: &'a mut dyn FnMut(&Snapshot),
@@ -395,6 +400,7 @@ impl Observer for Progress<'_, '_> {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
         self.rec.increment(snap)?;
         self.watch.increment(snap);
+        self.design.increment(snap);
         self.plausible.increment(snap);
         self.sustained.increment(snap);
         (self.on_increment)(snap);
@@ -578,6 +584,7 @@ pub fn run_file_opts(
     let mut obs = Progress {
         rec,
         watch: UltimateWatch::new(),
+        design: crate::results::design::DesignWatch::new(&model),
         plausible: Plausibility::new(),
         sustained: SustainedStress::new(),
         on_increment,
@@ -631,6 +638,7 @@ pub fn run_file_opts(
         }
     }
     let watch = obs.watch;
+    let design_checks = obs.design.results(&model);
     let plausibility = obs.plausible.findings();
     let sustained = obs.sustained.warning(&model);
     let mut failures = obs.failures;
@@ -754,6 +762,7 @@ pub fn run_file_opts(
         ultimate,
         plausibility,
         strength_exceeded,
+        design_checks,
         warnings,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

@@ -96,6 +96,7 @@ fn model_from_mesh(
         geometry: Default::default(),
         bars: Vec::new(),
         staging: Default::default(),
+        checks: Vec::new(),
     }
 }
 

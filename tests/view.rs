@@ -475,8 +475,9 @@ fn segfem_bin(dir: &Path, args: &[&str]) -> std::process::Output {
 }
 
 /// Examples that take more than a few seconds run only their first step here (reduced
-/// run: rc-beam's 25-increment cracking step instead of its 145 increments to failure).
-const SLOW_EXAMPLES: &[&str] = &["rc-beam"];
+/// run: rc-beam's 25-increment cracking step instead of its 145 increments to failure;
+/// viaduct-concrete's first stage, its whole run being tests/viaduct.rs's).
+const SLOW_EXAMPLES: &[&str] = &["rc-beam", "viaduct-concrete"];
 
 /// Every bundled example (`segfem example` lists them) is written out, run (reduced for
 /// [`SLOW_EXAMPLES`]) and reported; its report must have a headline counting the converged

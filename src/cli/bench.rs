@@ -99,6 +99,7 @@ pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
         geometry: Default::default(),
         bars: Vec::new(),
         staging: Default::default(),
+        checks: Vec::new(),
     };
     let wall: Vec<(usize, Dir, f64)> = model
         .nodes
@@ -360,8 +361,29 @@ const VIADUCT_TANDEM_X: f64 = 15.375;
 /// the heating gradient and the traffic pattern to failure. Reports the final deflection
 /// under the tandem [m].
 pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
+    refined_viaduct(
+        include_str!("../../examples/viaduct.toml"),
+        "viaduct",
+        refine,
+    )
+}
+
+/// The same on cracking, crushing, creeping concrete (examples/viaduct-concrete.toml,
+/// issue 38 items 2 and 8): every stage, 30 years, the gradient and the traffic to tendon
+/// yield and L/100. Reports the final deflection under the tandem [m].
+pub fn viaduct_concrete_case(refine: usize) -> Result<NonlinearRow, String> {
+    refined_viaduct(
+        include_str!("../../examples/viaduct-concrete.toml"),
+        "viaduct-concrete",
+        refine,
+    )
+}
+
+/// A viaduct example's text `example` (file name `name`.toml) with its mesh refined
+/// `refine` times, timed.
+fn refined_viaduct(example: &str, name: &str, refine: usize) -> Result<NonlinearRow, String> {
     let r = refine.max(1);
-    let text = include_str!("../../examples/viaduct.toml")
+    let text = example
         .replace(
             "nx_per_segment = 2 ",
             &format!("nx_per_segment = {} ", 2 * r),
@@ -375,12 +397,12 @@ pub fn viaduct_case(refine: usize) -> Result<NonlinearRow, String> {
             &format!("depth = 1.90, rows = {} }}", 4 * r),
         );
     if r > 1 && !text.contains(&format!("depth = 1.90, rows = {} }}", 4 * r)) {
-        return Err("viaduct.toml changed: cannot refine its mesh".into());
+        return Err(format!("{name}.toml changed: cannot refine its mesh"));
     }
     timed_row(
         &text,
-        "viaduct.toml",
-        format!("viaduct, {} rows", 6 * r),
+        &format!("{name}.toml"),
+        format!("{name}, {} rows", 6 * r),
         VIADUCT_TANDEM_X,
     )
 }

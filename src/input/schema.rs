@@ -33,8 +33,34 @@ pub struct File {
     #[serde(default)]
     pub bar_layers: Vec<BarLayerIn>,
     pub analysis: Option<AnalysisIn>,
+    /// Design checks read from the results.
+    #[serde(default)]
+    pub checks: Vec<CheckIn>,
     /// Generator of a span-by-span segmental viaduct (expanded before validation).
     pub viaduct: Option<super::generators::viaduct::ViaductIn>,
+}
+
+/// One `[[checks]]` table (docs/input.md, "[[checks]]").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckIn {
+    pub name: String,
+    pub check: String,
+    pub step: String,
+    pub code: Option<String>,
+    pub combination: Option<String>,
+    pub joints: Option<Vec<String>>,
+    pub regions: Option<Vec<String>>,
+    pub include_d_regions: Option<bool>,
+    pub tendons: Option<Vec<String>>,
+    pub tendon: Option<String>,
+    pub min_compression: Option<f64>,
+    pub fck: Option<f64>,
+    pub x: Option<f64>,
+    pub support_hinges: Option<usize>,
+    pub fpe_step: Option<String>,
+    pub key_area: Option<f64>,
+    pub phi: Option<f64>,
 }
 
 // The material table lives with its kinds and builders (one file per material law's input).

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod checkpoint;
+pub mod design;
 pub mod fields;
 pub mod gauss_points;
 pub mod joints;

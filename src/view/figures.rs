@@ -3,6 +3,7 @@
 //! patterns and joint diagrams.
 
 use super::data::{bounds, Grid};
+use super::glyphs::GlyphText;
 use super::ViewError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -17,8 +18,7 @@ pub const FONT: &str = "sans-serif";
 pub fn init_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
-        let bytes: &'static [u8] = include_bytes!("../../assets/DejaVuSans.ttf");
-        plotters::style::register_font(FONT, FontStyle::Normal, bytes)
+        plotters::style::register_font(FONT, FontStyle::Normal, super::glyphs::DEJAVU_SANS)
             .unwrap_or_else(|_| panic!("the bundled font is a valid TTF"));
     });
 }
@@ -54,7 +54,8 @@ pub fn svg_string(fig: &impl Figure) -> Result<String, ViewError> {
 pub fn write_png(fig: &impl Figure, path: &Path) -> Result<(), ViewError> {
     init_font();
     let io = |e: String| ViewError::Io(format!("{}: {e}", path.display()));
-    let root = BitMapBackend::new(path, fig.size()).into_drawing_area();
+    // Text through GlyphText: plotters' bitmap text ignores glyph side bearings.
+    let root = GlyphText::new(BitMapBackend::new(path, fig.size())).into_drawing_area();
     root.fill(&WHITE).map_err(|e| io(de(e)))?;
     fig.draw(&root).map_err(io)?;
     root.present().map_err(|e| io(de(e)))?;

@@ -9,6 +9,7 @@
 
 pub mod data;
 pub mod figures;
+pub mod glyphs;
 pub mod report;
 pub mod units;
 

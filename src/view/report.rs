@@ -406,6 +406,58 @@ fn summary_section(dir: &Path) -> (String, String) {
 /// table of the stages with their history rows and largest joint opening, and a warning in
 /// words for each joint that opened in a stage before the last one (during construction).
 /// Empty for a run without stages.
+/// The design checks of summary.json (`design_checks`): one row per check, its governing
+/// item, utilisation and verdict; failures marked.
+fn design_section(dir: &Path) -> String {
+    let Some(v) = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+    else {
+        return String::new();
+    };
+    let Some(checks) = v["design_checks"].as_array().filter(|c| !c.is_empty()) else {
+        return String::new();
+    };
+    let mut s = String::from(
+        "<h2>Design checks</h2>\n<table id=\"design\">\n<tr><th>check</th><th>clause</th><th>step</th><th>governing</th><th>demand</th><th>limit</th><th>utilisation</th><th>verdict</th></tr>\n",
+    );
+    for c in checks {
+        let text = |k: &str| c[k].as_str().unwrap_or("").to_string();
+        let verdict = text("verdict");
+        let item = c["items"]
+            .as_array()
+            .and_then(|items| items.iter().find(|i| i["item"] == c["governing"]));
+        let unit = text("unit");
+        let value = |k: &str| {
+            item.and_then(|i| i[k].as_f64())
+                .map_or("–".to_string(), |x| format!("{} {unit}", num(x)))
+        };
+        let u = match &c["utilisation"] {
+            serde_json::Value::Number(n) => format!("{:.3}", n.as_f64().unwrap_or(0.0)),
+            serde_json::Value::Null if verdict == "not_evaluated" => "–".into(),
+            _ => "∞".into(),
+        };
+        let class = if verdict == "fail" {
+            " class=\"bad\""
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            s,
+            "<tr{class}><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{u}</td><td>{}</td></tr>",
+            esc(&text("name")),
+            esc(&text("clause")),
+            esc(&text("step")),
+            esc(&text("governing")),
+            value("demand"),
+            value("limit"),
+            esc(&verdict.replace('_', " ")),
+        );
+    }
+    s.push_str("</table>\n<p class=\"note\">Every item of each check is in summary.json (<code>design_checks</code>); docs/theory-design.md gives the formulas.</p>\n");
+    s
+}
+
 fn stages_section(dir: &Path) -> String {
     let Some(v) = std::fs::read_to_string(dir.join("summary.json"))
         .ok()
@@ -510,6 +562,7 @@ pub fn report(opts: &ReportOptions) -> Result<(PathBuf, Vec<String>), ViewError>
         d = esc(&opts.dir.display().to_string())
     );
     html.push_str(&stages_section(&opts.dir));
+    html.push_str(&design_section(&opts.dir));
     let _ = write!(
         html,
         "<h2>Key numbers of the history ({} converged increments)</h2>\n{}",

@@ -7,6 +7,7 @@
 
 mod anchorage;
 mod bars;
+mod checks;
 mod controls;
 mod fields;
 mod joints;
@@ -86,6 +87,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         geometry: Default::default(),
         bars: Vec::new(),
         staging: Default::default(),
+        checks: Vec::new(),
     };
     units::model_size(w, ctx, locate::model_size(&model));
     if !joints.is_empty() {
@@ -133,6 +135,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     loads::thermal_coefficients(ctx, &file, &mut model)?;
     stages::check_tendons(ctx, &model)?;
     controls::solver(ctx, file.solver.as_ref(), &mut model)?;
+    checks::build(ctx, &file.checks, &mut model)?;
     // Last, once stages and thermal coefficients are known (the zones' region copies
     // inherit them).
     anchorage::apply_local_zones(&mut model, &zones, &used);
