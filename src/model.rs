@@ -445,10 +445,11 @@ pub struct SolverControls {
     /// most `max_cuts` times (docs/theory-concrete.md §5.2). None (the default): off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub implex_tolerance: Option<f64>,
-    /// Error-controlled increments of load steps (without `time`) and displacement steps
-    /// on nonlinear materials (`[solver] increment_tolerance`, docs/theory.md): each pair
-    /// of increments is solved whole and as its halves and kept if they agree within this
-    /// fraction of the displacement change over the pair [-]. None (the default): off.
+    /// Error-controlled increments of load steps (without `time`), displacement steps and
+    /// arc-length steps on nonlinear materials (`[solver] increment_tolerance`,
+    /// docs/theory.md): each pair of increments (of arcs) is solved whole and as its halves
+    /// and kept if they agree within this fraction of the displacement change over the
+    /// pair [-]. None (the default): off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub increment_tolerance: Option<f64>,
     /// Print every Newton iteration's residual and energy norms to standard error

@@ -249,3 +249,54 @@ fn crack_spacing_of_the_beams_follows_mc90() {
         assert!((s - want).abs() < 1e-4, "{id}: s_rm = {s} m, hand {want} m");
     }
 }
+
+/// OA1 with the default model (fixed cracks, seed β, IMPL-EX) at converged plate increments
+/// (issue 42 item 5; docs/validation.md "Converged plate increments" and "Error-controlled
+/// increments"), coarse mesh (10 rows), about 20 s of CPU in release for both runs:
+///
+/// * the peak at 0.05 and 0.025 mm plate increments agrees within 2 % (issue 38's
+///   objectivity criterion; measured 370.9 / 374.6 kN, 1.0 %; at the bench's 0.2 mm it is
+///   457.1 kN, 22 % above: IMPL-EX's first-order error in the increment);
+/// * the failure is brittle as in the test: a limit point ("loss of equilibrium") and the
+///   run ending below 0.8 of its peak (measured 0.65);
+/// * **a known deviation**: the converged peak misses docs/validation.md's acceptance band
+///   (|P/P_test − 1| ≤ 10 %) by over-estimating it, +12.8 % measured. Fixed cracks lock
+///   stress across the inclined crack (docs/theory-concrete.md §5.5b), so the model must be
+///   above the test; asserted between P_test and 1.15 P_test, so that both an unexplained
+///   improvement (into the band) and a regression fail and are looked at.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "release test: 1,200 increments of a shear beam"
+)]
+fn oa1_default_model_converged_in_the_increment_a_known_deviation_above_the_band() {
+    let oa1 = &beam("OA1");
+    let p_u = oa1.test.0;
+    let keys = option("fixed, seed β");
+    let coarse = run_beam(oa1, keys, 10, -0.02, 0.05e-3).unwrap();
+    let fine = run_beam(oa1, keys, 10, -0.02, 0.025e-3).unwrap();
+    eprintln!(
+        "OA1 default: {:.1} kN (0.05 mm), {:.1} kN (0.025 mm, end {:.2} of peak, {:?}); test {:.0} kN",
+        coarse.p_peak / 1e3,
+        fine.p_peak / 1e3,
+        fine.end_ratio,
+        fine.ultimate.as_ref().map(|u| &u.mode),
+        p_u / 1e3
+    );
+    assert!(
+        (coarse.p_peak - fine.p_peak).abs() < 0.02 * fine.p_peak,
+        "peak {:.1} kN (0.05 mm) vs {:.1} kN (0.025 mm)",
+        coarse.p_peak / 1e3,
+        fine.p_peak / 1e3
+    );
+    for r in [&coarse, &fine] {
+        let u = r.ultimate.as_ref().expect("a verdict");
+        assert_eq!(u.mode, "loss of equilibrium");
+        assert!(r.end_ratio < 0.8, "end {:.2} of the peak", r.end_ratio);
+    }
+    let ratio = fine.p_peak / p_u;
+    assert!(
+        (1.0..1.15).contains(&ratio),
+        "P/P_test = {ratio:.3} (known deviation: +12.8 % measured)"
+    );
+}

@@ -214,6 +214,12 @@ pub struct Timings {
     /// max|u_whole − u_halves| / max|Δu over the pair| (0 without error control).
     #[serde(skip_serializing_if = "is_zero_f")]
     pub increment_max_error: f64,
+    /// Pairs of increments kept with their estimated error above the tolerance: the
+    /// shortest pair allowed, or one whose error a shorter pair did not lower (a crack or
+    /// a joint jumping open inside it). Where these occur, `increment_max_error` measures
+    /// such jumps, not a path error the increment size controls.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub increments_over_tolerance: usize,
 }
 
 /// Counts of the displacement driver's line searches ([`Timings::line_searches`]).

@@ -35,15 +35,17 @@ pub(super) fn external_forces_along(base: &[f64], reference: &[f64], lambda: f64
 }
 
 /// Phase of an error-controlled pair of increments (`substep_tolerance` of a time step,
-/// `[solver] increment_tolerance` of load and displacement steps; docs/theory-time.md §9).
+/// `[solver] increment_tolerance` of load, displacement and arc-length steps;
+/// docs/theory-time.md §9, docs/theory.md).
 /// The pair over the levels [a, b] of the step is solved once as one increment (the probe,
 /// not kept) and then as its two halves; the halves are kept if
 /// max|u_probe − u| ≤ tol · max|u − u_a| (step doubling: the difference estimates the
 /// probe's error and bounds the halves' own, about 1/(2^p − 1) of it for a method of order
 /// p ≥ 1), else the state goes back to a and a shorter pair is tried.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub enum Pair {
     /// Next: the whole pair as one increment.
+    #[default]
     Probe,
     /// Next: the first half.
     First(Box<PairStart>),
@@ -529,6 +531,9 @@ pub(super) fn run(
             Verdict::Accepted { pair_error } => {
                 if let Some(e) = pair_error {
                     ctx.timings.increment_max_error = ctx.timings.increment_max_error.max(e);
+                    if ctl.tolerance.is_some_and(|tol| e > tol) {
+                        ctx.timings.increments_over_tolerance += 1;
+                    }
                 }
                 stepper.accept(ctx, obs, ctl, f_int, iterations)?;
             }
@@ -539,7 +544,11 @@ pub(super) fn run(
 
 /// Sizing of an arc-length step: its arc length Δl, set by the first increment, cut after
 /// failures to ½, 2, ¼, 4, … of the failed length, halved for the IMPL-EX error, and grown
-/// by the iterations an increment took.
+/// by the iterations an increment took. With a step-doubling tolerance
+/// (`[solver] increment_tolerance`) Δl is the length of a pair of arcs: solved once whole
+/// (the probe) and then as two arcs of Δl/2, kept if the rms difference of the
+/// displacements is within the tolerance of the rms change over the pair
+/// ([`ArcSizing::converged`]), and sized by that error as well as by the iterations.
 #[derive(Debug, Default)]
 pub(super) struct ArcSizing {
     /// Arc length of the next increment (None before the first sets it).
@@ -554,20 +563,130 @@ pub(super) struct ArcSizing {
     pub prev_dl: Option<f64>,
     /// IMPL-EX error of the last attempt of this increment, if it was cut for it.
     pub implex_last: Option<f64>,
+    /// Step-doubling tolerance (None: single arcs).
+    pub tolerance: Option<f64>,
+    /// Phase of the current pair of arcs (with a tolerance).
+    pub pair: Pair,
+    /// Relative error of the last rejected pair at this point, if any (a shorter pair whose
+    /// error did not fall below [`MIN_REDUCTION`] of it is kept, as in [`Controller`]).
+    last_rejected: Option<f64>,
+    /// Growth factor the last kept pair's error allows (applied with the iterations' one).
+    pair_growth: Option<f64>,
 }
 
 impl ArcSizing {
+    /// Arc-length sizing with the step-doubling tolerance `tolerance` (None: single arcs).
+    pub fn with_tolerance(tolerance: Option<f64>) -> Self {
+        ArcSizing {
+            tolerance,
+            ..ArcSizing::default()
+        }
+    }
+
+    /// Arc length of the next attempt (None before the first sets it): the pair's length
+    /// for its probe, half of it for its halves.
+    pub fn attempt_length(&self) -> Option<f64> {
+        match self.pair {
+            Pair::Probe => self.dl,
+            _ => self.dl.map(|l| 0.5 * l),
+        }
+    }
+
+    /// Set the pair's (or single arc's) length from the first attempt's, `tried`.
+    pub fn set_first(&mut self, tried: Option<f64>) {
+        if self.dl.is_none() {
+            self.dl = tried;
+        }
+    }
+
+    /// Whether the IMPL-EX error of a converged attempt is to be checked: a single arc or
+    /// the second half of a pair (a probe is thrown away anyway and a first half is
+    /// checked with the second, as in [`Controller::converged`]).
+    pub fn checks_implex(&self) -> bool {
+        self.tolerance.is_none() || matches!(self.pair, Pair::Second(_))
+    }
+
     /// History extrapolation factor (IMPL-EX cracking): ratio of the arc lengths.
     pub fn extrapolation(&self) -> f64 {
-        match (self.prev_dl, self.dl) {
+        match (self.prev_dl, self.attempt_length()) {
             (Some(p), Some(l)) if p > 0.0 => l / p,
             _ => 0.0,
+        }
+    }
+
+    /// A converged arc of a pair (with a tolerance; outside pairs always
+    /// `Accepted { pair_error: None }`): `u` the displacements it reached [m], `committed_u`
+    /// the committed ones [m] and `lambda` the committed load factor [-].
+    /// - the probe: kept to compare with the halves ([`Verdict::Probed`], the caller throws
+    ///   its state away and sets [`PairStart::saved`]);
+    /// - the first half: committed, not reported ([`Verdict::FirstHalf`]);
+    /// - the second half: kept if rms|u_probe − u| ≤ tol · rms|u − u_a| (step doubling, as
+    ///   [`Controller::converged`]), or if the pair is already the shortest (1/1024 of the
+    ///   first) or its error did not fall below [`MIN_REDUCTION`] of the last rejected
+    ///   one's; else rejected with the pair length × 0.9 (tol · change/err)^½ (at least ¼).
+    pub fn converged(&mut self, u: &[f64], committed_u: &[f64], lambda: f64) -> Verdict {
+        let Some(tol) = self.tolerance else {
+            return Verdict::Accepted { pair_error: None };
+        };
+        match std::mem::take(&mut self.pair) {
+            Pair::Probe => {
+                self.pair = Pair::First(Box::new(PairStart {
+                    level: lambda,
+                    end: lambda,
+                    probe: u.to_vec(),
+                    start_u: committed_u.to_vec(),
+                    saved: None,
+                    prev_size: self.prev_dl,
+                    mark: 0.0,
+                    norm: PairNorm::Rms,
+                }));
+                Verdict::Probed
+            }
+            Pair::First(s) => {
+                self.accept(self.dl.map(|l| 0.5 * l));
+                self.pair = Pair::Second(s);
+                Verdict::FirstHalf
+            }
+            Pair::Second(s) => {
+                let min_dl = self.dl0 / 1024.0;
+                let may_shorten = self.dl.is_some_and(|l| l > min_dl);
+                let error = s.relative_error(u);
+                let growth = s.growth(u, Some(tol));
+                let falls = self
+                    .last_rejected
+                    .is_none_or(|last| error < MIN_REDUCTION * last);
+                if may_shorten && falls && error > tol {
+                    self.dl = self.dl.map(|l| (l * growth).max(min_dl));
+                    self.prev_dl = s.prev_size;
+                    self.last_rejected = Some(error);
+                    self.pair_growth = None;
+                    return Verdict::Rejected(s);
+                }
+                if error <= tol {
+                    self.last_rejected = None;
+                    self.pair_growth = Some(growth);
+                } else {
+                    // Kept above the tolerance (the shortest pair, or an error that a
+                    // shorter pair did not lower: a joint or a crack jumping open inside
+                    // it). Its size does not control that error: the next pair keeps the
+                    // size, and the rejected error stays the reference, so that a run of
+                    // such pairs is not shortened by ¼ at each (measured: the 2× seed beam
+                    // at 8× finer arcs crawled to its increment limit, 3,707 increments).
+                    self.pair_growth = Some(growth.max(1.0));
+                }
+                Verdict::Accepted {
+                    pair_error: Some(error),
+                }
+            }
         }
     }
 
     /// After a converged attempt: true if it is to be retried for its IMPL-EX error (the
     /// arc halved, not counted against the cuts).
     pub fn implex_retry(&mut self, sys: &super::system::System, timings: &mut Timings) -> bool {
+        if !self.checks_implex() {
+            return false;
+        }
         let dl = self.dl.unwrap_or(0.0);
         let nominal = if self.dl0 == 0.0 { dl } else { self.dl0 };
         if !implex_retry(sys, timings, (dl, nominal), &mut self.implex_last) {
@@ -577,6 +696,8 @@ impl ArcSizing {
             self.dl0 = self.dl.expect("set by the first increment");
         }
         self.dl = self.dl.map(|l| 0.5 * l);
+        // A pair retried: from the level reached (its first half stays committed).
+        self.pair = Pair::Probe;
         true
     }
 
@@ -591,11 +712,13 @@ impl ArcSizing {
 
     /// Step-size adaptation after a kept increment of `iterations`:
     /// Δl ← Δl √(desired/N), bounded to [½, 2] per increment and to `max_growth` × the
-    /// first arc length.
+    /// first arc length; after a kept pair, by the smaller of that and the factor its error
+    /// allows ([`PairStart::growth`]).
     pub fn grow(&mut self, desired: usize, iterations: usize, max_growth: f64) {
         let ratio = (desired as f64 / iterations.max(1) as f64)
             .sqrt()
             .clamp(0.5, 2.0);
+        let ratio = self.pair_growth.take().map_or(ratio, |g| ratio.min(g));
         let dl0 = self.dl0;
         self.dl = self.dl.map(|l| (l * ratio).min(max_growth * dl0));
     }
@@ -609,6 +732,8 @@ impl ArcSizing {
         if self.cuts >= max_cuts || self.dl.is_none() {
             return false;
         }
+        // A failed arc of a pair: a new pair from the point reached.
+        self.pair = Pair::Probe;
         if self.cuts == 0 {
             self.failed_dl = self.dl;
         }
@@ -770,5 +895,90 @@ mod tests {
         let shortest = sizes.iter().cloned().fold(f64::MAX, f64::min);
         assert!(rejected_time > rejected, "{rejected_time} vs {rejected}");
         assert!(shortest < 0.25 / 100.0, "shortest increment {shortest}");
+    }
+
+    /// Drive an [`ArcSizing`] with a tolerance along a scripted path from `u0` as the
+    /// arc-length step does: `attempt(u_committed, arc)` gives the displacements an arc of
+    /// length `arc` [m] reaches (the first pair is `first` long). Returns the committed
+    /// displacements after `reports` reported increments, the lengths of the kept arcs, the
+    /// kept pairs' errors and the rejected pairs.
+    fn drive_arcs(
+        sizing: &mut ArcSizing,
+        u0: Vec<f64>,
+        first: f64,
+        reports: usize,
+        attempt: impl Fn(&[f64], f64) -> Vec<f64>,
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>, usize) {
+        let mut committed = u0;
+        let mut saved = committed.clone();
+        let (mut kept, mut errors, mut rejected, mut reported) = (Vec::new(), Vec::new(), 0, 0);
+        while reported < reports {
+            let arc = sizing.attempt_length().unwrap_or(first);
+            sizing.set_first(Some(arc));
+            let u = attempt(&committed, arc);
+            match sizing.converged(&u, &committed, 0.0) {
+                Verdict::Probed => saved = committed.clone(),
+                Verdict::FirstHalf => {
+                    kept.push(arc);
+                    committed = u;
+                }
+                Verdict::Rejected(_) => {
+                    rejected += 1;
+                    kept.pop();
+                    committed = saved.clone();
+                }
+                Verdict::ImplexRetry => unreachable!("no IMPL-EX control here"),
+                Verdict::Accepted { pair_error } => {
+                    sizing.accept(Some(arc));
+                    // One iteration where four are desired: the iterations allow ×2.
+                    sizing.grow(4, 1, 1e9);
+                    kept.push(arc);
+                    errors.push(pair_error.expect("a pair"));
+                    committed = u;
+                    reported += 1;
+                }
+            }
+        }
+        (committed, kept, errors, rejected)
+    }
+
+    #[test]
+    fn arc_pairs_on_a_straight_path_are_kept_and_grow() {
+        // u moves along a straight line: whole and halves end at the same point, the pair
+        // error is 0, every pair is kept and the next is twice as long (the iterations
+        // allow ×2 too): pairs of 1, 2, 4 → arcs 0.5, 0.5, 1, 1, 2, 2.
+        let mut sizing = ArcSizing::with_tolerance(Some(0.05));
+        let line = |u: &[f64], l: f64| vec![u[0] + 0.6 * l, u[1] + 0.8 * l];
+        let (u, kept, errors, rejected) = drive_arcs(&mut sizing, vec![0.0, 0.0], 1.0, 3, line);
+        assert_eq!(rejected, 0);
+        assert_eq!(kept, vec![0.5, 0.5, 1.0, 1.0, 2.0, 2.0]);
+        assert!(errors.iter().all(|&e| e < 1e-12), "{errors:?}");
+        // 7 of arc length along the unit direction (0.6, 0.8).
+        assert!(
+            (u[0] - 4.2).abs() < 1e-12 && (u[1] - 5.6).abs() < 1e-12,
+            "{u:?}"
+        );
+    }
+
+    #[test]
+    fn an_arc_pair_off_the_path_is_rejected_and_shortened_to_meet_the_tolerance() {
+        // The path is the unit circle, followed by forward Euler: an arc of length l from u
+        // goes along the tangent (−u₁, u₀)/|u|. From (1, 0) the probe ends at (1, l), the
+        // halves at ≈ (1 − l²/4, l): the pair's relative rms error is ≈ (l²/4)/l = l/4,
+        // 0.25 for the first pair of 1. With tol = 0.02 pairs are rejected down to
+        // l ≈ 4 tol = 0.08 and every kept pair's error is within the tolerance (the
+        // shortest pair, 1/1024 of the first, is not reached).
+        let tol = 0.02;
+        let mut sizing = ArcSizing::with_tolerance(Some(tol));
+        let euler = |u: &[f64], l: f64| {
+            let r = (u[0] * u[0] + u[1] * u[1]).sqrt();
+            vec![u[0] - l * u[1] / r, u[1] + l * u[0] / r]
+        };
+        let (_, kept, errors, rejected) = drive_arcs(&mut sizing, vec![1.0, 0.0], 1.0, 6, euler);
+        assert!(rejected >= 2, "the first pair misses by ~25 %: {rejected}");
+        assert!(errors.iter().all(|&e| e <= tol), "{errors:?}");
+        // Pairs near 4 tol = 0.08 (between ¼ and 1 of it: the growth factor 0.9 (tol/e)^½
+        // keeps them below the size where e = tol): arcs of half that.
+        assert!(kept.iter().all(|&k| (0.01..=0.04).contains(&k)), "{kept:?}");
     }
 }

@@ -6,7 +6,8 @@
 use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{
-    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm,
+    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, Pair, PairNorm,
+    Verdict,
 };
 use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
 use super::solver::SparseCholesky;
@@ -685,8 +686,17 @@ fn arc_length_step(
     let q_full = external_forces(n_dofs, ctx.cases, &a.reference);
     let max_cuts = ctx.sys.model.controls.max_cuts;
     let mut lambda = 0.0;
-    let mut sizing = ArcSizing::default();
+    // Nonlinear materials: pairs of arcs with `[solver] increment_tolerance`.
+    let tolerance = (!ctx.sys.linear)
+        .then_some(ctx.sys.model.controls.increment_tolerance)
+        .flatten();
+    let mut sizing = ArcSizing::with_tolerance(tolerance);
     let mut du_prev: Option<Vec<f64>> = None;
+    // The load factor and direction at the start of the current pair (restored when its
+    // halves are rejected) and at the last reported increment (where a target factor is
+    // crossed from).
+    let mut pair_start: (f64, Option<Vec<f64>>) = (0.0, None);
+    let mut reported_lambda = 0.0;
     let mut increment = 0;
     // Rounds of one-way support switches in the current increment.
     let mut rounds = 0;
@@ -702,11 +712,15 @@ fn arc_length_step(
     while increment < a.max_increments {
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
         ctx.sys.time.extrapolation = sizing.extrapolation();
-        let dl_try = sizing.dl;
+        let mut dl_try = sizing.attempt_length();
         // On the equations free now (one-way supports hold and let go of theirs).
         let q_free = ctx.sys.to_free(&q_full);
         let loads = (f_base.as_slice(), q_full.as_slice(), q_free.as_slice());
-        match arc_increment(ctx, loads, lambda, &mut sizing.dl, a, &du_prev) {
+        let solved = arc_increment(ctx, loads, lambda, &mut dl_try, a, &du_prev);
+        // The first attempt sets the arc length, converged or not (a failed first arc is
+        // cut from it).
+        sizing.set_first(dl_try);
+        match solved {
             Ok(inc) if sizing.implex_retry(ctx.sys, ctx.timings) => {
                 // The IMPL-EX error is above the tolerance: the arc retried at half its
                 // length (not counted against the cuts).
@@ -723,6 +737,51 @@ fn arc_length_step(
                     super::one_way::resume(ctx, &trial);
                     continue;
                 }
+                let verdict = sizing.converged(ctx.u, &ctx.sys.u, lambda);
+                match verdict {
+                    Verdict::Probed => {
+                        // Thrown away; the committed state kept in case the halves are
+                        // rejected.
+                        ctx.timings.iterations += inc.iterations;
+                        ctx.back_to_committed();
+                        if let Pair::First(start) = &mut sizing.pair {
+                            start.saved = Some(ctx.sys.snapshot());
+                        }
+                        pair_start = (lambda, du_prev.clone());
+                        continue;
+                    }
+                    Verdict::FirstHalf => {
+                        // Committed, reported with the second half.
+                        ctx.timings.iterations += inc.iterations;
+                        let u = ctx.u.clone();
+                        ctx.sys.commit(&u);
+                        lambda += inc.d_lambda;
+                        *ctx.factors = factors_at(lambda);
+                        du_prev = Some(inc.du);
+                        continue;
+                    }
+                    Verdict::Rejected(start) => {
+                        // Back to the pair's start with a shorter pair.
+                        ctx.timings.iterations += inc.iterations;
+                        ctx.timings.increments_rejected += 1;
+                        let saved = start.saved.expect("saved after the probe");
+                        ctx.sys.restore(saved).map_err(AnalysisError::Mechanism)?;
+                        ctx.back_to_committed();
+                        (lambda, du_prev) = (pair_start.0, pair_start.1.take());
+                        *ctx.factors = factors_at(lambda);
+                        continue;
+                    }
+                    Verdict::ImplexRetry => unreachable!("checked before the verdict"),
+                    Verdict::Accepted { pair_error } => {
+                        if let Some(e) = pair_error {
+                            ctx.timings.increment_max_error =
+                                ctx.timings.increment_max_error.max(e);
+                            if tolerance.is_some_and(|tol| e > tol) {
+                                ctx.timings.increments_over_tolerance += 1;
+                            }
+                        }
+                    }
+                }
                 sizing.accept(dl_try);
                 let mut lam_new = lambda + inc.d_lambda;
                 let mut f_int = inc.f_int;
@@ -731,7 +790,7 @@ fn arc_length_step(
                 // crossed it on the way up (the arc-length point is kept if that fails).
                 let mut reached = false;
                 if let Some(t) = a.target_factor {
-                    if lambda < t && lam_new >= t {
+                    if reported_lambda < t && lam_new >= t {
                         reached = true;
                         if let Some((fi, it)) = land_on_factor(ctx, &f_base, &q_full, t)? {
                             f_int = fi;
@@ -743,6 +802,7 @@ fn arc_length_step(
                 let u = ctx.u.clone();
                 ctx.sys.commit(&u);
                 lambda = lam_new;
+                reported_lambda = lambda;
                 increment += 1;
                 *ctx.factors = factors_at(lambda);
                 if let (Some((n, d, v)), Some(u0)) = (a.target_displacement, start_disp) {

@@ -271,7 +271,7 @@ const SEED_MIDSPAN: f64 = 3.6;
 
 /// `text` (the seed beam's mesh keys: 6 columns a segment, rows of 0.10 m and 0.40 m) with
 /// its mesh refined `r` times in both directions.
-fn refine_seed_mesh(text: &str, r: usize) -> String {
+pub fn refine_seed_mesh(text: &str, r: usize) -> String {
     text.replace(
         "nx_per_segment = 6 ",
         &format!("nx_per_segment = {} ", 6 * r),
@@ -579,12 +579,20 @@ pub fn seed_failure_case(refine: usize, concrete: bool) -> Result<FailureRow, St
         // The elastic example's own step on to failure (arc length to L/60).
         seed_text_to_failure(r)
     };
+    seed_failure_of(&text, r, concrete)
+}
+
+/// The seed beam's run to failure from its model text `text` (already refined `refine` ×,
+/// on MC90 `concrete` or elastic: the case's name), as [`seed_failure_case`] runs it: the
+/// text of a variant (other increments, `[solver]` keys) run and measured the same way.
+pub fn seed_failure_of(text: &str, refine: usize, concrete: bool) -> Result<FailureRow, String> {
+    let r = refine.max(1);
     if !text.contains("[[steps]]\nname = \"failure\"") {
         return Err("seed-beam.toml has no failure step".into());
     }
     let t0 = Instant::now();
     let cpu0 = process_cpu_s();
-    let model = segfem::input::parse(&text, "seed-beam.toml")
+    let model = segfem::input::parse(text, "seed-beam.toml")
         .map_err(|e| e.to_string())?
         .model;
     let mut obs = Reach::default();

@@ -353,8 +353,23 @@ pub fn run_beam(
     push: f64,
     increment: f64,
 ) -> Result<BeamRun, String> {
+    run_beam_solver(beam, keys, rows, push, increment, "")
+}
+
+/// As [`run_beam`], with the lines `solver` added to the model's `[solver]` table (say
+/// `increment_tolerance = 0.05\n`: the increment objectivity measurements,
+/// docs/validation.md).
+pub fn run_beam_solver(
+    beam: &Beam,
+    keys: &str,
+    rows: usize,
+    push: f64,
+    increment: f64,
+    solver: &str,
+) -> Result<BeamRun, String> {
     let t0 = std::time::Instant::now();
-    let text = beam_toml(beam, keys, rows, push, increment);
+    // The `[solver]` table is the model text's last.
+    let text = beam_toml(beam, keys, rows, push, increment) + solver;
     let built =
         crate::input::parse(&text, &format!("beam {}", beam.id)).map_err(|e| e.to_string())?;
     let model = &built.model;
