@@ -82,8 +82,8 @@ pub trait Observer {
     }
 }
 
-/// Work for an idle core ([`Observer::idle_work`]).
-pub type IdleWork = Box<dyn FnOnce() + Send + Sync + 'static>;
+/// Work run beside the next factorisation (defined with the solver, which runs it).
+pub use super::solver::IdleWork;
 
 /// The state at a step end, as observers see it (for checkpoints).
 pub struct StepEnd<'a, 's> {

@@ -55,6 +55,10 @@ pub enum SolverError {
     Singular,
 }
 
+/// Work for an idle core, run beside the next numeric factorisation (handed over by the
+/// step driver's observer, `analysis::driver::Observer::idle_work`).
+pub type IdleWork = Box<dyn FnOnce() + Send + Sync + 'static>;
+
 /// Timing and size figures of the solver, for summaries and benchmarks.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct SolverStats {
@@ -388,7 +392,7 @@ pub struct SparseCholesky {
     analysis: Option<std::thread::JoinHandle<Result<SparseCholesky, SolverError>>>,
     /// Work to start on a thread of its own when the next numeric factorisation starts
     /// ([`SparseCholesky::beside_next_factorisation`]).
-    beside: Option<super::driver::IdleWork>,
+    beside: Option<IdleWork>,
     factor: Factor,
     /// Whether the last [`SparseCholesky::factorize_indefinite`] ended in LDLᵀ: the next
     /// one then computes LDLᵀ beside its LLᵀ attempt ([`SparseCholesky::factorize_both`]).
@@ -420,7 +424,7 @@ impl SparseCholesky {
     /// Start `work` on a thread of its own when the next numeric factorisation starts (its
     /// storage ready): faer's sequential factorisation leaves the other cores idle. Work
     /// handed earlier and not started yet is dropped (never run).
-    pub fn beside_next_factorisation(&mut self, work: super::driver::IdleWork) {
+    pub fn beside_next_factorisation(&mut self, work: IdleWork) {
         self.beside = Some(work);
     }
 
