@@ -2,9 +2,9 @@
 //! results; Gmsh mapping errors are reported clearly.
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
-use segfem::fem::shape::QuadKind;
 use segfem::mesh::banded::Band;
 use segfem::mesh::segmental::generate_segments;
+use segfem::model::QuadKind;
 use std::fmt::Write;
 
 /// Write a Gmsh 2.2 ASCII file of the decompression example's mesh: Q8 elements in the

@@ -18,10 +18,10 @@ use segfem::elements::bar::{add_bar_point, bar_strain, BarPoint};
 use segfem::elements::continuum::{response, GaussOutput, Integration};
 use segfem::elements::interface::{InterfaceElement, InterfaceParams};
 use segfem::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
-use segfem::fem::shape::QuadKind;
 use segfem::materials::concrete::{self, ConcreteParams, ConcreteState};
 use segfem::materials::point::{update, Material, PointState};
 use segfem::materials::steel::{update_uniaxial, HardeningRule, SteelParams, SteelState};
+use segfem::model::QuadKind;
 use std::cell::Cell;
 
 // ------------------------------------------------------------------------------------------

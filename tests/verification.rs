@@ -3,9 +3,10 @@
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::elements::continuum::{rule, Integration};
-use segfem::fem::shape::{jacobian, QuadKind};
+use segfem::fem::shape::jacobian;
 use segfem::materials::point::Material;
 use segfem::mesh::banded::{generate, Band};
+use segfem::model::QuadKind;
 use segfem::model::*;
 
 /// Keeps the last converged displacements, internal and external forces, and Gauss stresses.

@@ -557,7 +557,7 @@ mod tests {
     /// coordinates, continuum element node lists and all couplings.
     #[allow(clippy::type_complexity)]
     fn jointed_mesh(
-        kind: crate::fem::shape::QuadKind,
+        kind: crate::model::QuadKind,
         nx: usize,
         ny: usize,
         extra: usize,
@@ -609,7 +609,7 @@ mod tests {
     #[test]
     fn element_dissection_is_a_permutation() {
         use crate::fem::assembly::Assembler;
-        use crate::fem::shape::QuadKind;
+        use crate::model::QuadKind;
         for kind in [QuadKind::Q8, QuadKind::Q9] {
             let (xy, elements, couplings) = jointed_mesh(kind, 12, 9, 7);
             let cons: Vec<(usize, f64)> = (0..xy.len())
@@ -648,7 +648,7 @@ mod tests {
     #[test]
     fn element_separators_separate() {
         use crate::fem::assembly::Assembler;
-        use crate::fem::shape::QuadKind;
+        use crate::model::QuadKind;
         fn check(
             d: &mut Dissection,
             el: &mut Elements,
@@ -726,8 +726,8 @@ mod tests {
     fn element_dissection_factor_vs_amd() {
         use crate::analysis::solver::SparseCholesky;
         use crate::fem::assembly::Assembler;
-        use crate::fem::shape::QuadKind;
         use crate::mesh::banded::{generate, Band};
+        use crate::model::QuadKind;
         let n = 40;
         let band = [Band {
             depth: 1.0,

@@ -364,7 +364,7 @@ impl<'m> System<'m> {
                 let all_q4 = model
                     .elements
                     .iter()
-                    .all(|e| e.kind == crate::fem::shape::QuadKind::Q4);
+                    .all(|e| e.kind == crate::model::QuadKind::Q4);
                 let ordering = if all_q4 {
                     (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
                         super::ordering::nested_dissection(

@@ -7,8 +7,8 @@
 use super::system::System;
 use crate::elements::continuum::rule_points;
 use crate::elements::thermal::ThermalAction;
-use crate::fem::shape::QuadKind;
 use crate::model::Model;
+use crate::model::QuadKind;
 
 /// Unit-factor imposed strains of one thermal load case.
 #[derive(Debug, Clone)]

@@ -3,9 +3,9 @@
 
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::elements::continuum::Integration;
-use segfem::fem::shape::QuadKind;
 use segfem::materials::point::Material;
 use segfem::mesh::banded::{generate, Band};
+use segfem::model::QuadKind;
 use segfem::model::*;
 use std::time::Instant;
 

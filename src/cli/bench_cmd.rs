@@ -1,7 +1,7 @@
 //! The `segfem bench` command: one function per `--case`, printing one row per size or
 //! refinement (the cases themselves are in [`super::bench`]).
 
-use segfem::fem::shape::QuadKind;
+use segfem::model::QuadKind;
 use std::process::ExitCode;
 
 use crate::stdout_failed;

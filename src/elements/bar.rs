@@ -10,8 +10,9 @@
 //! Conventions: element displacement vectors are interleaved `[u_0, v_0, u_1, v_1, …]` in the
 //! host's VTK node order; element matrices are dense, row-major, `2n × 2n`.
 
-use crate::fem::shape::{cartesian_derivatives, jacobian, QuadKind, MAX_NODES};
+use crate::fem::shape::{cartesian_derivatives, jacobian, MAX_NODES};
 use crate::materials::steel::{update_uniaxial, SteelParams, SteelState};
+use crate::model::QuadKind;
 
 /// A bar point (plain model data, defined in [`crate::model`]).
 pub use crate::model::element_data::BarPoint;

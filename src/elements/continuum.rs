@@ -2,8 +2,9 @@
 //! stiffness from the trial displacements, consistent body and edge loads.
 
 use crate::fem::quadrature::{gauss, gauss_square, Point2};
-use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, QuadKind, MAX_NODES};
+use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
+use crate::model::QuadKind;
 use serde::{Deserialize, Serialize};
 
 /// Integration rule (plain model data, defined in [`crate::model`]).

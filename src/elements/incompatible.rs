@@ -15,8 +15,9 @@
 //! f = ∫ Bᵀ σ t dA and the condensed tangent K = K_uu − K_uα K_αα⁻¹ K_αu.
 
 use super::continuum::{gauss_geometry, rule_points, GaussGeometry, GaussOutput, Integration};
-use crate::fem::shape::{jacobian, QuadKind, MAX_NODES};
+use crate::fem::shape::{jacobian, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
+use crate::model::QuadKind;
 
 /// Local Newton iterations allowed for α.
 const MAX_LOCAL: usize = 30;

@@ -15,8 +15,8 @@
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
 use super::continuum::{GaussOutput, NodeBlocks};
-use crate::fem::shape::QuadKind;
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
+use crate::model::QuadKind;
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
 /// `h[i][j] = ∂u_i/∂X_j` [-].

@@ -8,8 +8,8 @@
 /// Maximum number of nodes of any element kind.
 pub const MAX_NODES: usize = 9;
 
-/// The quadrilateral element kinds (plain model data, defined in [`crate::model`]).
-pub use crate::model::element_data::QuadKind;
+// The element kinds are model data (crate::model); shape functions read them.
+use crate::model::QuadKind;
 
 /// Natural coordinates of the nodes of a Q9 (the first 4 / 8 are those of Q4 / Q8).
 pub const NODE_XI: [[f64; 2]; 9] = [

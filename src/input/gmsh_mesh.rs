@@ -6,10 +6,10 @@ use super::error::{Ctx, InputError};
 use super::limits::{available_memory, check_size, degenerate, extent};
 use super::schema::MeshIn;
 use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
-use crate::fem::shape::QuadKind;
 use crate::mesh::gmsh::{parse_msh, GmshElementKind, GmshMesh};
 use crate::mesh::segmental::{Joint, JointFace};
 use crate::model::Element;
+use crate::model::QuadKind;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -53,7 +53,7 @@ pub fn build_gmsh(mesh: &MeshIn, ctx: &Ctx, region_names: &[&str]) -> R<GmshBuil
         ctx,
         "mesh.integration",
         mesh.integration.as_deref(),
-        crate::fem::shape::QuadKind::Q4,
+        crate::model::QuadKind::Q4,
     )?;
     for k in [
         "length",
@@ -163,7 +163,7 @@ fn map(
             if let Some(m) = degenerate(&coords, &el.nodes, size) {
                 return Err(ctx.err("mesh.file", format!("{file}: element {}: {m}", el.tag)));
             }
-            if integ == Integration::Incompatible && kind != crate::fem::shape::QuadKind::Q4 {
+            if integ == Integration::Incompatible && kind != crate::model::QuadKind::Q4 {
                 return Err(ctx.err("mesh.integration", format!("{file}: element {} is a {kind:?}: 'incompatible' (bending modes) is for Q4 elements only", el.tag)));
             }
             let detj = min_jacobian(kind, &coords, integ);

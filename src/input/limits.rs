@@ -122,8 +122,8 @@ pub fn check_size(
 
 /// Number of nodes of a structured grid of `nx` × `ny` quadrilaterals of `kind` (f64: the
 /// count is checked before anything is allocated).
-pub fn grid_nodes(kind: crate::fem::shape::QuadKind, nx: f64, ny: f64) -> f64 {
-    use crate::fem::shape::QuadKind;
+pub fn grid_nodes(kind: crate::model::QuadKind, nx: f64, ny: f64) -> f64 {
+    use crate::model::QuadKind;
     match kind {
         QuadKind::Q4 => (nx + 1.0) * (ny + 1.0),
         QuadKind::Q9 => (2.0 * nx + 1.0) * (2.0 * ny + 1.0),
@@ -134,7 +134,7 @@ pub fn grid_nodes(kind: crate::fem::shape::QuadKind, nx: f64, ny: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fem::shape::QuadKind;
+    use crate::model::QuadKind;
 
     fn ctx() -> Ctx {
         Ctx {

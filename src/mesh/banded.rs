@@ -2,7 +2,7 @@
 //! its own depth, thickness (through its region) and number of element rows — the
 //! plane-stress idealisation of I, T and box sections.
 
-use crate::fem::shape::QuadKind;
+use crate::model::QuadKind;
 
 /// One horizontal band, listed from the bottom up.
 #[derive(Debug, Clone, PartialEq)]

@@ -24,7 +24,8 @@
 //! Newton inverse mapping.
 
 use crate::elements::bar::BarPoint;
-use crate::fem::shape::{jacobian, line_shape, map_point, QuadKind};
+use crate::fem::shape::{jacobian, line_shape, map_point};
+use crate::model::QuadKind;
 use serde::{Deserialize, Serialize};
 
 /// Tolerance of the inside test in natural coordinates: a point is in an element when

@@ -12,7 +12,7 @@
 //! input never panics, and no allocation is sized by a count larger than the input itself.
 //! See `docs/gmsh.md`.
 
-use crate::fem::shape::QuadKind;
+use crate::model::QuadKind;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::Path;

@@ -3,7 +3,7 @@
 //! element-edge pairs between them.
 
 use super::banded::{generate, Band};
-use crate::fem::shape::QuadKind;
+use crate::model::QuadKind;
 
 /// One joint face pair: the nodes of the left segment's edge and the right segment's edge at
 /// the same height, both ordered bottom to top as (start, end, [mid]).

@@ -4,12 +4,12 @@
 use super::fields::{index_by_name, positive};
 use super::R;
 use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
-use crate::fem::shape::QuadKind;
 use crate::input::error::Ctx;
 use crate::input::schema::MeshIn;
 use crate::input::{gmsh_mesh, limits, locate};
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
+use crate::model::QuadKind;
 use crate::model::{Element, Model, Region};
 
 /// A generated or read mesh: nodes [m], elements, the joints between segments and the gmsh
