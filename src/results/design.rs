@@ -9,6 +9,7 @@ use crate::design::joint_section::{ContactPoint, JointSection, Piece};
 use crate::model::checks::{CheckKind, Code, DesignCheck};
 use crate::model::Model;
 use crate::results::fields::principal;
+use crate::results::strength::element_place;
 use serde::Serialize;
 
 /// The verdict of a check.
@@ -227,15 +228,6 @@ pub fn joint_section(sys: &System, j: usize) -> JointSection {
     JointSection::new(&pieces, &points)
 }
 
-fn place(model: &Model, e: usize) -> String {
-    let el = &model.elements[e];
-    let n = el.nodes.len() as f64;
-    let (x, y) = el.nodes.iter().fold((0.0, 0.0), |(x, y), &i| {
-        (x + model.nodes[i][0] / n, y + model.nodes[i][1] / n)
-    });
-    format!("element {} (x = {x:.2} m, y = {y:.2} m)", e + 1)
-}
-
 const MPA: f64 = 1e6;
 
 fn evaluate(
@@ -378,7 +370,7 @@ fn concrete_items(sys: &System, c: &DesignCheck) -> Items {
                 at: if worst.1 == usize::MAX {
                     String::new()
                 } else {
-                    place(model, worst.1)
+                    element_place(model, worst.1)
                 },
             }
         })

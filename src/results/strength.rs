@@ -310,7 +310,8 @@ impl StrengthWatch {
 
 /// "element 97 (region 'webs', x = 2.30 m, y = 0.50 m)": 1-based number, centroid of the
 /// element's nodes.
-fn element_place(model: &Model, e: usize) -> String {
+/// Where element `e` is, for messages: its number, region and centroid.
+pub(crate) fn element_place(model: &Model, e: usize) -> String {
     let el = &model.elements[e];
     let n = el.nodes.len() as f64;
     let (x, y) = el.nodes.iter().fold((0.0, 0.0), |(x, y), &i| {

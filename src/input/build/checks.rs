@@ -610,21 +610,19 @@ fn d_region_elements(model: &Model, step: usize) -> Vec<usize> {
     points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
     points.dedup();
     // Bounding boxes of the elements.
-    let boxes: Vec<([f64; 2], [f64; 2], [f64; 2])> = model
+    let boxes: Vec<([f64; 2], [f64; 2])> = model
         .elements
         .iter()
         .map(|el| {
             let mut lo = [f64::INFINITY; 2];
             let mut hi = [f64::NEG_INFINITY; 2];
-            let mut c = [0.0; 2];
             for &n in &el.nodes {
                 for k in 0..2 {
                     lo[k] = lo[k].min(model.nodes[n][k]);
                     hi[k] = hi[k].max(model.nodes[n][k]);
-                    c[k] += model.nodes[n][k] / el.nodes.len() as f64;
                 }
             }
-            (lo, hi, c)
+            (lo, hi)
         })
         .collect();
     // The member depth at x: the height of the elements spanning x.
