@@ -87,6 +87,34 @@ pub struct CreepState {
 /// Local iterations of the series equation before the increment is cut.
 const MAX_LOCAL: usize = 60;
 
+/// Changes of the crushed status between Newton iterates of the local series after which a
+/// point is held crushed for the rest of its solve.
+///
+/// Crushing is a jump of the concrete law's stress to zero at ε̄ = ε_cu. In series with the
+/// chain the local residual jumps with it, by (1/E'' − 1/E_c) D1⁻¹ σ_cu; where the chain is
+/// stiffer than E_c (a load increment on concrete older than 28 days: E'' = E_c(t) > E_c)
+/// the jump can straddle the root. The uncrushed law then asks for more strain than ε_cu
+/// (its Newton step crosses into crushing) and the crushed one, relieved of its stress,
+/// springs back below it (its step crosses out): the iterates bounce across the jump and no
+/// uncrushed state satisfies the series. Along the strain path the point reached ε_cu, so it
+/// is crushed: it carries no stress and the series becomes linear. Three crossings (in, out,
+/// in or out, in, out) by Newton steps are asked before the hold, so that a single overshoot
+/// into crushing that comes back to an uncrushed root is not taken for the jump.
+const CRUSH_CROSSINGS: usize = 3;
+
+/// Keep the crushed status of the accepted iterate `st` and, if crushed, its state (the base
+/// of a crushing hold, [`CRUSH_CROSSINGS`]).
+fn note_crushing(
+    st: &ConcreteState,
+    was_crushed: &mut bool,
+    crushed_trial: &mut Option<ConcreteState>,
+) {
+    *was_crushed = st.crushed;
+    if st.crushed {
+        *crushed_trial = Some(st.clone());
+    }
+}
+
 fn matvec(m: &[[f64; 3]; 3], v: &[f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| (0..3).map(|j| m[i][j] * v[j]).sum())
 }
@@ -205,11 +233,19 @@ pub fn update(
     let (mut st, mut s, mut d, mut g) = eval(&base, &x)?;
     let mut it = 0;
     let mut frozen = false;
+    // Crushing of the iterates: how often a Newton step changed it, and the last crushed
+    // trial state (see `CRUSH_CROSSINGS`).
+    let mut crush_changes = 0;
+    let mut was_crushed = st.crushed;
+    let mut crushed_trial = st.crushed.then(|| st.clone());
     while g.iter().any(|v| v.abs() > tol) {
         // Latching, as the global iterations do (point.rs): a crack formed or a plastic
         // route taken in an iterate is kept for the rest of the solve, and crack branches
         // are held once the iterates cycle; the law is then smooth in x.
-        let latched = crack_latch(p, &base, &st)
+        let latched = (crush_changes >= CRUSH_CROSSINGS && !base.crushed)
+            .then(|| crushed_trial.take())
+            .flatten()
+            .or_else(|| crack_latch(p, &base, &st))
             .or_else(|| plastic_latch(&base, &st))
             .or_else(|| {
                 (it >= 12 && !frozen).then(|| {
@@ -220,6 +256,7 @@ pub fn update(
         if let Some(b) = latched {
             base = b;
             (st, s, d, g) = eval(&base, &x)?;
+            note_crushing(&st, &mut was_crushed, &mut crushed_trial);
             continue;
         }
         if it == MAX_LOCAL {
@@ -256,6 +293,10 @@ pub fn update(
             if r_norm < g_norm || step < 1e-3 {
                 x = xt;
                 (st, s, d, g) = r;
+                if st.crushed != was_crushed {
+                    crush_changes += 1;
+                }
+                note_crushing(&st, &mut was_crushed, &mut crushed_trial);
                 break;
             }
             step *= 0.5;

@@ -887,6 +887,8 @@ fn crush_band_dissipates_gc_per_unit_band_area() {
     assert!((2.0 * p.fcm / d - s * p.ec / (1.0 - s)).abs() < 1e-6 * p.ec);
 }
 
+/// Creep in series with the law at a crushing point.
+mod creep;
 /// The IMPL-EX tension law within an increment.
 mod implex;
 /// Compression softening, rotating cracks and aggregate-interlock shear retention.
