@@ -19,7 +19,8 @@
 //!
 //!     G(x) = x + (1/E'' − 1/E_c) D1⁻¹ [F(ε_m,n + x) − σ_n] − (Δε − Δε'' − Δε_sh − Δε_nl) = 0,
 //!
-//! solved by Newton from the elastic value x0 = (E''/E_c)(Δε − Δε'' − Δε_sh − Δε_nl); the
+//! solved by Newton from the elastic value x0 = (E''/E_c)(Δε − Δε'' − Δε_sh − Δε_nl) (a point
+//! whose iterates bounce across the crushing jump is held crushed, `CRUSH_CROSSINGS`); the
 //! tangent of the point is dσ/dε = D_F (I + (1/E'' − 1/E_c) D1⁻¹ D_F)⁻¹. Where the law is
 //! elastic the first evaluation solves G = 0 and the point is the ageing chain of
 //! `elastic_creep` (σ = σ_n + E'' D1 (Δε − Δε'' − Δε_sh)).
@@ -241,7 +242,8 @@ pub fn update(
     while g.iter().any(|v| v.abs() > tol) {
         // Latching, as the global iterations do (point.rs): a crack formed or a plastic
         // route taken in an iterate is kept for the rest of the solve, and crack branches
-        // are held once the iterates cycle; the law is then smooth in x.
+        // are held once the iterates cycle; the law is then smooth in x. A point whose
+        // iterates keep crossing the crushing jump is held crushed (`CRUSH_CROSSINGS`).
         let latched = (crush_changes >= CRUSH_CROSSINGS && !base.crushed)
             .then(|| crushed_trial.take())
             .flatten()
