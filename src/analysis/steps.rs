@@ -327,11 +327,28 @@ impl increments::Stepper for LoadStepper<'_> {
                 }
             })
             .collect();
+        // Parts placed at the start of a load step: their out-of-balance force, found once
+        // an attempt stops short of the step's end (an attempt to the end needs none, so
+        // steps that converge at once are not touched), comes in over the step.
+        if target < 1.0 && self.step.kind == StepKind::Load && ctx.sys.stage_jump_pending() {
+            let f0 = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.start);
+            ctx.sys.set_thermal(&self.start);
+            ctx.sys.begin_time_increment(TimeContext::at(self.clock));
+            // A committed state that no longer assembles is left to the attempt to report.
+            let _ = ctx.sys.ramp_stage_jump(&f0);
+        }
         self.f_ext = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.lam);
         ctx.sys.set_thermal(&self.lam);
         // Reactions of supports removed at the start of the step, released over it.
         if let Some(st) = &ctx.sys.stages {
             st.add_release(&mut self.f_ext, target);
+        }
+        // The out-of-balance of parts placed at the start of the step, brought in over it.
+        let rest = 1.0 - target;
+        if rest > 0.0 {
+            for (f, j) in self.f_ext.iter_mut().zip(&ctx.sys.stage_jump) {
+                *f -= rest * j;
+            }
         }
         ctx.sys.begin_time_increment(match &step.time {
             Some(span) => TimeContext {

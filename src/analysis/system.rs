@@ -84,6 +84,15 @@ pub struct System<'m> {
     /// Construction stages: active elements, their reference displacements, held equations
     /// (None: the model has no stages).
     pub stages: Option<StageState>,
+    /// Out-of-balance force of the parts that started to act at the start of the current
+    /// step (all dofs, zero on held equations) [N]: the load step removes (1 − level) of it
+    /// from the external forces, so that the weight of newly placed segments and the
+    /// prestress of tendons stressed with them come in over the step's increments, which
+    /// the step can then cut (docs/theory-stages.md §2). Empty: nothing to ramp.
+    pub stage_jump: Vec<f64>,
+    /// The stage entered last placed elements (set by [`System::enter_stage`], taken by
+    /// [`System::ramp_stage_jump`]).
+    placed: bool,
     /// Element force vectors and matrices of one chunk, kept between assemblies (every
     /// element writes its own before use: a run of many small assemblies zeroed and
     /// reallocated them each time).
@@ -509,6 +518,8 @@ impl<'m> System<'m> {
             thermal,
             stages: (model.staging.is_staged() || model.staging.has_one_way())
                 .then(StageState::default),
+            stage_jump: Vec::new(),
+            placed: false,
             elem_buf: (Vec::new(), Vec::new()),
             elem_buf2: (Vec::new(), Vec::new()),
             last: LastAssembly {
@@ -1211,9 +1222,54 @@ impl<'m> System<'m> {
             None
         };
         let (model, u, eq) = (self.model, &self.u, &self.dofs.eq);
+        self.stage_jump.clear();
         if let Some(st) = self.stages.as_mut() {
+            let before = st.element_active.clone();
             st.enter(model, step, u, eq, reaction.as_deref());
+            self.placed = entered
+                && st
+                    .element_active
+                    .iter()
+                    .enumerate()
+                    .any(|(e, &a)| a && !before.get(e).copied().unwrap_or(false));
         }
+        Ok(())
+    }
+
+    /// Whether the stage entered last placed elements whose out-of-balance force
+    /// [`System::ramp_stage_jump`] has not yet computed.
+    pub fn stage_jump_pending(&self) -> bool {
+        self.placed
+    }
+
+    /// After [`System::enter_stage`] and [`System::stress_tendons`] of a step that placed
+    /// elements: the out-of-balance force `f_ext` (the external forces at the step's start,
+    /// all dofs [N]) plus the released reactions, less the internal forces at the committed
+    /// displacements, on the free equations — the jump the new parts bring (see
+    /// [`System::stage_jump`]).
+    pub fn ramp_stage_jump(&mut self, f_ext: &[f64]) -> Result<(), (usize, UpdateError)> {
+        self.stage_jump.clear();
+        if !std::mem::take(&mut self.placed) {
+            return Ok(());
+        }
+        self.last.valid = false;
+        let u = self.u.clone();
+        let a = self.assemble(&u, false);
+        self.families.revert();
+        let f_int = a?.f_int;
+        let st = self.stages.as_ref().expect("placing needs stages");
+        let mut jump: Vec<f64> = f_ext
+            .iter()
+            .zip(&st.release)
+            .zip(&f_int)
+            .map(|((e, r), i)| e + r - i)
+            .collect();
+        for (d, &q) in self.dofs.eq.iter().enumerate() {
+            if q == CONSTRAINED || st.held[q] {
+                jump[d] = 0.0;
+            }
+        }
+        self.stage_jump = jump;
         Ok(())
     }
 }

@@ -317,7 +317,12 @@ fn joints(
             return Err(ctx.err(format!("{key}.a"), format!("no edge of '{}' faces the edge of '{}' at {p:?}: the joint has no opposite face there (faces must coincide, node for node)", pair.a, pair.b)));
         }
         let x = faces.first().map(|f| nodes[f.a[0]][0]).unwrap_or(0.0);
-        out.push(Joint { left: j, x, faces });
+        out.push(Joint {
+            left: j,
+            x,
+            faces,
+            cast: false,
+        });
     }
     Ok(out)
 }

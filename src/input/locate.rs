@@ -84,6 +84,33 @@ pub type EdgePart = (Vec<usize>, [f64; 2]);
 /// nodes (start, end, [mid]) with the overlapped range of the edge's natural coordinate, and
 /// the total overlapped length [m]. Each geometric edge is taken once.
 pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> (Vec<EdgePart>, f64) {
+    edges_on_segment_of(model, a, b, |_| true)
+}
+
+/// As [`edges_on_segment`], keeping only the edges of elements on the `into` side of the
+/// segment (their centroid beyond it along the unit vector `into`): a plate bears on the
+/// concrete behind it, not on the segment across a joint whose face lies on the same line.
+pub fn edges_on_segment_into(
+    model: &Model,
+    a: [f64; 2],
+    b: [f64; 2],
+    into: [f64; 2],
+) -> (Vec<EdgePart>, f64) {
+    edges_on_segment_of(model, a, b, |e| {
+        let n = e.nodes.len() as f64;
+        let (cx, cy) = e.nodes.iter().fold((0.0, 0.0), |(x, y), &k| {
+            (x + model.nodes[k][0] / n, y + model.nodes[k][1] / n)
+        });
+        (cx - a[0]) * into[0] + (cy - a[1]) * into[1] > 0.0
+    })
+}
+
+fn edges_on_segment_of(
+    model: &Model,
+    a: [f64; 2],
+    b: [f64; 2],
+    keep: impl Fn(&crate::model::Element) -> bool,
+) -> (Vec<EdgePart>, f64) {
     let tol = 1e-6 * model_size(model);
     let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
     let len = (ex * ex + ey * ey).sqrt();
@@ -95,7 +122,7 @@ pub fn edges_on_segment(model: &Model, a: [f64; 2], b: [f64; 2]) -> (Vec<EdgePar
     }
     let param = |p: [f64; 2]| ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len; // [m] along a→b
     let off_line = |p: [f64; 2]| ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex).abs() / len;
-    for e in &model.elements {
+    for e in model.elements.iter().filter(|e| keep(e)) {
         for k in 0..4 {
             let local = e.kind.edge_nodes(k);
             let nodes: Vec<usize> = local.iter().map(|&l| e.nodes[l]).collect();

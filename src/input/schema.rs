@@ -97,6 +97,13 @@ pub struct MeshIn {
     pub n_segments: Option<usize>,
     pub nx_per_segment: Option<usize>,
     pub joint_material: Option<String>,
+    #[serde(default)]
+    pub cast_joints: Vec<String>,
+    #[serde(default)]
+    pub soffit: Vec<[f64; 2]>,
+    pub soffit_band: Option<String>,
+    #[serde(default)]
+    pub camber: Vec<[f64; 2]>,
     // gmsh
     pub file: Option<String>,
     #[serde(default)]
@@ -187,7 +194,7 @@ pub struct SupportIn {
     pub name: String,
     pub node: Option<i64>,
     pub point: Option<[f64; 2]>,
-    pub line: Option<[[f64; 2]; 2]>,
+    pub line: Option<Vec<[f64; 2]>>,
     pub group: Option<String>,
     pub ux: Option<f64>,
     pub uy: Option<f64>,

@@ -26,6 +26,9 @@ pub struct Joint {
     pub x: f64,
     /// Facing edge pairs, bottom to top.
     pub faces: Vec<JointFace>,
+    /// Cast in place (a wet joint): the two faces share their nodes and no contact element
+    /// is made; the joint keeps its place in the numbering (J1, J2, … stay the same).
+    pub cast: bool,
 }
 
 /// A generated segmental mesh.
@@ -96,6 +99,7 @@ pub fn generate_segments(
                 left: s - 1,
                 x,
                 faces,
+                cast: false,
             });
         }
         prev_right = Some(
@@ -113,6 +117,98 @@ pub fn generate_segments(
         x += len;
     }
     out
+}
+
+/// Cast the joints `wet` (0-based indices into `mesh.joints`) in place: the right face's
+/// nodes are replaced by the left face's, the nodes left unused are dropped and the rest
+/// renumbered in their order. The joints stay in the list, marked `cast`.
+pub fn cast_joints(mesh: &mut SegmentalMesh, wet: &[usize]) {
+    let mut map: Vec<usize> = (0..mesh.nodes.len()).collect();
+    for &j in wet {
+        let joint = &mut mesh.joints[j];
+        joint.cast = true;
+        for f in &joint.faces {
+            for (&a, &b) in f.a.iter().zip(&f.b) {
+                map[b] = a;
+            }
+        }
+    }
+    // Follow chains (a node merged into one that is itself merged) to their end.
+    for i in 0..map.len() {
+        let mut k = map[i];
+        while map[k] != k {
+            k = map[k];
+        }
+        map[i] = k;
+    }
+    let mut new_id = vec![usize::MAX; mesh.nodes.len()];
+    let mut nodes = Vec::new();
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        if map[i] == i {
+            new_id[i] = nodes.len();
+            nodes.push(*p);
+        }
+    }
+    let renumber = |n: usize| new_id[map[n]];
+    for (el, _, _) in &mut mesh.elements {
+        el.iter_mut().for_each(|n| *n = renumber(*n));
+    }
+    for j in &mut mesh.joints {
+        for f in &mut j.faces {
+            f.a.iter_mut().for_each(|n| *n = renumber(*n));
+            f.b.iter_mut().for_each(|n| *n = renumber(*n));
+        }
+    }
+    mesh.nodes = nodes;
+}
+
+/// Lower the soffit to `soffit(x)` [m] (at or below `y0`, the soffit the bands were
+/// stacked from): the bands below band `stretch` move down with it, band `stretch` takes
+/// the extra depth (its nodes spread linearly between its top, which stays, and its new
+/// bottom), the bands above stay. This is how a haunched box deepens its webs towards
+/// the piers while its deck stays level.
+pub fn lower_soffit(
+    mesh: &mut SegmentalMesh,
+    y0: f64,
+    bands: &[Band],
+    stretch: usize,
+    soffit: impl Fn(f64) -> f64,
+) {
+    let bottom = y0 + bands[..stretch].iter().map(|b| b.depth).sum::<f64>();
+    let top = bottom + bands[stretch].depth;
+    // Round-off only: band boundaries are sums of the same depths as the nodes' ordinates.
+    let tol = 1e-9 * (top - y0).max(1.0);
+    for p in &mut mesh.nodes {
+        let drop = y0 - soffit(p[0]);
+        if p[1] <= bottom + tol {
+            p[1] -= drop;
+        } else if p[1] < top - tol {
+            p[1] = top - (top - p[1]) * (top - bottom + drop) / (top - bottom);
+        }
+    }
+}
+
+/// Raise every node by `camber(x)` [m]: the casting curve, the level each section is set
+/// at so that the girder reaches its design profile once it has deflected.
+pub fn raise(mesh: &mut SegmentalMesh, camber: impl Fn(f64) -> f64) {
+    for p in &mut mesh.nodes {
+        p[1] += camber(p[0]);
+    }
+}
+
+/// The piecewise-linear function through `points` (x increasing), constant beyond its ends.
+pub fn piecewise_linear(points: &[[f64; 2]]) -> impl Fn(f64) -> f64 + '_ {
+    move |x| {
+        let i = points.partition_point(|p| p[0] < x);
+        if i == 0 {
+            points[0][1]
+        } else if i == points.len() {
+            points[i - 1][1]
+        } else {
+            let (a, b) = (points[i - 1], points[i]);
+            a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0])
+        }
+    }
 }
 
 #[cfg(test)]

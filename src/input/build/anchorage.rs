@@ -94,8 +94,9 @@ pub fn plate_line(model: &Model, node: usize, axis: [f64; 2]) -> Option<[f64; 2]
 }
 
 /// Spread over a plate of length `length` [m] centred on `node`, lying along the element
-/// edge through the node most nearly perpendicular to `axis` (unit): the consistent nodal
-/// forces of a uniform pressure on the part of the plate on element edges, per unit force.
+/// edge through the node most nearly perpendicular to `axis` (unit, the way the plate
+/// pushes the concrete): the consistent nodal forces of a uniform pressure on the part of
+/// the plate on edges of the elements it pushes into, per unit force.
 pub fn spread(model: &Model, node: usize, axis: [f64; 2], length: f64) -> Spread {
     let Some(t) = plate_line(model, node, axis) else {
         return Spread {
@@ -107,7 +108,9 @@ pub fn spread(model: &Model, node: usize, axis: [f64; 2], length: f64) -> Spread
     let h = 0.5 * length;
     let a = [c[0] - h * t[0], c[1] - h * t[1]];
     let b = [c[0] + h * t[0], c[1] + h * t[1]];
-    let (edges, covered) = locate::edges_on_segment(model, a, b);
+    // Only the concrete the plate pushes into (+axis): at a joint face, the edges of the
+    // segment across the joint lie on the same line.
+    let (edges, covered) = locate::edges_on_segment_into(model, a, b, axis);
     if edges.is_empty() || covered <= 0.0 {
         return Spread {
             weights: vec![(node, 1.0)],

@@ -89,7 +89,7 @@ pub(super) fn locate_nodes(
     used: &[bool],
     node: Option<i64>,
     point: Option<[f64; 2]>,
-    line: Option<[[f64; 2]; 2]>,
+    line: Option<&[[f64; 2]]>,
 ) -> R<Vec<usize>> {
     let given = node.is_some() as u8 + point.is_some() as u8 + line.is_some() as u8;
     if given != 1 {
@@ -114,12 +114,30 @@ pub(super) fn locate_nodes(
         }
         return Ok(vec![locate::nearest_node(model, used, p)]);
     }
-    let [a, b] = line.expect("one location given");
-    let nodes = locate::nodes_on_segment(model, used, a, b);
-    if nodes.is_empty() {
+    let line = line.expect("one location given");
+    if line.len() < 2 {
         return Err(ctx.err(
             format!("{key}.line"),
-            format!("no node lies on the segment {a:?}–{b:?}"),
+            format!(
+                "give at least two points [[x, y], …] (got {}): a line or a polyline",
+                line.len()
+            ),
+        ));
+    }
+    let mut nodes: Vec<usize> = Vec::new();
+    for w in line.windows(2) {
+        for n in locate::nodes_on_segment(model, used, w[0], w[1]) {
+            if !nodes.contains(&n) {
+                nodes.push(n);
+            }
+        }
+    }
+    if nodes.is_empty() {
+        let pts: Vec<String> = line.iter().map(|p| format!("{p:?}")).collect();
+        let what = if line.len() == 2 { "segment" } else { "line" };
+        return Err(ctx.err(
+            format!("{key}.line"),
+            format!("no node lies on the {what} {}", pts.join("–")),
         ));
     }
     Ok(nodes)

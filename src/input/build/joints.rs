@@ -152,6 +152,11 @@ pub(super) fn add(
     )?;
     let spec = &materials[jm].1;
     for (ji, j) in joints.iter().enumerate() {
+        if j.cast {
+            // Cast in place: the faces share their nodes, no contact element.
+            continue;
+        }
+        let index = model.joints.len();
         let mut ids = Vec::new();
         for f in &j.faces {
             let region = &model.regions[f.region];
@@ -202,7 +207,7 @@ pub(super) fn add(
                 n_a: f.a.len(),
                 thickness: region.thickness,
                 params,
-                joint: ji,
+                joint: index,
             });
         }
         model.joints.push(Joint {

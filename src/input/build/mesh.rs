@@ -25,6 +25,18 @@ pub(super) struct Generated {
 pub(super) fn generate(ctx: &Ctx, mesh: &MeshIn, regions: &[Region]) -> R<Generated> {
     let region_names = || regions.iter().map(|r| r.name.as_str());
     let mut groups = gmsh_mesh::Groups::default();
+    if mesh.kind != "segmental" {
+        for (key, given) in [
+            ("cast_joints", !mesh.cast_joints.is_empty()),
+            ("soffit", !mesh.soffit.is_empty()),
+            ("soffit_band", mesh.soffit_band.is_some()),
+            ("camber", !mesh.camber.is_empty()),
+        ] {
+            if given {
+                return Err(ctx.err(format!("mesh.{key}"), "only for type = \"segmental\""));
+            }
+        }
+    }
     let (nodes, elements, joints) = if mesh.kind == "segmental" {
         build_segmental(mesh, ctx, &region_names)?
     } else if mesh.kind == "gmsh" {
@@ -359,7 +371,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         n_seg * nx as f64 * ny,
         limits::available_memory(),
     )?;
-    let g = segmental::generate_segments(
+    let mut g = segmental::generate_segments(
         origin[0],
         origin[1],
         &lengths,
@@ -367,6 +379,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         &bands,
         kind,
     );
+    shape_segmental(mesh, ctx, &bands, origin, &mut g)?;
     let elements = g
         .elements
         .into_iter()
@@ -383,6 +396,108 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         })
         .collect();
     Ok((g.nodes, elements, g.joints))
+}
+
+/// `cast_joints`, `soffit` (with `soffit_band`) and `camber` of a segmental mesh, applied to
+/// the generated segments in that order.
+fn shape_segmental(
+    mesh: &MeshIn,
+    ctx: &Ctx,
+    bands: &[Band],
+    origin: [f64; 2],
+    g: &mut segmental::SegmentalMesh,
+) -> R<()> {
+    let mut wet = Vec::new();
+    for (i, name) in mesh.cast_joints.iter().enumerate() {
+        let key = format!("mesh.cast_joints[{i}]");
+        let j = name
+            .strip_prefix('J')
+            .and_then(|n| n.parse::<usize>().ok())
+            .filter(|&n| n >= 1 && n <= g.joints.len())
+            .ok_or_else(|| {
+                ctx.err(
+                    &key,
+                    format!(
+                        "'{name}' is not a joint of this mesh (J1 … J{})",
+                        g.joints.len()
+                    ),
+                )
+            })?;
+        if wet.contains(&(j - 1)) {
+            return Err(ctx.err(key, format!("'{name}' is listed twice")));
+        }
+        wet.push(j - 1);
+    }
+    segmental::cast_joints(g, &wet);
+    let profile = |key: &str, points: &[[f64; 2]]| -> R<()> {
+        for (i, p) in points.iter().enumerate() {
+            if !(p[0].is_finite() && p[1].is_finite()) {
+                return Err(ctx.err(
+                    format!("mesh.{key}[{i}]"),
+                    "must be two finite numbers [x, y] (m)",
+                ));
+            }
+            if i > 0 && p[0] <= points[i - 1][0] {
+                return Err(ctx.err(
+                    format!("mesh.{key}[{i}]"),
+                    format!(
+                        "x must increase along the list (x = {} after {})",
+                        p[0],
+                        points[i - 1][0]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    };
+    match (mesh.soffit.is_empty(), &mesh.soffit_band) {
+        (true, None) => {}
+        (true, Some(_)) => {
+            return Err(ctx.err(
+                "mesh.soffit_band",
+                "only with mesh.soffit (the band that takes a lowered soffit's extra depth)",
+            ))
+        }
+        (false, None) => return Err(ctx.err(
+            "mesh.soffit_band",
+            "missing: name the band (its region) that deepens where mesh.soffit lowers the soffit",
+        )),
+        (false, Some(name)) => {
+            profile("soffit", &mesh.soffit)?;
+            let stretch = mesh
+                .bands
+                .iter()
+                .position(|b| &b.region == name)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = mesh.bands.iter().map(|b| b.region.as_str()).collect();
+                    ctx.err(
+                        "mesh.soffit_band",
+                        format!("no band of region '{name}' (bands: {})", names.join(", ")),
+                    )
+                })?;
+            if let Some(i) = mesh.soffit.iter().position(|p| p[1] > origin[1]) {
+                return Err(ctx.err(
+                    format!("mesh.soffit[{i}]"),
+                    format!(
+                        "the soffit can only be lowered: y = {} lies above the mesh's origin y = {}",
+                        mesh.soffit[i][1], origin[1]
+                    ),
+                ));
+            }
+            segmental::lower_soffit(
+                g,
+                origin[1],
+                bands,
+                stretch,
+                segmental::piecewise_linear(&mesh.soffit),
+            );
+        }
+    }
+    if !mesh.camber.is_empty() {
+        profile("camber", &mesh.camber)?;
+        segmental::raise(g, segmental::piecewise_linear(&mesh.camber));
+    }
+    Ok(())
 }
 
 /// Degenerate elements of a generated mesh: tiny lengths or depths next to large ones give

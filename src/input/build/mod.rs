@@ -136,7 +136,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
     regions::check_ages(ctx, &model, start, placed, w)?;
     tendons::assign_steps(ctx, &file.tendons, &external_of, &mut model)?;
     loads::thermal_coefficients(ctx, &file, &mut model)?;
-    stages::check_tendons(ctx, &model)?;
+    stages::check_tendons(ctx, &mut model)?;
     controls::solver(ctx, file.solver.as_ref(), &mut model)?;
     checks::build(ctx, &file.checks, &mut model)?;
     // Last, once stages and thermal coefficients are known (the zones' region copies

@@ -199,6 +199,29 @@ pub(crate) fn alive_nodes(model: &Model, step: usize) -> Vec<bool> {
     alive
 }
 
+/// A tendon point on a joint lies on two coincident nodes, one of each face; the nearest
+/// node found first may belong to a segment placed later than the tendon is stressed (a
+/// cantilever tendon anchored at the tip face of the pair just placed). Tie such a point
+/// to the coincident node of the part that is active when the tendon is stressed.
+fn tie_to_active_faces(model: &mut Model) {
+    // Coincident: the faces' nodes are generated from the same abscissae (round-off only).
+    let tol = 1e-9 * crate::input::locate::model_size(model);
+    let same = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() <= tol && (a[1] - b[1]).abs() <= tol;
+    for t in 0..model.tendons.len() {
+        let alive = alive_nodes(model, model.tendons[t].stressed_in_step);
+        for j in 0..model.tendons[t].nodes.len() {
+            let n = model.tendons[t].nodes[j];
+            if alive[n] {
+                continue;
+            }
+            let p = model.nodes[n];
+            if let Some(m) = (0..model.nodes.len()).find(|&m| alive[m] && same(model.nodes[m], p)) {
+                model.tendons[t].nodes[j] = m;
+            }
+        }
+    }
+}
+
 /// Analysis time [d] at the start of step `step`: the end of the last time step before it,
 /// else the start of the first time step (the default start day without time steps).
 pub(super) fn clock_at(model: &Model, step: usize) -> f64 {
@@ -213,10 +236,12 @@ pub(super) fn clock_at(model: &Model, step: usize) -> f64 {
 /// Checks that need the tendons' steps: an external tendon is anchored and deviated on
 /// nodes of active parts from its stressing on, a bonded post-tensioned tendon runs through
 /// active elements when stressed.
-pub(super) fn check_tendons(ctx: &Ctx, model: &Model) -> R<()> {
+pub(super) fn check_tendons(ctx: &Ctx, model: &mut Model) -> R<()> {
     if !model.staging.is_staged() {
         return Ok(());
     }
+    tie_to_active_faces(model);
+    let model = &*model;
     for (t, tendon) in model.tendons.iter().enumerate() {
         for k in tendon.stressed_in_step..model.steps.len() {
             let alive = alive_nodes(model, k);

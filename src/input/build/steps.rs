@@ -236,7 +236,15 @@ pub(super) fn control_dof(
     model: &Model,
     used: &[bool],
 ) -> R<(Vec<usize>, Dir, f64)> {
-    let nodes = locate_nodes(ctx, key, model, used, c.node, c.point, c.line)?;
+    let nodes = locate_nodes(
+        ctx,
+        key,
+        model,
+        used,
+        c.node,
+        c.point,
+        c.line.as_ref().map(|l| &l[..]),
+    )?;
     let d = dir(ctx, &format!("{key}.component"), c.component.as_deref())?;
     if !c.value.is_finite() {
         return Err(ctx.err(format!("{key}.value"), "must be a finite number [m]"));

@@ -51,7 +51,7 @@ pub(super) fn build(
                     )
                 })?
             }
-            None => locate_nodes(ctx, &key, model, used, s.node, s.point, s.line)?,
+            None => locate_nodes(ctx, &key, model, used, s.node, s.point, s.line.as_deref())?,
         };
         let mut dofs = Vec::new();
         for n in nodes {

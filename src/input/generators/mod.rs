@@ -6,6 +6,7 @@
 //! the validation finds in a generated entry is reported against the generator's section,
 //! naming the generated part; an error in one of the user's entries keeps the user's index.
 
+pub mod cantilever;
 pub mod viaduct;
 
 use super::error::{Ctx, InputError};
@@ -15,15 +16,15 @@ use super::schema::File;
 #[derive(Debug, Default, Clone)]
 pub struct Generated {
     /// Section that generated them (`"viaduct"`), empty when nothing was generated.
-    section: &'static str,
+    pub(super) section: &'static str,
     /// Per list (`"supports"`, `"steps"`, …): the names of the generated entries, in
     /// front of the user's.
-    lists: Vec<(&'static str, Vec<String>)>,
+    pub(super) lists: Vec<(&'static str, Vec<String>)>,
     /// Lists only the generator writes (`"regions"`: the bands, split per segment when
     /// the mesh is built, so their final number is not known here).
-    owned: Vec<&'static str>,
+    pub(super) owned: Vec<&'static str>,
     /// The generator wrote `[mesh]`.
-    mesh: bool,
+    pub(super) mesh: bool,
 }
 
 /// Expand every generator section of `file` into its ordinary tables.

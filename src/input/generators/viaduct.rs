@@ -40,10 +40,16 @@ pub struct ViaductIn {
     pub element: Option<String>,
     pub integration: Option<String>,
     pub nx_per_segment: usize,
+    #[serde(default)]
     pub cast_start: Vec<f64>,
-    pub cast_interval: f64,
+    pub cast_interval: Option<f64>,
     pub erection_start: Option<f64>,
-    pub span_interval: f64,
+    pub span_interval: Option<f64>,
+    pub segment_age: Option<f64>,
+    pub cantilever: Option<super::cantilever::CantileverIn>,
+    pub closure_tendons: Option<super::cantilever::ClosureTendonsIn>,
+    #[serde(default)]
+    pub camber: Vec<[f64; 2]>,
     pub strike_increments: Option<usize>,
     pub strand: Option<String>,
     pub span_tendons: Option<SpanTendonsIn>,
@@ -142,46 +148,43 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     let k = |f: &str| format!("viaduct.{f}");
     match v.sequence.as_str() {
         "span_by_span" => {}
+        "balanced_cantilever" => return super::cantilever::expand(v, file, ctx),
         o => {
             return Err(ctx.err(
                 k("sequence"),
-                format!("unknown erection sequence '{o}' (expected span_by_span)"),
+                format!(
+                    "unknown erection sequence '{o}' (expected span_by_span or balanced_cantilever)"
+                ),
             ))
         }
     }
-    if file.mesh.is_some() {
-        return Err(ctx.err(
-            "mesh",
-            "[viaduct] generates the mesh: leave out the [mesh] table",
-        ));
+    for (key, given) in [
+        ("segment_age", v.segment_age.is_some()),
+        ("cantilever", v.cantilever.is_some()),
+        ("closure_tendons", v.closure_tendons.is_some()),
+        ("camber", !v.camber.is_empty()),
+    ] {
+        if given {
+            return Err(ctx.err(k(key), "only with sequence = \"balanced_cantilever\""));
+        }
     }
-    if !file.regions.is_empty() {
-        return Err(ctx.err(
-            "regions",
-            "[viaduct] generates the regions from viaduct.section: leave out [[regions]]",
-        ));
-    }
+    let span_interval = v.span_interval.ok_or_else(|| {
+        ctx.err(
+            k("span_interval"),
+            "missing: days between the erection of successive spans",
+        )
+    })?;
+    let cast_interval = v.cast_interval.ok_or_else(|| {
+        ctx.err(
+            k("cast_interval"),
+            "missing: days between the castings of a span's segments",
+        )
+    })?;
+    no_generated_mesh(file, ctx)?;
     let layout = layout(v, ctx)?;
     node_columns(v, ctx)?;
     let depth = section(v, ctx)?;
-    let materials: Vec<&str> = file.materials.iter().map(|m| m.name.as_str()).collect();
-    for (key, name) in std::iter::once(("concrete".to_string(), &v.concrete)).chain(
-        v.section.iter().enumerate().filter_map(|(i, b)| {
-            b.material
-                .as_ref()
-                .map(|m| (format!("section[{i}].material"), m))
-        }),
-    ) {
-        if !materials.contains(&name.as_str()) {
-            return Err(ctx.err(
-                k(&key),
-                format!(
-                    "no [[materials]] entry named '{name}' (defined: {})",
-                    materials.join(", ")
-                ),
-            ));
-        }
-    }
+    check_materials(v, file, ctx)?;
     let n = v.spans.len();
     let finite = |key: &str, x: f64| -> R<f64> {
         if x.is_finite() {
@@ -204,20 +207,17 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     for (i, d) in v.cast_start.iter().enumerate() {
         finite(&format!("cast_start[{i}]"), *d)?;
     }
-    if !(v.cast_interval.is_finite() && v.cast_interval >= 0.0) {
+    if !(cast_interval.is_finite() && cast_interval >= 0.0) {
         return Err(ctx.err(
             k("cast_interval"),
-            format!(
-                "must be zero or positive [days between castings] (got {})",
-                v.cast_interval
-            ),
+            format!("must be zero or positive [days between castings] (got {cast_interval})"),
         ));
     }
     let start = finite("erection_start", v.erection_start.unwrap_or(0.0))?;
-    if !(v.span_interval.is_finite() && v.span_interval > 0.0) {
+    if !(span_interval.is_finite() && span_interval > 0.0) {
         return Err(ctx.err(
             k("span_interval"),
-            format!("must be positive [days per span] (got {})", v.span_interval),
+            format!("must be positive [days per span] (got {span_interval})"),
         ));
     }
     let strike = v.strike_increments.unwrap_or(STRIKE_INCREMENTS);
@@ -225,6 +225,39 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
         return Err(ctx.err(k("strike_increments"), "must be at least 1"));
     }
 
+    let cast_days = cast_days(
+        ctx,
+        &layout,
+        &v.cast_start,
+        cast_interval,
+        start,
+        span_interval,
+    )?;
+    let mut generated = generated_regions(v, file);
+    file.mesh = Some(mesh_in(v, &layout.lengths, layout.x0, cast_days));
+    let steps = erection_steps(v, &layout, start, strike, span_interval);
+    let supports = hold_down(v, supports(&layout), ctx)?;
+    let tendons = tendons(v, &layout, depth, file, ctx)?;
+    let lists = Lists {
+        supports,
+        tendons,
+        load_cases: vec![self_weight()],
+        steps,
+    };
+    attach(ctx, &mut generated, file, lists)?;
+    Ok(generated)
+}
+
+/// The generated entries of the model's lists, put in front of the user's by [`attach`].
+pub(super) struct Lists {
+    pub supports: Vec<SupportIn>,
+    pub tendons: Vec<TendonIn>,
+    pub load_cases: Vec<LoadCaseIn>,
+    pub steps: Vec<StepIn>,
+}
+
+/// One region per band of the section (the generator owns `[[regions]]`).
+pub(super) fn generated_regions(v: &ViaductIn, file: &mut File) -> Generated {
     let mut generated = Generated {
         section: "viaduct",
         lists: Vec::new(),
@@ -246,12 +279,16 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
         .lists
         .push(("regions", names(&regions, |r| &r.name)));
     file.regions = regions;
+    generated
+}
 
-    let cast_days = cast_days(ctx, &layout, &v.cast_start, v.cast_interval, start, v)?;
-    file.mesh = Some(MeshIn {
+/// The segmental `[mesh]` of the girder: segments of `lengths` [m] from `x0`, the section's
+/// bands, one casting day per segment.
+pub(super) fn mesh_in(v: &ViaductIn, lengths: &[f64], x0: f64, cast_days: Vec<f64>) -> MeshIn {
+    MeshIn {
         kind: "segmental".into(),
         length: None,
-        origin: Some([layout.x0, 0.0]),
+        origin: Some([x0, 0.0]),
         nx: None,
         element: v.element.clone(),
         integration: v.integration.clone(),
@@ -264,19 +301,24 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
                 rows: b.rows,
             })
             .collect(),
-        segments: Some(layout.lengths.clone()),
+        segments: Some(lengths.to_vec()),
         n_segments: None,
         nx_per_segment: Some(v.nx_per_segment),
         joint_material: Some(v.joint_material.clone()),
+        cast_joints: Vec::new(),
+        soffit: Vec::new(),
+        soffit_band: None,
+        camber: Vec::new(),
         file: None,
         joints: Vec::new(),
         segment_cast_days: Some(cast_days),
         nodes: Vec::new(),
         blocks: Vec::new(),
-    });
+    }
+}
 
-    let steps = erection_steps(v, &layout, start, strike);
-    let supports = supports(&layout);
+/// Make the supports named in `hold_down` two-way (an error for a name not generated).
+pub(super) fn hold_down(v: &ViaductIn, supports: Vec<SupportIn>, ctx: &Ctx) -> R<Vec<SupportIn>> {
     for (i, name) in v.hold_down.iter().enumerate() {
         if !supports.iter().any(|s| &s.name == name) {
             let names: Vec<&str> = supports.iter().map(|s| s.name.as_str()).collect();
@@ -289,7 +331,7 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
             ));
         }
     }
-    let supports = supports
+    Ok(supports
         .into_iter()
         .map(|mut s| {
             if v.hold_down.contains(&s.name) {
@@ -297,43 +339,90 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
             }
             s
         })
-        .collect();
-    let tendons = tendons(v, &layout, depth, file, ctx)?;
-    let self_weight = LoadCaseIn {
+        .collect())
+}
+
+/// The generated `self_weight` load case (gravity [`GRAVITY`] downwards).
+pub(super) fn self_weight() -> LoadCaseIn {
+    LoadCaseIn {
         name: "self_weight".into(),
         gravity: Some([0.0, -GRAVITY]),
         point_loads: Vec::new(),
         line_loads: Vec::new(),
         temperature: None,
-    };
+    }
+}
+
+/// Put the generated lists in front of the user's.
+pub(super) fn attach(ctx: &Ctx, generated: &mut Generated, file: &mut File, l: Lists) -> R<()> {
     prepend(
         ctx,
-        &mut generated,
+        generated,
         "supports",
         &mut file.supports,
-        supports,
+        l.supports,
         |s| &s.name,
     )?;
     prepend(
         ctx,
-        &mut generated,
+        generated,
         "tendons",
         &mut file.tendons,
-        tendons,
+        l.tendons,
         |t| &t.name,
     )?;
     prepend(
         ctx,
-        &mut generated,
+        generated,
         "load_cases",
         &mut file.load_cases,
-        vec![self_weight],
+        l.load_cases,
         |c| &c.name,
     )?;
-    prepend(ctx, &mut generated, "steps", &mut file.steps, steps, |s| {
+    prepend(ctx, generated, "steps", &mut file.steps, l.steps, |s| {
         &s.name
-    })?;
-    Ok(generated)
+    })
+}
+
+/// `concrete` and every band's `material` name a `[[materials]]` entry.
+pub(super) fn check_materials(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<()> {
+    let k = |f: &str| format!("viaduct.{f}");
+    let materials: Vec<&str> = file.materials.iter().map(|m| m.name.as_str()).collect();
+    for (key, name) in std::iter::once(("concrete".to_string(), &v.concrete)).chain(
+        v.section.iter().enumerate().filter_map(|(i, b)| {
+            b.material
+                .as_ref()
+                .map(|m| (format!("section[{i}].material"), m))
+        }),
+    ) {
+        if !materials.contains(&name.as_str()) {
+            return Err(ctx.err(
+                k(&key),
+                format!(
+                    "no [[materials]] entry named '{name}' (defined: {})",
+                    materials.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `[mesh]` and `[[regions]]` are the generator's.
+pub(super) fn no_generated_mesh(file: &File, ctx: &Ctx) -> R<()> {
+    if file.mesh.is_some() {
+        return Err(ctx.err(
+            "mesh",
+            "[viaduct] generates the mesh: leave out the [mesh] table",
+        ));
+    }
+    if !file.regions.is_empty() {
+        return Err(ctx.err(
+            "regions",
+            "[viaduct] generates the regions from viaduct.section: leave out [[regions]]",
+        ));
+    }
+    Ok(())
 }
 
 /// The casting day of every segment: span by span from its first segment's, `interval`
@@ -344,7 +433,7 @@ fn cast_days(
     first: &[f64],
     interval: f64,
     start: f64,
-    v: &ViaductIn,
+    span_interval: f64,
 ) -> R<Vec<f64>> {
     let mut days = vec![0.0; layout.lengths.len()];
     for (g, group) in layout.groups.iter().enumerate() {
@@ -352,7 +441,7 @@ fn cast_days(
             days[s] = first[g] + j as f64 * interval;
         }
         let last = days[group[group.len() - 1]];
-        let placed = start + g as f64 * v.span_interval;
+        let placed = start + g as f64 * span_interval;
         if last > placed {
             return Err(ctx.err(
                 format!("viaduct.cast_start[{g}]"),
@@ -368,13 +457,13 @@ fn cast_days(
 }
 
 /// The names of `items`.
-fn names<T>(items: &[T], name: impl Fn(&T) -> &String) -> Vec<String> {
+pub(super) fn names<T>(items: &[T], name: impl Fn(&T) -> &String) -> Vec<String> {
     items.iter().map(|t| name(t).clone()).collect()
 }
 
 /// Put the generated `new` entries in front of the user's `list`, refusing a user's entry
 /// that takes a generated name.
-fn prepend<T>(
+pub(super) fn prepend<T>(
     ctx: &Ctx,
     generated: &mut Generated,
     list_name: &'static str,
@@ -488,7 +577,7 @@ fn layout(v: &ViaductIn, ctx: &Ctx) -> R<Layout> {
 /// support between columns would be moved to the nearest node without a word from the
 /// generator's user, who never wrote the point): node columns are `nx_per_segment` per
 /// segment for Q4, with the mid-side nodes twice as many for Q8 and Q9.
-fn node_columns(v: &ViaductIn, ctx: &Ctx) -> R<()> {
+pub(super) fn node_columns(v: &ViaductIn, ctx: &Ctx) -> R<()> {
     let nx = v.nx_per_segment;
     if nx == 0 {
         return Err(ctx.err("viaduct.nx_per_segment", "must be at least 1"));
@@ -518,7 +607,7 @@ fn node_columns(v: &ViaductIn, ctx: &Ctx) -> R<()> {
 }
 
 /// Check the section bands; their total depth [m].
-fn section(v: &ViaductIn, ctx: &Ctx) -> R<f64> {
+pub(super) fn section(v: &ViaductIn, ctx: &Ctx) -> R<f64> {
     if v.section.is_empty() {
         return Err(ctx.err(
             "viaduct.section",
@@ -585,7 +674,7 @@ fn supports(layout: &Layout) -> Vec<SupportIn> {
         list.push(support(
             format!("falsework {}", i + 1),
             None,
-            Some([[b[i] + gap, 0.0], [b[i + 1] - gap, 0.0]]),
+            Some(vec![[b[i] + gap, 0.0], [b[i + 1] - gap, 0.0]]),
             None,
         ));
     }
@@ -593,7 +682,7 @@ fn supports(layout: &Layout) -> Vec<SupportIn> {
 }
 
 /// The name of bearing `i` of `n` spans: A1, P1 … P(n−1), A2.
-fn bearing_name(i: usize, n: usize) -> String {
+pub(super) fn bearing_name(i: usize, n: usize) -> String {
     if i == 0 {
         "A1".into()
     } else if i == n {
@@ -610,7 +699,13 @@ fn place_step(k: usize) -> String {
 
 /// Per span: place its segments on their falsework (with the far bearing, from span 2 on)
 /// and stress its tendons; strike the falsework; let it creep until the next span.
-fn erection_steps(v: &ViaductIn, layout: &Layout, start: f64, strike: usize) -> Vec<StepIn> {
+fn erection_steps(
+    v: &ViaductIn,
+    layout: &Layout,
+    start: f64,
+    strike: usize,
+    span_interval: f64,
+) -> Vec<StepIn> {
     let n = v.spans.len();
     let sw = || BTreeMap::from([("self_weight".to_string(), 1.0)]);
     let mut steps = Vec::new();
@@ -631,14 +726,14 @@ fn erection_steps(v: &ViaductIn, layout: &Layout, start: f64, strike: usize) -> 
         steps.push(strike_step);
         let mut creep = step(format!("span {} creeps", i + 1), "time");
         creep.from = (i == 0).then_some(start);
-        creep.to = Some(start + (i + 1) as f64 * v.span_interval);
+        creep.to = Some(start + (i + 1) as f64 * span_interval);
         steps.push(creep);
     }
     steps
 }
 
 /// A step with every optional key left out.
-fn step(name: String, kind: &str) -> StepIn {
+pub(super) fn step(name: String, kind: &str) -> StepIn {
     StepIn {
         name,
         kind: kind.into(),
@@ -663,7 +758,7 @@ fn step(name: String, kind: &str) -> StepIn {
 }
 
 /// The strand's E_p, f_ptk [Pa] and ε_uk from the `[[materials]]` entry `viaduct.strand`.
-fn strand(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<(f64, f64, Option<f64>)> {
+pub(super) fn strand(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<(f64, f64, Option<f64>)> {
     let name = v.strand.as_deref().ok_or_else(|| {
         ctx.err(
             "viaduct.strand",
@@ -706,7 +801,7 @@ fn strand(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<(f64, f64, Option<f64>)> {
 }
 
 /// A tendon of the strand with every optional key left out.
-fn tendon(
+pub(super) fn tendon(
     name: String,
     points: Vec<[f64; 2]>,
     area: f64,

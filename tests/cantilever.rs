@@ -1,0 +1,274 @@
+//! Balanced-cantilever erection by the `[viaduct]` generator (issue 39 item 2;
+//! docs/theory-stages.md §6b): the cantilevers carry their segments, travellers and
+//! tendons as statics says at every stage before closure; the closures make the girder
+//! continuous; a casting curve taken from one run closes the deck's profile in a rerun.
+//! Run with `cargo nextest run --release --test cantilever`.
+
+mod common;
+
+use common::TempDir;
+use segfem::run::{run_file_opts, RunOptions};
+use std::path::Path;
+
+/// Section bands bottom up: (out-of-plane width [m], depth [m], element rows).
+const BANDS: [(f64, f64, usize); 3] = [(6.5, 0.30, 1), (0.90, 1.95, 4), (12.0, 0.25, 1)];
+/// Concrete density [kg/m³] and the generator's gravity [m/s²].
+const RHO: f64 = 2500.0;
+const G: f64 = 9.81;
+/// Segment, pier segment, closure, end segment [m]; overhang [m]; pairs per pier.
+const SEG: f64 = 3.5;
+const PIER: f64 = 6.0;
+const CLOSURE: f64 = 3.0;
+const PAIRS: usize = 3;
+/// Traveller weight [N]; cantilever tendon area [m²] and height [m].
+const TRAVELLER: f64 = 300e3;
+const AREA: f64 = 0.002;
+const HEIGHT: f64 = 2.375;
+
+/// A 18 + 30 + 18 m girder of constant depth, three pairs per pier (side spans: the end
+/// segment and the closure only). `extra` is appended (monitors, steps).
+fn model(extra: &str) -> String {
+    let section: Vec<String> = BANDS
+        .iter()
+        .zip(["bottom", "webs", "deck"])
+        .map(|((w, d, r), n)| format!("{{ name = \"{n}\", width = {w}, depth = {d}, rows = {r} }}"))
+        .collect();
+    format!(
+        r#"
+title = "balanced cantilever, three pairs"
+
+[[materials]]
+name = "concrete"
+kind = "elastic_creep"
+fcm = 48e6
+rh = 0.70
+h0 = 0.30
+cement = "N"
+nu = 0.2
+density = {RHO}
+n_units = 5
+
+[[materials]]
+name = "strand"
+kind = "prestressing_steel"
+Ep = 195e9
+fptk = 1860e6
+
+[[joint_materials]]
+name = "dry"
+kind = "keyed"
+
+[viaduct]
+sequence = "balanced_cantilever"
+spans = [18.0, 30.0, 18.0]
+segment_length = {SEG}
+pier_segment = {PIER}
+end_segment = 2.0
+overhang = 0.5
+concrete = "concrete"
+joint_material = "dry"
+strand = "strand"
+nx_per_segment = 2
+segment_age = 60.0
+section = [{section}]
+
+[viaduct.cantilever]
+pairs = [{PAIRS}, {PAIRS}]
+closure = {CLOSURE}
+pair_interval = 7.0
+traveller = {TRAVELLER}
+tendons = {{ area = {AREA}, height = {HEIGHT}, jacking_stress = 1200e6, wobble = 0.0 }}
+{extra}
+"#,
+        section = section.join(", ")
+    )
+}
+
+/// history.csv as its header and rows of numbers.
+fn history(out: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+fn col(header: &[String], name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name || h.starts_with(&format!("{name} [")))
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+fn run(tmp: &TempDir, name: &str, text: &str) -> std::path::PathBuf {
+    let path = tmp.join(&format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let out = tmp.join(name);
+    run_file_opts(Some(&path), &out, &mut |_| {}, &RunOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    out
+}
+
+/// Height [m] of the resultant of a cantilever tendon's anchor force: the documented
+/// default plate (docs/input.md, `anchor_plate`: 0.085 √n m for n = ⌈A / 140 mm²⌉ strands)
+/// centred on the anchor, a uniform pressure over the part of it on the member (the deck's
+/// top at the section's depth cuts it).
+fn anchor_height() -> f64 {
+    let strands = (AREA / 140e-6).ceil();
+    let plate = 0.085 * strands.sqrt();
+    let depth: f64 = BANDS.iter().map(|b| b.1).sum();
+    let (lo, hi) = (
+        (HEIGHT - plate / 2.0).max(0.0),
+        (HEIGHT + plate / 2.0).min(depth),
+    );
+    (lo + hi) / 2.0
+}
+
+/// Gauss points of a 3 × 3 rule on [−1, 1]: abscissae and weights.
+const GAUSS: [(f64, f64); 3] = [
+    (-0.774_596_669_241_483_4, 5.0 / 9.0),
+    (0.0, 8.0 / 9.0),
+    (0.774_596_669_241_483_4, 5.0 / 9.0),
+];
+
+/// Every Gauss point of the section's rows at abscissa x: (y [m], weight × width [m²]).
+fn section_points() -> Vec<(f64, f64)> {
+    let mut pts = Vec::new();
+    let mut y0 = 0.0;
+    for (w, d, rows) in BANDS {
+        let h = d / rows as f64;
+        for r in 0..rows {
+            let yc = y0 + (r as f64 + 0.5) * h;
+            for (eta, wt) in GAUSS {
+                pts.push((yc + eta * h / 2.0, wt * h / 2.0 * w));
+            }
+        }
+        y0 += d;
+    }
+    pts
+}
+
+/// The cantilevers of P1 at every stage from the first pair to the closure, cut through
+/// the middle of the right arm's second segment (5.25 m from the pier segment's face, clear
+/// of the pier segment's disturbance): the section forces integrated from the Gauss-point
+/// stresses there (3 × 3 rule over each element row, exact for the Q8's polynomial field
+/// through the depth) against the statics of everything outboard — the segments' weight
+/// ρ g A per metre, the traveller one node column in from the tip, and the cantilever
+/// tendons anchored outboard at their monitored forces:
+///   N = −Σ P_j,  M = w L²/2 + W (x_T − x_s) − Σ P_j (y_t − y_c),  V = w L + W
+/// (M = ∫σx (y − y_c) dA, positive with the deck in tension), and the fixity's vertical
+/// reactions against the weight of the whole T. The tendons' anchor forces act at the
+/// centre of their default plates ([`anchor_height`]). The cantilever is statically
+/// determinate, so creep between pairs changes only the tendon forces, which the statics
+/// reads from the monitors. Tolerances: N 0.2 % of the prestress (measured 0.05 %); M 2 % of
+/// the moment scale w L²/2 + W L and V 3 % (measured 1.3 % and 0.3 % for M, 0.8 % and
+/// 2.4 % for V with two and three pairs): the section is a Gauss column 0.875 m from a dry
+/// joint, whose keyed contact passes the shear at its Lobatto points, between the
+/// traveller's point load and the anchors; Gauss-point stresses of 1.75 m Q8 elements there
+/// are not pointwise in equilibrium. The fixity's reactions are global equilibrium: 1e-6
+/// (the solver's tolerance).
+#[test]
+fn cantilever_section_forces_follow_statics_at_every_stage() {
+    let tmp = TempDir::new("cantilever-statics");
+    let xp = 18.0; // P1
+    let face = xp + PIER / 2.0;
+    let x_s = face + SEG + SEG / 4.0; // centre of the second segment's first element
+    let pts = section_points();
+    let mut extra = String::new();
+    for (i, (y, _)) in pts.iter().enumerate() {
+        for c in ["sx", "txy"] {
+            extra += &format!(
+                "\n[[monitors]]\nname = \"{c}{i}\"\nkind = \"stress\"\ncomponent = \"{c}\"\npoint = [{x_s}, {y}]\n"
+            );
+        }
+    }
+    for j in 1..=PAIRS {
+        extra += &format!(
+            "\n[[monitors]]\nname = \"P{j}\"\nkind = \"tendon_force\"\ntendon = \"P1-{j}\"\n"
+        );
+    }
+    for side in ["left", "right"] {
+        extra += &format!(
+            "\n[[monitors]]\nname = \"R{side}\"\nkind = \"reaction\"\nsupport = \"fixity P1 {side}\"\ncomponent = \"y\"\n"
+        );
+    }
+    let out = run(&tmp, "bc", &model(&extra));
+    let (h, rows) = history(&out);
+    let stages = std::fs::read_to_string(out.join("stages.csv")).unwrap();
+
+    let area: f64 = BANDS.iter().map(|(w, d, _)| w * d).sum();
+    let mut y0 = 0.0;
+    let mut first_moment = 0.0;
+    for (w, d, _) in BANDS {
+        first_moment += w * d * (y0 + d / 2.0);
+        y0 += d;
+    }
+    let yc = first_moment / area;
+    let w = RHO * G * area;
+    let spacing = SEG / 4.0; // node columns of a Q8 segment with nx_per_segment = 2
+    let mut checked = 0;
+    for line in stages.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (name, last) = (f[1], f[5].parse::<usize>().unwrap());
+        let pairs = if let Some(j) = name.strip_prefix("place pair ") {
+            j.parse::<usize>().unwrap()
+        } else if let Some(j) = name.strip_prefix("cantilevers creep ") {
+            j.parse::<usize>().unwrap() - 1
+        } else if name == "closures harden" {
+            PAIRS
+        } else {
+            continue;
+        };
+        if pairs < 2 {
+            continue; // the section is in the second pair
+        }
+        let r = &rows[last - 1];
+        let (mut n, mut m, mut v) = (0.0, 0.0, 0.0);
+        for (i, (y, wa)) in pts.iter().enumerate() {
+            let sx = r[col(&h, &format!("sx{i}"))];
+            n += wa * sx;
+            m += wa * sx * (y - yc);
+            v += wa * r[col(&h, &format!("txy{i}"))];
+        }
+        let tip = face + pairs as f64 * SEG;
+        let l = tip - x_s;
+        let x_t = tip - spacing;
+        let forces: Vec<f64> = (2..=pairs).map(|j| r[col(&h, &format!("P{j}"))]).collect();
+        let p: f64 = forces.iter().sum();
+        let n_ref = -p;
+        let m_ref = w * l * l / 2.0 + TRAVELLER * (x_t - x_s) - p * (anchor_height() - yc);
+        let v_ref = w * l + TRAVELLER;
+        let scale = w * l * l / 2.0 + TRAVELLER * l;
+        assert!(
+            (n - n_ref).abs() <= 2e-3 * p,
+            "{name}: N = {n:.1} N against −ΣP = {n_ref:.1} N"
+        );
+        assert!(
+            (m - m_ref).abs() <= 2e-2 * scale,
+            "{name}: M = {m:.1} N·m against statics {m_ref:.1} N·m (scale {scale:.1})"
+        );
+        // τxy on the cut face of the outboard part carries its load upwards: V = −∫τ dA
+        // with the outward normal −x.
+        assert!(
+            (-v - v_ref).abs() <= 3e-2 * v_ref,
+            "{name}: V = {:.1} N against w L + W = {v_ref:.1} N",
+            -v
+        );
+        let reaction = r[col(&h, "Rleft")] + r[col(&h, "Rright")];
+        let weight = w * (PIER + 2.0 * pairs as f64 * SEG) + 2.0 * TRAVELLER;
+        assert!(
+            (reaction - weight).abs() <= 1e-6 * weight,
+            "{name}: fixity reactions {reaction:.1} N against the T's weight {weight:.1} N"
+        );
+        checked += 1;
+    }
+    // Pairs 2 and 3 placed, the two creep periods between and after them, the closures'
+    // hardening.
+    assert_eq!(checked, 4, "stages checked");
+}
