@@ -5,6 +5,7 @@ pub mod checks;
 pub mod element_data;
 pub mod influence;
 pub mod stages;
+pub mod thermal;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
@@ -12,6 +13,7 @@ pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, Qua
 pub use influence::{Combination, Influence, Placement};
 use serde::Serialize;
 pub use stages::{Lifetime, Push, Staging};
+pub use thermal::ThermalAction;
 
 /// A continuum element.
 #[derive(Debug, Clone, Serialize)]
@@ -111,7 +113,7 @@ pub struct LoadCase {
     /// Gravity acceleration [m/s²] applied to all regions' density, if any.
     pub gravity: Option<[f64; 2]>,
     /// Temperature field of a thermal load case: imposed strains, no forces (None: none).
-    pub thermal: Option<crate::elements::thermal::ThermalAction>,
+    pub thermal: Option<ThermalAction>,
 }
 
 /// What a monitor records.

@@ -6,7 +6,7 @@
 
 use super::system::System;
 use crate::elements::continuum::rule_points;
-use crate::elements::thermal::ThermalAction;
+use crate::model::ThermalAction;
 use crate::model::Model;
 use crate::model::QuadKind;
 
