@@ -4,7 +4,7 @@
 //! pivots, points that changed state in that attempt). Everything in it is already at hand
 //! when Newton gives up, so building it costs one pass over the states.
 
-use super::solver::SolverError;
+use crate::linalg::solver::SolverError;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::materials::point::UpdateError;

@@ -5,7 +5,7 @@
 //! displacements plus the solution. Nothing is committed: the state after is the state
 //! before.
 
-use super::solver::SparseCholesky;
+use crate::linalg::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::materials::point::TimeContext;

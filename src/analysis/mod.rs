@@ -1,4 +1,5 @@
-//! Analysis: steps, the Newton loop, and the linear-solver wrapper.
+//! Analysis: state, assembly, the Newton loop and the step drivers (the linear algebra they
+//! call is [`crate::linalg`]).
 
 pub mod bonded_time;
 mod driver;
@@ -9,11 +10,8 @@ pub mod influence;
 pub mod loads;
 mod newton;
 pub mod one_way;
-pub mod ordering;
 pub mod path;
 mod responses;
-pub mod solver;
-mod split;
 pub mod staged;
 pub mod stages;
 pub mod state;

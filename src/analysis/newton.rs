@@ -5,7 +5,7 @@
 
 use super::driver::Timings;
 use super::failure::NewtonFailure;
-use super::solver::SparseCholesky;
+use crate::linalg::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::StepKind;

@@ -10,7 +10,7 @@ use super::increments::{
     Verdict,
 };
 use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
-use super::solver::SparseCholesky;
+use crate::linalg::solver::SparseCholesky;
 use super::system::{Assembled, System};
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::{ArcLengthControl, PathControl, Predictor, Step, StepKind};

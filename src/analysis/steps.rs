@@ -10,7 +10,7 @@ use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{self, external_forces, Controller, Growth, PairNorm};
 use super::loads::load_vector;
 use super::newton::newton;
-use super::solver::{SolverError, SparseCholesky};
+use crate::linalg::solver::{SolverError, SparseCholesky};
 use super::state::DriverState;
 use super::system::System;
 use crate::materials::point::TimeContext;

@@ -663,7 +663,7 @@ pub struct BareRow {
     /// Floating-point operations of one numeric LLᵀ after segfem's ordering.
     pub own_factor_flops: f64,
     /// Whether segfem's ordering factorises the LLᵀ by halves on two threads (large systems
-    /// ordered by nested dissection, [`segfem::analysis::solver::SPLIT_MIN_EQUATIONS`]).
+    /// ordered by nested dissection, [`segfem::linalg::solver::SPLIT_MIN_EQUATIONS`]).
     pub own_split: bool,
     /// Medians of [`BARE_ROUNDS`] numeric LLᵀ (and solves of one right-hand side) after
     /// segfem's ordering, the whole matrix on one core and by halves, alternated [s] (both
@@ -682,7 +682,7 @@ const BARE_ROUNDS: usize = 5;
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
 /// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
 pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
-    use segfem::analysis::solver::SparseCholesky;
+    use segfem::linalg::solver::SparseCholesky;
     use segfem::analysis::system::System;
     let model = segfem::input::load(path).map_err(|e| e.to_string())?.model;
     let mut sys = System::new(&model);

@@ -14,7 +14,7 @@ const SKIP: u32 = u32::MAX;
 #[derive(Debug, Clone)]
 pub struct Assembler {
     /// Lower-triangle pattern over the free equations (shared with the symbolic analysis
-    /// running on a thread of its own: [`crate::analysis::solver::SparseCholesky::in_background`]).
+    /// running on a thread of its own: [`crate::linalg::solver::SparseCholesky::in_background`]).
     pub pattern: std::sync::Arc<LowerPattern>,
     /// Node graph (compressed rows): the neighbours of node a, itself included, sorted, are
     /// `node_adj[node_ptr[a]..node_ptr[a + 1]]`. Kept for the fill-reducing ordering.

@@ -629,7 +629,7 @@ impl Half {
 
 #[cfg(test)]
 mod tests {
-    use crate::analysis::solver::SparseCholesky;
+    use crate::linalg::solver::SparseCholesky;
     use crate::analysis::system::System;
 
     /// The LLᵀ by halves against the whole matrix's on a model's stiffness: K x = K·1 and a

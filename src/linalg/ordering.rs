@@ -499,7 +499,7 @@ mod tests {
     /// (within 25 %): the reason to use it.
     #[test]
     fn factor_is_correct_and_as_sparse_as_amd() {
-        use crate::analysis::solver::{LowerPattern, SparseCholesky};
+        use crate::linalg::solver::{LowerPattern, SparseCholesky};
         let m = 60;
         let (ptr, adj, xy) = grid(m);
         // One equation per node here (take the x dofs): the 9-point Laplacian shifted to be
@@ -724,7 +724,7 @@ mod tests {
     /// along node coordinates, whose median lines cut through the elements (1,250,416).
     #[test]
     fn element_dissection_factor_vs_amd() {
-        use crate::analysis::solver::SparseCholesky;
+        use crate::linalg::solver::SparseCholesky;
         use crate::fem::assembly::Assembler;
         use crate::mesh::banded::{generate, Band};
         use crate::model::QuadKind;
