@@ -755,3 +755,17 @@ pub struct ArcLengthControl {
     /// Reference load factors per load case (the step's `loads`) [-].
     pub reference: Vec<f64>,
 }
+
+/// Length scale of the model (bounding-box diagonal) [m], for relative tolerances.
+pub fn model_size(model: &Model) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &model.nodes {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2))
+        .sqrt()
+        .max(f64::MIN_POSITIVE)
+}

@@ -198,7 +198,7 @@ pub(super) fn check(
     if st.one_way.points.is_empty() {
         return None;
     }
-    let size = crate::input::locate::model_size(ctx.sys.model);
+    let size = crate::model::model_size(ctx.sys.model);
     let which = st.one_way.switches(ctx.u, f_int, f_ext, size);
     if which.is_empty() || *rounds >= MAX_ROUNDS {
         if !which.is_empty() {

@@ -5,5 +5,6 @@
 //! coordinates and element node lists.
 
 pub mod ordering;
+pub mod pattern;
 pub mod solver;
 mod split;

@@ -210,7 +210,7 @@ impl Elements {
     /// The elements `elements` (node lists) of a mesh with nodes at `coords` [m], all in
     /// part 1.
     fn new(elements: &[Vec<usize>], coords: &[[f64; 2]]) -> Self {
-        let (inc_ptr, inc) = crate::fem::assembly::incidence(coords.len(), elements);
+        let (inc_ptr, inc) = super::pattern::incidence(coords.len(), elements);
         let centroid = elements
             .iter()
             .map(|el| {
