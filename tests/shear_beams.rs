@@ -10,9 +10,7 @@ mod beam_bench;
 #[allow(dead_code)]
 mod panel_bench;
 
-use beam_bench::{
-    options, read_beams, run_beam, Beam, PLATE_INCREMENT,
-};
+use beam_bench::{options, read_beams, run_beam, Beam, PLATE_INCREMENT};
 
 /// The beam `id` of validation/beams/beams.csv.
 fn beam(id: &str) -> Beam {

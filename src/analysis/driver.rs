@@ -4,9 +4,9 @@
 //! `note_limit_point`). The drivers point down to this module; it calls neither of them.
 
 use super::failure::FailureReport;
-use crate::linalg::solver::SolverStats;
 use super::state::{DriverState, SystemState};
 use super::system::System;
+use crate::linalg::solver::SolverStats;
 
 /// A converged increment, as observers see it.
 pub struct Snapshot<'a, 's> {

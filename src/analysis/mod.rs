@@ -2,6 +2,7 @@
 //! call is [`crate::linalg`]).
 
 pub mod bonded_time;
+mod context;
 mod driver;
 pub mod failure;
 pub mod families;
@@ -17,5 +18,6 @@ pub mod stages;
 pub mod state;
 pub mod steps;
 pub mod system;
+pub mod tendon_time;
 pub mod thermal;
 pub mod time;

@@ -682,8 +682,8 @@ const BARE_ROUNDS: usize = 5;
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
 /// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
 pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
-    use segfem::linalg::solver::SparseCholesky;
     use segfem::analysis::system::System;
+    use segfem::linalg::solver::SparseCholesky;
     let model = segfem::input::load(path).map_err(|e| e.to_string())?.model;
     let mut sys = System::new(&model);
     let u = vec![0.0; model.n_dofs()];

@@ -724,8 +724,8 @@ mod tests {
     /// along node coordinates, whose median lines cut through the elements (1,250,416).
     #[test]
     fn element_dissection_factor_vs_amd() {
-        use crate::linalg::solver::SparseCholesky;
         use crate::fem::assembly::Assembler;
+        use crate::linalg::solver::SparseCholesky;
         use crate::mesh::banded::{generate, Band};
         use crate::model::QuadKind;
         let n = 40;
