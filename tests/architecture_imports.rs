@@ -96,7 +96,6 @@ fn production_code(src: &str) -> (Vec<String>, Vec<String>) {
         let Some(item) = lines.get(i) else { break };
         let code = strip_comment(item).trim_end();
         if let Some(name) = code
-            .trim_start()
             .split_whitespace()
             .skip_while(|w| *w != "mod")
             .nth(1)
