@@ -13,6 +13,7 @@ pub mod design;
 pub mod elements;
 pub mod fem;
 pub mod input;
+pub mod linalg;
 pub mod materials;
 pub mod mesh;
 pub mod model;

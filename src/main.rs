@@ -44,9 +44,11 @@ fn stdout_failed(e: std::io::Error) -> ! {
 /// Large blocks on transparent huge pages (cli::hugepages: fewer page faults).
 /// Binary-side modules: the benchmark cases and the allocator (not part of the library).
 mod cli {
+    pub mod beam_bench;
     pub mod bench;
     pub mod bench_cmd;
     pub mod hugepages;
+    pub mod panel_bench;
 }
 use cli::bench_cmd::{
     bench, bench_bare, bench_beams, bench_material_point, bench_panels, bench_rc, bench_seed,
@@ -391,7 +393,7 @@ fn main() -> ExitCode {
                 "seed-failure-concrete" => bench_seed_failure(refine, true),
                 "panels" => bench_panels(model.as_deref()),
                 "beams" => {
-                    let mut set = segfem::materials::concrete::beam_bench::SeriesSettings {
+                    let mut set = cli::beam_bench::SeriesSettings {
                         options,
                         ..Default::default()
                     };

@@ -5,6 +5,7 @@ pub mod checks;
 pub mod element_data;
 pub mod influence;
 pub mod stages;
+pub mod thermal;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
@@ -12,6 +13,7 @@ pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, Qua
 pub use influence::{Combination, Influence, Placement};
 use serde::Serialize;
 pub use stages::{Lifetime, Push, Staging};
+pub use thermal::ThermalAction;
 
 /// A continuum element.
 #[derive(Debug, Clone, Serialize)]
@@ -111,7 +113,7 @@ pub struct LoadCase {
     /// Gravity acceleration [m/s²] applied to all regions' density, if any.
     pub gravity: Option<[f64; 2]>,
     /// Temperature field of a thermal load case: imposed strains, no forces (None: none).
-    pub thermal: Option<crate::elements::thermal::ThermalAction>,
+    pub thermal: Option<ThermalAction>,
 }
 
 /// What a monitor records.
@@ -752,4 +754,18 @@ pub struct ArcLengthControl {
     pub max_increments: usize,
     /// Reference load factors per load case (the step's `loads`) [-].
     pub reference: Vec<f64>,
+}
+
+/// Length scale of the model (bounding-box diagonal) [m], for relative tolerances.
+pub fn model_size(model: &Model) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &model.nodes {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2))
+        .sqrt()
+        .max(f64::MIN_POSITIVE)
 }

@@ -8,6 +8,14 @@
 #[allow(dead_code)]
 mod bench;
 
+/// The beam bench of the `segfem` binary and the panel bench whose CSV reader it shares.
+#[path = "../src/cli/beam_bench.rs"]
+#[allow(dead_code)]
+mod beam_bench;
+#[path = "../src/cli/panel_bench.rs"]
+#[allow(dead_code)]
+mod panel_bench;
+
 mod common;
 
 /// The bundled `seed-beam` example (MC90 concrete) refined `refine` × with its increments
@@ -214,7 +222,7 @@ fn summary_and_report_state_the_path_error_of_an_arc_length_run() {
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_shear_beam() {
-    use segfem::materials::concrete::beam_bench::{options, read_beams, run_beam_solver};
+    use crate::beam_bench::{options, read_beams, run_beam_solver};
     let var = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
     let id = var("SEGFEM_BEAM", "OA1");
     let rows: usize = var("SEGFEM_ROWS", "10").parse().unwrap();

@@ -2,7 +2,12 @@
 //! and of strut crushing with compression softening (docs/validation.md, "Membrane
 //! panels").
 
-use segfem::materials::concrete::panel_bench::{run_panel, Panel};
+/// The panel bench of the `segfem` binary (not part of the library).
+#[path = "../src/cli/panel_bench.rs"]
+#[allow(dead_code)]
+mod panel_bench;
+
+use panel_bench::{run_panel, Panel};
 
 fn panel(rho: [f64; 2], fcm: f64) -> Panel {
     Panel {
@@ -194,7 +199,7 @@ fn fixed_crack_on_the_unequal_panel_stalls_below_the_rotating_truss_a_known_devi
 /// must take part (the file, not a run, fixes that count).
 #[test]
 fn panel_series_change_detector() {
-    use segfem::materials::concrete::panel_bench::{mean_cov, options, read_panels};
+    use crate::panel_bench::{mean_cov, options, read_panels};
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/panels/panels.csv");
     let panels: Vec<Panel> = read_panels(&path)

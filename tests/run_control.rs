@@ -564,7 +564,7 @@ fn results_above_the_split_threshold_do_not_depend_on_the_thread_count() {
     // The system really is factorised by halves (ordered by dissection, with a top-level
     // split), not the whole-matrix way.
     {
-        use segfem::analysis::solver::SparseCholesky;
+        use segfem::linalg::solver::SparseCholesky;
         let model = segfem::input::parse(&text, "m.toml").unwrap().model;
         let sys = segfem::analysis::system::System::new(&model);
         let chol = SparseCholesky::with_ordering(&sys.asm.pattern, sys.ordering.as_deref());

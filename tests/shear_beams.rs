@@ -1,9 +1,16 @@
 //! Shear-critical beam OA1 of Vecchio & Shim (2004), no stirrups, through the engine
 //! (docs/validation.md, "Shear beams"; data and sources in validation/beams/).
 
-use segfem::materials::concrete::beam_bench::{
-    options, read_beams, run_beam, Beam, PLATE_INCREMENT,
-};
+/// The beam bench of the `segfem` binary (not part of the library) and the panel bench
+/// whose CSV reader it shares.
+#[path = "../src/cli/beam_bench.rs"]
+#[allow(dead_code)]
+mod beam_bench;
+#[path = "../src/cli/panel_bench.rs"]
+#[allow(dead_code)]
+mod panel_bench;
+
+use beam_bench::{options, read_beams, run_beam, Beam, PLATE_INCREMENT};
 
 /// The beam `id` of validation/beams/beams.csv.
 fn beam(id: &str) -> Beam {
@@ -243,7 +250,7 @@ fn b1_rankine_cut_off_reaches_the_measured_peak_by_crushing() {
 /// ρ_w = 0.148 %, s_y = 801 mm) s_45 = 79.6 mm. Tolerance 0.1 mm (the hand values' rounding).
 #[test]
 fn crack_spacing_of_the_beams_follows_mc90() {
-    use segfem::materials::concrete::beam_bench::crack_spacing;
+    use crate::beam_bench::crack_spacing;
     for (id, want) in [("OA1", 0.1203), ("B1", 0.0796)] {
         let s = crack_spacing(&beam(id));
         assert!((s - want).abs() < 1e-4, "{id}: s_rm = {s} m, hand {want} m");

@@ -1,6 +1,6 @@
 //! Relaxation and loss records of bonded tendons (post-tensioned once stressed,
 //! pre-tensioned from the start), one per tendon integration point: the bonded counterpart of
-//! the external tendons' [`super::time::TendonTime`] (docs/theory-prestress.md, "Losses and
+//! the external tendons' [`super::tendon_time::TendonTime`] (docs/theory-prestress.md, "Losses and
 //! relaxation of bonded tendons").
 //!
 //! Relaxation is a stress-free strain R per point, subtracted from the bond strain
@@ -17,74 +17,8 @@
 //! Units: days, Pa, strains dimensionless.
 
 use super::system::{BarPhase, System};
-use crate::materials::chain::SteelRelaxationChain;
+use super::tendon_time::BarPointTime;
 use crate::model::{Bar, LossPart};
-
-/// Time-dependent record of one bonded-tendon integration point.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BarPointTime {
-    /// Stress when the tendon was bonded or locked off (σ_0, the losses' origin) [Pa].
-    pub sigma_initial: f64,
-    /// Committed stress [Pa].
-    pub stress: f64,
-    /// Committed accumulated relaxation strain R [-].
-    pub relax_strain: f64,
-    /// R of the current (trial) increment [-].
-    pub relax_strain_trial: f64,
-    /// Committed total steel strain (bond strain + R) the chain has seen [-].
-    pub steel_strain: f64,
-    /// Relaxation chain (None: no `relaxation_class`, or σ_0 ≤ 0.5 f_ptk).
-    pub chain: Option<SteelRelaxationChain>,
-    /// Chain unit stresses [Pa] (empty without relaxation).
-    pub hidden: Vec<f64>,
-    /// Stress drop at constant strain of the current increment [Pa].
-    pub relax_drop: f64,
-    /// Loss from instantaneous increments (load steps) [Pa].
-    pub loss_elastic: f64,
-    /// Loss during time steps not due to relaxation (concrete creep and shrinkage) [Pa].
-    pub loss_creep: f64,
-    /// Loss by relaxation of the steel [Pa].
-    pub loss_relax: f64,
-}
-
-impl BarPointTime {
-    /// Record of a point bonded (or locked off) at stress `sigma0` [Pa].
-    fn new(bar: &Bar, sigma0: f64) -> Self {
-        let ep = bar.steel.es;
-        let chain = bar.relaxation.and_then(|(class, fptk)| {
-            SteelRelaxationChain::fit(class, sigma0 / fptk, ep)
-                .ok()
-                .filter(|c| c.n_units() > 1)
-        });
-        let hidden = chain
-            .as_ref()
-            .map(|c| c.fractions.iter().map(|a| a * sigma0).collect())
-            .unwrap_or_default();
-        Self {
-            sigma_initial: sigma0,
-            stress: sigma0,
-            relax_strain: 0.0,
-            relax_strain_trial: 0.0,
-            steel_strain: sigma0 / ep,
-            chain,
-            hidden,
-            relax_drop: 0.0,
-            loss_elastic: 0.0,
-            loss_creep: 0.0,
-            loss_relax: 0.0,
-        }
-    }
-
-    /// One part of the loss since σ_0 [Pa] (positive = loss).
-    pub fn loss(&self, part: LossPart) -> f64 {
-        match part {
-            LossPart::Total => self.loss_elastic + self.loss_creep + self.loss_relax,
-            LossPart::Elastic => self.loss_elastic,
-            LossPart::CreepShrinkage => self.loss_creep,
-            LossPart::Relaxation => self.loss_relax,
-        }
-    }
-}
 
 /// True for the bars that are tendons (post-tensioned, or pre-tensioned with an initial
 /// stress or a relaxation class): they get loss records.

@@ -4,9 +4,9 @@
 //! `note_limit_point`). The drivers point down to this module; it calls neither of them.
 
 use super::failure::FailureReport;
-use super::solver::SolverStats;
 use super::state::{DriverState, SystemState};
 use super::system::System;
+use crate::linalg::solver::SolverStats;
 
 /// A converged increment, as observers see it.
 pub struct Snapshot<'a, 's> {
@@ -83,7 +83,7 @@ pub trait Observer {
 }
 
 /// Work run beside the next factorisation (defined with the solver, which runs it).
-pub use super::solver::IdleWork;
+pub use crate::linalg::solver::IdleWork;
 
 /// The state at a step end, as observers see it (for checkpoints).
 pub struct StepEnd<'a, 's> {

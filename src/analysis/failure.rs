@@ -4,9 +4,9 @@
 //! pivots, points that changed state in that attempt). Everything in it is already at hand
 //! when Newton gives up, so building it costs one pass over the states.
 
-use super::solver::SolverError;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
+use crate::linalg::solver::SolverError;
 use crate::materials::point::UpdateError;
 use serde::{Deserialize, Serialize};
 use std::fmt;

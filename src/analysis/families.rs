@@ -10,9 +10,8 @@
 //! Not in the blocks: the model's topology (Gauss-point and bar-point offsets, element
 //! numbers), which `System::new` derives from the model.
 
-use super::bonded_time::BarPointTime;
 use super::staged::Staged;
-use super::time::TendonTime;
+use super::tendon_time::{BarPointTime, TendonTime};
 use crate::elements::continuum::GaussOutput;
 use crate::elements::interface::InterfacePointState;
 use crate::elements::tendon::TendonState;

@@ -7,9 +7,9 @@
 //! size is an arc length rather than a fraction of the step, uses the same cut, retry and
 //! force pieces ([`ArcSizing`], [`external_forces_along`]).
 
+use super::context::PathContext;
 use super::driver::{implex_retry, AnalysisError, Observer, Timings};
 use super::failure::NewtonFailure;
-use super::path::PathContext;
 use super::state::SystemState;
 
 /// Σ_c λ_c f_c over the `n_dofs` dofs [N]: the external forces of the load cases `cases`
@@ -484,10 +484,10 @@ pub(super) fn run(
         };
         // A one-way support lifted off or touched down: the same increment again, from
         // its start, with the new statuses.
-        if let Some(trial) = super::one_way::check(ctx, &f_int, stepper.external(), &mut rounds) {
+        if let Some(trial) = ctx.one_way_check(&f_int, stepper.external(), &mut rounds) {
             ctx.timings.iterations += iterations;
             stepper.discard(ctx);
-            super::one_way::resume(ctx, &trial);
+            ctx.one_way_resume(&trial);
             ctl.retry = true;
             continue;
         }

@@ -5,9 +5,9 @@
 //! displacements plus the solution. Nothing is committed: the state after is the state
 //! before.
 
-use super::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
+use crate::linalg::solver::SparseCholesky;
 use crate::materials::point::TimeContext;
 use crate::model::{Influence, Model, MonitorKind, Placement};
 use crate::traffic::{envelope, unfavourable_stretch};

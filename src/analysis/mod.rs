@@ -1,6 +1,8 @@
-//! Analysis: steps, the Newton loop, and the linear-solver wrapper.
+//! Analysis: state, assembly, the Newton loop and the step drivers (the linear algebra they
+//! call is [`crate::linalg`]).
 
 pub mod bonded_time;
+mod context;
 mod driver;
 pub mod failure;
 pub mod families;
@@ -9,15 +11,13 @@ pub mod influence;
 pub mod loads;
 mod newton;
 pub mod one_way;
-pub mod ordering;
 pub mod path;
 mod responses;
-pub mod solver;
-mod split;
 pub mod staged;
 pub mod stages;
 pub mod state;
 pub mod steps;
 pub mod system;
+pub mod tendon_time;
 pub mod thermal;
 pub mod time;

@@ -5,9 +5,9 @@
 
 use super::driver::Timings;
 use super::failure::NewtonFailure;
-use super::solver::SparseCholesky;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
+use crate::linalg::solver::SparseCholesky;
 use crate::model::StepKind;
 use std::time::Instant;
 

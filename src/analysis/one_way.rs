@@ -184,57 +184,6 @@ impl OneWay {
     }
 }
 
-/// After an attempt converged at `ctx.u` with internal forces `f_int` and external forces
-/// `f_ext` [N]: the trial statuses to solve it again with (one round more in `rounds`), or
-/// None when its statuses hold (or have chattered for [`MAX_ROUNDS`] rounds: then counted in
-/// `support_chatter` and kept). `rounds` is set back to 0 when None is returned.
-pub(super) fn check(
-    ctx: &mut super::path::PathContext,
-    f_int: &[f64],
-    f_ext: &[f64],
-    rounds: &mut usize,
-) -> Option<Vec<bool>> {
-    let st = ctx.sys.stages.as_ref()?;
-    if st.one_way.points.is_empty() {
-        return None;
-    }
-    let size = crate::input::locate::model_size(ctx.sys.model);
-    let which = st.one_way.switches(ctx.u, f_int, f_ext, size);
-    if which.is_empty() || *rounds >= MAX_ROUNDS {
-        if !which.is_empty() {
-            ctx.timings.support_chatter += 1;
-        }
-        *rounds = 0;
-        return None;
-    }
-    *rounds += 1;
-    ctx.timings.support_switches += 1;
-    let mut next = st.one_way.clone();
-    if ctx.sys.model.controls.verbose {
-        let off = which.iter().filter(|&&i| next.points[i].trial).count();
-        eprintln!(
-            "    one-way supports: {off} points lift off, {} touch down: the increment again (round {rounds})",
-            which.len() - off
-        );
-    }
-    next.switch(&which);
-    Some(next.points.iter().map(|p| p.trial).collect())
-}
-
-/// Start the attempt again (after its trial state was thrown away) with the trial
-/// statuses `trial`: the held equations follow them and the points touching down are put
-/// on their seats.
-pub(super) fn resume(ctx: &mut super::path::PathContext, trial: &[bool]) {
-    let Some(st) = ctx.sys.stages.as_mut() else {
-        return;
-    };
-    for (p, &t) in st.one_way.points.iter_mut().zip(trial) {
-        p.trial = t;
-    }
-    st.apply_contacts();
-    st.one_way.seat(ctx.u);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

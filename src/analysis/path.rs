@@ -3,48 +3,20 @@
 //! tangent may then be indefinite: it is factorised by LLᵀ with an LDLᵀ fallback that
 //! reports the number of negative pivots.
 
-use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot, Timings};
+use super::context::PathContext;
+use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{
     self, external_forces, external_forces_along, ArcSizing, Controller, Growth, Pair, PairNorm,
     Verdict,
 };
 use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
-use super::solver::SparseCholesky;
 use super::system::{Assembled, System};
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::{ArcLengthControl, PathControl, Predictor, Step, StepKind};
 use std::time::Instant;
 
-/// The analysis state a path-following step works on (owned by `steps::run`).
-pub(super) struct PathContext<'a, 's> {
-    /// The system.
-    pub sys: &'a mut System<'s>,
-    /// The linear solver.
-    pub solver: &'a mut SparseCholesky,
-    /// Load vectors of the load cases at factor 1 (all dofs) [N].
-    pub cases: &'a [Vec<f64>],
-    /// Current load-case factors (updated).
-    pub factors: &'a mut Vec<f64>,
-    /// Current displacements (all dofs) [m].
-    pub u: &'a mut Vec<f64>,
-    /// Timings and counters.
-    pub timings: &'a mut Timings,
-    /// Negative pivots at the last converged increment.
-    pub neg_pivots: &'a mut usize,
-}
-
 impl PathContext<'_, '_> {
-    /// Throw the trial state of an attempt away: the displacements back to the committed
-    /// ones and the iteration's crack holds released.
-    pub(super) fn back_to_committed(&mut self) {
-        self.u.copy_from_slice(&self.sys.u);
-        self.sys.unlatch();
-        if let Some(st) = self.sys.stages.as_mut() {
-            st.revert_contacts();
-        }
-    }
-
     /// Internal forces, tangent values and the element-force scale (the residual reference
     /// that stays finite under self-equilibrated loading) at displacements `u`.
     fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
@@ -731,10 +703,10 @@ fn arc_length_step(
                 // A one-way support lifted off or touched down: the same arc again, from
                 // its start, with the new statuses.
                 let f_try = external_forces_along(&f_base, &q_full, lambda + inc.d_lambda);
-                if let Some(trial) = super::one_way::check(ctx, &inc.f_int, &f_try, &mut rounds) {
+                if let Some(trial) = ctx.one_way_check(&inc.f_int, &f_try, &mut rounds) {
                     ctx.timings.iterations += inc.iterations;
                     ctx.back_to_committed();
-                    super::one_way::resume(ctx, &trial);
+                    ctx.one_way_resume(&trial);
                     continue;
                 }
                 let verdict = sizing.converged(ctx.u, &ctx.sys.u, lambda);

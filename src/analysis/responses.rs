@@ -4,7 +4,7 @@
 
 use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
-use crate::analysis::bonded_time::BarPointTime;
+use super::tendon_time::BarPointTime;
 use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
 use crate::elements::continuum::{
     gauss_geometry, rule_points, ContinuumElement, Formulation, GaussGeometry, GaussOutput,

@@ -12,7 +12,7 @@
 
 use super::one_way::OneWay;
 use crate::fem::dofs::CONSTRAINED;
-use crate::fem::pattern::LowerPattern;
+use crate::linalg::pattern::LowerPattern;
 use crate::model::Model;
 
 /// The stage the analysis is in and what it implies for the assembly. Saved in the

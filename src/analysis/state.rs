@@ -227,10 +227,10 @@ pub(crate) mod layout {
     //! saved type gains, loses or reorders a field.
 
     use super::*;
-    use crate::analysis::bonded_time::BarPointTime;
     use crate::analysis::families::*;
     use crate::analysis::staged::Staged;
-    use crate::analysis::time::{SpanTime, TendonTime};
+    use crate::analysis::tendon_time::BarPointTime;
+    use crate::analysis::tendon_time::{SpanTime, TendonTime};
     use crate::elements::continuum::GaussOutput;
     use crate::elements::interface::InterfacePointState;
     use crate::elements::tendon::{SpanState, TendonState};

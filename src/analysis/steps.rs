@@ -10,9 +10,9 @@ use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{self, external_forces, Controller, Growth, PairNorm};
 use super::loads::load_vector;
 use super::newton::newton;
-use super::solver::{SolverError, SparseCholesky};
 use super::state::DriverState;
 use super::system::System;
+use crate::linalg::solver::{SolverError, SparseCholesky};
 use crate::materials::point::TimeContext;
 use crate::model::{Model, Predictor, Step, StepKind, DEFAULT_START_DAY};
 use std::time::Instant;
@@ -116,14 +116,14 @@ pub fn run_with(
         sys.stress_tendons(si);
         // Thermal strains of the factors held at the start of the step (path steps keep
         // them; load steps set them again per increment).
-        sys.set_thermal(&factors);
+        sys.thermal.impose(&factors, &mut sys.tendons);
         // Every step starts as an instantaneous increment at the current clock: path steps
         // keep this context for all their increments (no creep, shrinkage or relaxation
         // while they run; their time is the clock), load steps set it again per increment,
         // and time steps replace it with their substeps.
         sys.begin_time_increment(TimeContext::at(clock));
         let mut reached_clock = clock;
-        let mut ctx = super::path::PathContext {
+        let mut ctx = super::context::PathContext {
             sys: &mut sys,
             solver: &mut solver,
             cases: &cases,
@@ -231,7 +231,7 @@ pub fn run_with(
 /// ([`increments::run`]). `reached_clock` follows the time of the last converged increment.
 #[allow(clippy::too_many_arguments)]
 fn load_step(
-    ctx: &mut super::path::PathContext,
+    ctx: &mut super::context::PathContext,
     si: usize,
     step: &Step,
     clock: f64,
@@ -307,7 +307,7 @@ struct LoadStepper<'a> {
 impl increments::Stepper for LoadStepper<'_> {
     fn attempt(
         &mut self,
-        ctx: &mut super::path::PathContext,
+        ctx: &mut super::context::PathContext,
         obs: &mut dyn Observer,
         ctl: &Controller,
         target: f64,
@@ -338,7 +338,7 @@ impl increments::Stepper for LoadStepper<'_> {
             let _ = ctx.sys.ramp_stage_jump(&f0);
         }
         self.f_ext = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.lam);
-        ctx.sys.set_thermal(&self.lam);
+        ctx.sys.thermal.impose(&self.lam, &mut ctx.sys.tendons);
         // Reactions of supports removed at the start of the step, released over it.
         if let Some(st) = &ctx.sys.stages {
             st.add_release(&mut self.f_ext, target);
@@ -390,7 +390,7 @@ impl increments::Stepper for LoadStepper<'_> {
         self.step.kind != StepKind::Linear
     }
 
-    fn discard(&mut self, ctx: &mut super::path::PathContext) {
+    fn discard(&mut self, ctx: &mut super::context::PathContext) {
         discard_trial(ctx);
     }
 
@@ -402,14 +402,14 @@ impl increments::Stepper for LoadStepper<'_> {
         self.reached_clock = mark;
     }
 
-    fn commit_half(&mut self, ctx: &mut super::path::PathContext) {
+    fn commit_half(&mut self, ctx: &mut super::context::PathContext) {
         ctx.sys.commit(ctx.u);
         self.reached_clock = ctx.sys.time.t_to;
     }
 
     fn accept(
         &mut self,
-        ctx: &mut super::path::PathContext,
+        ctx: &mut super::context::PathContext,
         obs: &mut dyn Observer,
         ctl: &Controller,
         f_int: Vec<f64>,
@@ -454,7 +454,7 @@ impl increments::Stepper for LoadStepper<'_> {
 
     fn failed(
         &mut self,
-        ctx: &mut super::path::PathContext,
+        ctx: &mut super::context::PathContext,
         ctl: &Controller,
         target: f64,
         failure: NewtonFailure,
@@ -489,7 +489,7 @@ impl increments::Stepper for LoadStepper<'_> {
 
 /// Throw the trial state of a failed (or probing) increment away: the displacements back to
 /// the committed ones, prescribed values kept, the iteration holds released.
-fn discard_trial(ctx: &mut super::path::PathContext) {
+fn discard_trial(ctx: &mut super::context::PathContext) {
     ctx.back_to_committed();
     for &(d, v) in &ctx.sys.dofs.prescribed {
         ctx.u[d] = v;

@@ -375,8 +375,8 @@ impl<'m> System<'m> {
                     .iter()
                     .all(|e| e.kind == crate::model::QuadKind::Q4);
                 let ordering = if all_q4 {
-                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS).then(|| {
-                        super::ordering::nested_dissection(
+                    (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS).then(|| {
+                        crate::linalg::ordering::nested_dissection(
                             &asm.node_ptr,
                             &asm.node_adj,
                             &model.nodes,
@@ -385,8 +385,8 @@ impl<'m> System<'m> {
                         )
                     })
                 } else {
-                    (dofs.n_eq >= super::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
-                        super::ordering::element_dissection(
+                    (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
+                        crate::linalg::ordering::element_dissection(
                             &asm.node_ptr,
                             &asm.node_adj,
                             &model.nodes,

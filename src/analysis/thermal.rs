@@ -4,11 +4,11 @@
 //! total strains (docs/theory.md, "Thermal actions"). Not material state: the strains follow
 //! from the factors alone, so a cut or a restart simply sets them again.
 
-use super::system::System;
 use crate::elements::continuum::rule_points;
-use crate::elements::thermal::ThermalAction;
+use crate::elements::tendon::ExternalTendon;
 use crate::model::Model;
 use crate::model::QuadKind;
+use crate::model::ThermalAction;
 
 /// Unit-factor imposed strains of one thermal load case.
 #[derive(Debug, Clone)]
@@ -140,17 +140,18 @@ fn unit_case(model: &Model, bar_gps: &[(usize, usize)], c: usize, th: &ThermalAc
     }
 }
 
-impl System<'_> {
+impl Thermal {
     /// Impose the thermal strains of the load-case `factors` (the factors an increment is
-    /// solved for): continuum points and bar points through the assembly, external tendons
-    /// through their span strains. Nothing without thermal load cases.
-    pub fn set_thermal(&mut self, factors: &[f64]) {
-        if !self.thermal.is_active() {
+    /// solved for): continuum points and bar points through the assembly (which reads
+    /// them from here), the external tendons `tendons` (`System::tendons`) through their
+    /// span strains. Nothing without thermal load cases.
+    pub fn impose(&mut self, factors: &[f64], tendons: &mut [Option<ExternalTendon>]) {
+        if !self.is_active() {
             return;
         }
-        self.thermal.set(factors);
-        for (t, el) in self.tendons.iter_mut().enumerate() {
-            if let (Some(el), Some(e)) = (el.as_mut(), self.thermal.tendons.get(t)) {
+        self.set(factors);
+        for (t, el) in tendons.iter_mut().enumerate() {
+            if let (Some(el), Some(e)) = (el.as_mut(), self.tendons.get(t)) {
                 el.set_thermal_strains(e);
             }
         }

@@ -14,65 +14,9 @@
 //! Units: days, Pa, strains dimensionless.
 
 use super::system::System;
+use super::tendon_time::{SpanTime, TendonTime};
 use crate::materials::chain::SteelRelaxationChain;
 use crate::materials::point::TimeContext;
-use crate::model::LossPart;
-
-/// Time-dependent record of one tendon span.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SpanTime {
-    /// Span stress just after stressing [Pa].
-    pub sigma_initial: f64,
-    /// Initial (prestress) strain at stressing, before relaxation [-].
-    pub eps0: f64,
-    /// Committed accumulated relaxation strain R [-].
-    pub relax_strain: f64,
-    /// R of the current (trial) increment [-].
-    pub relax_strain_trial: f64,
-    /// Committed total steel strain the chain has seen [-].
-    pub steel_strain: f64,
-    /// Chain unit stresses [Pa] (empty without relaxation).
-    pub hidden: Vec<f64>,
-    /// Stress drop at constant strain of the current increment [Pa].
-    pub relax_drop: f64,
-    /// Loss from instantaneous increments (load steps) [Pa].
-    pub loss_elastic: f64,
-    /// Loss during time steps not due to relaxation (concrete creep and shrinkage) [Pa].
-    pub loss_creep: f64,
-    /// Loss by relaxation of the steel [Pa].
-    pub loss_relax: f64,
-}
-
-/// Time-dependent record of one external tendon.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct TendonTime {
-    /// One entry per span.
-    pub spans: Vec<SpanTime>,
-    /// Relaxation chain per span (None: relaxation off or stress ≤ 0.5 f_ptk).
-    pub chains: Vec<Option<SteelRelaxationChain>>,
-    /// Reference span lengths [m] (weights of the mean loss).
-    pub lengths: Vec<f64>,
-}
-
-impl TendonTime {
-    /// Length-weighted mean over the spans of a loss part [Pa].
-    pub fn loss(&self, part: LossPart) -> f64 {
-        let lt: f64 = self.lengths.iter().sum();
-        self.spans
-            .iter()
-            .zip(&self.lengths)
-            .map(|(s, l)| {
-                l * match part {
-                    LossPart::Total => s.loss_elastic + s.loss_creep + s.loss_relax,
-                    LossPart::Elastic => s.loss_elastic,
-                    LossPart::CreepShrinkage => s.loss_creep,
-                    LossPart::Relaxation => s.loss_relax,
-                }
-            })
-            .sum::<f64>()
-            / lt
-    }
-}
 
 impl System<'_> {
     /// Start an increment over `time`: set the clock of the material points and impose the

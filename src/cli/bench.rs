@@ -663,7 +663,7 @@ pub struct BareRow {
     /// Floating-point operations of one numeric LLᵀ after segfem's ordering.
     pub own_factor_flops: f64,
     /// Whether segfem's ordering factorises the LLᵀ by halves on two threads (large systems
-    /// ordered by nested dissection, [`segfem::analysis::solver::SPLIT_MIN_EQUATIONS`]).
+    /// ordered by nested dissection, [`segfem::linalg::solver::SPLIT_MIN_EQUATIONS`]).
     pub own_split: bool,
     /// Medians of [`BARE_ROUNDS`] numeric LLᵀ (and solves of one right-hand side) after
     /// segfem's ordering, the whole matrix on one core and by halves, alternated [s] (both
@@ -682,8 +682,8 @@ const BARE_ROUNDS: usize = 5;
 /// Assemble the initial stiffness of the model in `path` and time faer's sequential
 /// Cholesky on it: AMD (faer's default) and segfem's own ordering, each symbolic + numeric.
 pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
-    use segfem::analysis::solver::SparseCholesky;
     use segfem::analysis::system::System;
+    use segfem::linalg::solver::SparseCholesky;
     let model = segfem::input::load(path).map_err(|e| e.to_string())?.model;
     let mut sys = System::new(&model);
     let u = vec![0.0; model.n_dofs()];
@@ -921,8 +921,61 @@ pub fn material_point_rates(n: usize) -> Vec<(String, f64)> {
         ),
     ]
     .into_iter()
-    .chain(segfem::materials::concrete::panel_bench::shear_model_rates(
-        rate,
-    ))
+    .chain(shear_model_rates(rate))
     .collect()
+}
+
+/// Material-point update rates of the shear options (for `segfem bench --case
+/// material-point`), measured by `rate` (updates/s of a closure of s ∈ [0, 1)): rotating cracks and fixed cracks with compression softening, from a point
+/// cracked at 4 ε0, at the fixed model's benchmark strains and at a compressed state
+/// (ε1 = 10 ε0, ε2 = −5 ε0) where the reduction is active.
+pub fn shear_model_rates(rate: impl Fn(&dyn Fn(f64) -> f64) -> f64) -> Vec<(String, f64)> {
+    use segfem::materials::concrete::{
+        update, CompressionReduction, ConcreteParams, ConcreteState, CrackModel,
+    };
+    use std::hint::black_box;
+    let fixed = ConcreteParams::from_mc90(38e6, 0.2);
+    let mut fixed_vc = fixed.clone();
+    fixed_vc.compression_reduction = CompressionReduction::VecchioCollins1993 {
+        beta_min: 0.4,
+        spacing: 0.0,
+    };
+    let mut rot = fixed.clone();
+    rot.crack_model = CrackModel::Rotating;
+    let mut rot_vc = fixed_vc.clone();
+    rot_vc.crack_model = CrackModel::Rotating;
+    let mut fixed_lim = fixed_vc.clone();
+    fixed_lim.crack_shear_limit =
+        segfem::materials::concrete::cracking::CrackShearLimit::VecchioCollins1986 { d_agg: 0.016 };
+    let e0 = fixed.eps0();
+    let crack = |p: &ConcreteParams| {
+        update(p, &ConcreteState::new(), &[4.0 * e0, 0.0, 0.0], 0.1)
+            .expect("cracking update")
+            .0
+    };
+    let run = |p: &ConcreteParams, c: &ConcreteState, comp: bool| {
+        rate(&|s| {
+            let e = if comp {
+                [(10.0 + s) * e0, -5.0 * e0, s * e0]
+            } else {
+                [(4.0 + s) * e0, -0.2 * e0, 0.5 * s * e0]
+            };
+            black_box(update(p, c, black_box(&e), 0.1).map_or(0.0, |r| r.1[0]))
+        })
+    };
+    let (cr, crv, cfv) = (crack(&rot), crack(&rot_vc), crack(&fixed_vc));
+    vec![
+        ("cracked (rotating)".into(), run(&rot, &cr, false)),
+        ("rotating, compressed".into(), run(&rot, &cr, true)),
+        ("rotating+VC93, compressed".into(), run(&rot_vc, &crv, true)),
+        (
+            "fixed, compressed".into(),
+            run(&fixed, &crack(&fixed), true),
+        ),
+        ("fixed+VC93, compressed".into(), run(&fixed_vc, &cfv, true)),
+        (
+            "fixed+VC86 limit+VC93, compressed".into(),
+            run(&fixed_lim, &crack(&fixed_lim), true),
+        ),
+    ]
 }

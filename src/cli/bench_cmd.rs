@@ -190,7 +190,7 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
 
 pub(crate) fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
     let path = file.unwrap_or(std::path::Path::new("validation/panels/panels.csv"));
-    match segfem::materials::concrete::panel_bench::series(path) {
+    match super::panel_bench::series(path) {
         Ok((report, secs)) => {
             outln!("{report}");
             outln!("total time of the series: {secs:.1} s");
@@ -207,10 +207,10 @@ pub(crate) fn bench_panels(file: Option<&std::path::Path>) -> ExitCode {
 /// model option (or those of `set`) on two meshes (or those of `set`).
 pub(crate) fn bench_beams(
     file: Option<&std::path::Path>,
-    set: &segfem::materials::concrete::beam_bench::SeriesSettings,
+    set: &super::beam_bench::SeriesSettings,
 ) -> ExitCode {
     let path = file.unwrap_or(std::path::Path::new("validation/beams/beams.csv"));
-    match segfem::materials::concrete::beam_bench::series(path, set) {
+    match super::beam_bench::series(path, set) {
         Ok((report, secs)) => {
             outln!("{report}");
             outln!("total time of the series: {secs:.1} s");

@@ -10,7 +10,6 @@ pub mod continuum;
 pub mod incompatible;
 pub mod interface;
 pub mod tendon;
-pub mod thermal;
 pub mod total_lagrangian;
 
 use crate::materials::point::UpdateError;

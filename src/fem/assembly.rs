@@ -3,7 +3,7 @@
 //! refilling values is a scatter with no search and no allocation.
 
 use super::dofs::{DofMap, CONSTRAINED};
-use super::pattern::LowerPattern;
+use crate::linalg::pattern::{incidence, LowerPattern};
 use rayon::prelude::*;
 
 /// Position marker for an element matrix entry that is not assembled (constrained dof or
@@ -14,7 +14,7 @@ const SKIP: u32 = u32::MAX;
 #[derive(Debug, Clone)]
 pub struct Assembler {
     /// Lower-triangle pattern over the free equations (shared with the symbolic analysis
-    /// running on a thread of its own: [`crate::analysis::solver::SparseCholesky::in_background`]).
+    /// running on a thread of its own: [`crate::linalg::solver::SparseCholesky::in_background`]).
     pub pattern: std::sync::Arc<LowerPattern>,
     /// Node graph (compressed rows): the neighbours of node a, itself included, sorted, are
     /// `node_adj[node_ptr[a]..node_ptr[a + 1]]`. Kept for the fill-reducing ordering.
@@ -44,30 +44,6 @@ pub fn zeroed_values(n: usize) -> Vec<f64> {
         v.par_chunks_mut(1 << 16).for_each(|c| c.fill(0.0));
     }
     v
-}
-
-/// Node → element incidence in compressed rows: the elements holding node a are
-/// `inc[inc_ptr[a]..inc_ptr[a + 1]]`, in increasing order; `elem_nodes[e]` lists the nodes of
-/// element e.
-pub fn incidence(n_nodes: usize, elem_nodes: &[Vec<usize>]) -> (Vec<usize>, Vec<u32>) {
-    let mut inc_ptr = vec![0usize; n_nodes + 1];
-    for nodes in elem_nodes {
-        for &a in nodes {
-            inc_ptr[a + 1] += 1;
-        }
-    }
-    for a in 0..n_nodes {
-        inc_ptr[a + 1] += inc_ptr[a];
-    }
-    let mut fill = inc_ptr.clone();
-    let mut inc = vec![0u32; inc_ptr[n_nodes]];
-    for (e, nodes) in elem_nodes.iter().enumerate() {
-        for &a in nodes {
-            inc[fill[a]] = e as u32;
-            fill[a] += 1;
-        }
-    }
-    (inc_ptr, inc)
 }
 
 impl Assembler {

@@ -3,6 +3,5 @@
 pub mod assembly;
 pub mod dofs;
 pub mod numbering;
-pub mod pattern;
 pub mod quadrature;
 pub mod shape;

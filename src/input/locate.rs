@@ -3,19 +3,7 @@
 
 use crate::model::Model;
 
-/// Length scale of the model (bounding-box diagonal) [m], for relative tolerances.
-pub fn model_size(model: &Model) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &model.nodes {
-        for c in 0..2 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
-    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2))
-        .sqrt()
-        .max(f64::MIN_POSITIVE)
-}
+pub use crate::model::model_size;
 
 /// True if `p` lies inside or on the boundary (within `tol` [m]) of the straight-edged polygon
 /// of an element's corners.

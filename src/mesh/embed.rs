@@ -23,8 +23,8 @@
 //! [`BarPiece::nat_nodes`]; in the on-path placement they serve as starting guesses for the
 //! Newton inverse mapping.
 
-use crate::elements::bar::BarPoint;
 use crate::fem::shape::{jacobian, line_shape, map_point};
+use crate::model::BarPoint;
 use crate::model::QuadKind;
 use serde::{Deserialize, Serialize};
 

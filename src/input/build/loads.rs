@@ -155,8 +155,8 @@ fn temperature(
     i: usize,
     t: &crate::input::schema::TemperatureIn,
     model: &Model,
-) -> R<crate::elements::thermal::ThermalAction> {
-    use crate::elements::thermal::{aashto_profile, en1991_profile, ThermalAction};
+) -> R<crate::model::ThermalAction> {
+    use crate::model::thermal::{aashto_profile, en1991_profile, ThermalAction};
     let k = |f: &str| format!("load_cases[{i}].temperature.{f}");
     let finite = |f: &str, v: Option<f64>| -> R<Option<f64>> {
         match v {

@@ -15,14 +15,12 @@
 //! The update is a pure function of (committed state, total strain): calling it twice with
 //! the same arguments gives the same result, so a load step can be retried.
 
-pub mod beam_bench;
 pub mod biaxial;
 pub mod compression;
 pub mod cracking;
 pub mod creep;
 pub mod implex;
 pub mod ottosen;
-pub mod panel_bench;
 pub mod reduction;
 pub mod rotating;
 

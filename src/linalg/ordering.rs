@@ -210,7 +210,7 @@ impl Elements {
     /// The elements `elements` (node lists) of a mesh with nodes at `coords` [m], all in
     /// part 1.
     fn new(elements: &[Vec<usize>], coords: &[[f64; 2]]) -> Self {
-        let (inc_ptr, inc) = crate::fem::assembly::incidence(coords.len(), elements);
+        let (inc_ptr, inc) = super::pattern::incidence(coords.len(), elements);
         let centroid = elements
             .iter()
             .map(|el| {
@@ -499,7 +499,7 @@ mod tests {
     /// (within 25 %): the reason to use it.
     #[test]
     fn factor_is_correct_and_as_sparse_as_amd() {
-        use crate::analysis::solver::{LowerPattern, SparseCholesky};
+        use crate::linalg::solver::{LowerPattern, SparseCholesky};
         let m = 60;
         let (ptr, adj, xy) = grid(m);
         // One equation per node here (take the x dofs): the 9-point Laplacian shifted to be
@@ -724,8 +724,8 @@ mod tests {
     /// along node coordinates, whose median lines cut through the elements (1,250,416).
     #[test]
     fn element_dissection_factor_vs_amd() {
-        use crate::analysis::solver::SparseCholesky;
         use crate::fem::assembly::Assembler;
+        use crate::linalg::solver::SparseCholesky;
         use crate::mesh::banded::{generate, Band};
         use crate::model::QuadKind;
         let n = 40;

@@ -629,8 +629,8 @@ impl Half {
 
 #[cfg(test)]
 mod tests {
-    use crate::analysis::solver::SparseCholesky;
     use crate::analysis::system::System;
+    use crate::linalg::solver::SparseCholesky;
 
     /// The LLᵀ by halves against the whole matrix's on a model's stiffness: K x = K·1 and a
     /// second right-hand side, solutions equal to 1e-10 relative (measured 1e-13–1e-12: the

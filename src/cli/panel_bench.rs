@@ -4,7 +4,7 @@
 //! (docs/validation.md, "Membrane panels"). Used by `segfem bench --case panels` and by
 //! tests/panels.rs.
 
-use crate::analysis::steps::{self, Observer, Snapshot};
+use segfem::analysis::steps::{self, Observer, Snapshot};
 
 /// One panel test: geometry, materials and the measured strength (SI units).
 #[derive(Debug, Clone, PartialEq)]
@@ -227,7 +227,7 @@ impl Observer for Trace {
 pub fn run_panel(p: &Panel, keys: &str, n: usize) -> Result<PanelRun, String> {
     let text = panel_toml(p, keys, n);
     let built =
-        crate::input::parse(&text, &format!("panel {}", p.id)).map_err(|e| e.to_string())?;
+        segfem::input::parse(&text, &format!("panel {}", p.id)).map_err(|e| e.to_string())?;
     let mut tr = Trace {
         l: p.size,
         n,
@@ -473,57 +473,4 @@ pub fn series(path: &std::path::Path) -> Result<(String, f64), String> {
     s.push_str(&modes);
     s.push_str("```\n");
     Ok((s, start.elapsed().as_secs_f64()))
-}
-
-/// Material-point update rates of the shear options (for `segfem bench --case
-/// material-point`), measured by `rate` (updates/s of a closure of s ∈ [0, 1)): rotating cracks and fixed cracks with compression softening, from a point
-/// cracked at 4 ε0, at the fixed model's benchmark strains and at a compressed state
-/// (ε1 = 10 ε0, ε2 = −5 ε0) where the reduction is active.
-pub fn shear_model_rates(rate: impl Fn(&dyn Fn(f64) -> f64) -> f64) -> Vec<(String, f64)> {
-    use super::{update, CompressionReduction, ConcreteParams, ConcreteState, CrackModel};
-    use std::hint::black_box;
-    let fixed = ConcreteParams::from_mc90(38e6, 0.2);
-    let mut fixed_vc = fixed.clone();
-    fixed_vc.compression_reduction = CompressionReduction::VecchioCollins1993 {
-        beta_min: 0.4,
-        spacing: 0.0,
-    };
-    let mut rot = fixed.clone();
-    rot.crack_model = CrackModel::Rotating;
-    let mut rot_vc = fixed_vc.clone();
-    rot_vc.crack_model = CrackModel::Rotating;
-    let mut fixed_lim = fixed_vc.clone();
-    fixed_lim.crack_shear_limit =
-        super::cracking::CrackShearLimit::VecchioCollins1986 { d_agg: 0.016 };
-    let e0 = fixed.eps0();
-    let crack = |p: &ConcreteParams| {
-        update(p, &ConcreteState::new(), &[4.0 * e0, 0.0, 0.0], 0.1)
-            .expect("cracking update")
-            .0
-    };
-    let run = |p: &ConcreteParams, c: &ConcreteState, comp: bool| {
-        rate(&|s| {
-            let e = if comp {
-                [(10.0 + s) * e0, -5.0 * e0, s * e0]
-            } else {
-                [(4.0 + s) * e0, -0.2 * e0, 0.5 * s * e0]
-            };
-            black_box(update(p, c, black_box(&e), 0.1).map_or(0.0, |r| r.1[0]))
-        })
-    };
-    let (cr, crv, cfv) = (crack(&rot), crack(&rot_vc), crack(&fixed_vc));
-    vec![
-        ("cracked (rotating)".into(), run(&rot, &cr, false)),
-        ("rotating, compressed".into(), run(&rot, &cr, true)),
-        ("rotating+VC93, compressed".into(), run(&rot_vc, &crv, true)),
-        (
-            "fixed, compressed".into(),
-            run(&fixed, &crack(&fixed), true),
-        ),
-        ("fixed+VC93, compressed".into(), run(&fixed_vc, &cfv, true)),
-        (
-            "fixed+VC86 limit+VC93, compressed".into(),
-            run(&fixed_lim, &crack(&fixed_lim), true),
-        ),
-    ]
 }

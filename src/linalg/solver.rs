@@ -17,7 +17,7 @@ use faer::{Conj, MatMut, Par, Side};
 
 use super::split::{SplitCholesky, SplitOutcome};
 
-pub use crate::fem::pattern::LowerPattern;
+pub use super::pattern::LowerPattern;
 
 /// faer's view of a lower-triangle pattern.
 fn symbolic(p: &LowerPattern) -> SymbolicSparseColMatRef<'_, usize> {

@@ -6,8 +6,8 @@
 //! tests/shear_beams.rs.
 
 use super::panel_bench::csv_fields;
-use crate::analysis::steps::{self, Observer, Snapshot};
-use crate::results::ultimate::{Ultimate, UltimateWatch};
+use segfem::analysis::steps::{self, Observer, Snapshot};
+use segfem::results::ultimate::{Ultimate, UltimateWatch};
 
 /// One layer of longitudinal bars (SI units).
 #[derive(Debug, Clone, PartialEq)]
@@ -292,7 +292,7 @@ pub struct Locking {
 
 impl Locking {
     /// The measure over the points `pts` for tensile strength `ftm` [Pa].
-    pub fn of(pts: &[crate::materials::point::PointState], ftm: f64) -> Locking {
+    pub fn of(pts: &[segfem::materials::point::PointState], ftm: f64) -> Locking {
         let mut l = Locking::default();
         let mut sum = 0.0;
         for c in pts.iter().filter_map(|p| p.concrete()) {
@@ -300,7 +300,7 @@ impl Locking {
                 continue;
             }
             l.cracked += 1;
-            let (s1, phi) = super::principal_max(&c.stress());
+            let (s1, phi) = segfem::materials::concrete::principal_max(&c.stress());
             // Deviation from the crack axes, folded into [0, 45°].
             let q = std::f64::consts::FRAC_PI_2;
             let d = (phi - c.crack_angle()).rem_euclid(q);
@@ -371,7 +371,7 @@ pub fn run_beam_solver(
     // The `[solver]` table is the model text's last.
     let text = beam_toml(beam, keys, rows, push, increment) + solver;
     let built =
-        crate::input::parse(&text, &format!("beam {}", beam.id)).map_err(|e| e.to_string())?;
+        segfem::input::parse(&text, &format!("beam {}", beam.id)).map_err(|e| e.to_string())?;
     let model = &built.model;
     let (dx, n_half, n_over) = layout(beam, rows);
     let len = dx * (n_half + n_over) as f64;

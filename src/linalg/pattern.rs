@@ -1,5 +1,6 @@
-//! The sparse pattern shared by assembly (which fills it) and the solver (which factors it):
-//! it sits below both so that neither points up at the other.
+//! The sparse pattern shared by assembly (which fills it, `fem::assembly`) and the solver
+//! (which factors it), and the node → element incidence both the assembler and the
+//! element dissection build their graphs from: linear-algebra types, below both users.
 
 /// Compressed sparse column pattern of the lower triangle of a symmetric matrix.
 #[derive(Debug, Clone)]
@@ -46,4 +47,28 @@ impl LowerPattern {
             }
         }
     }
+}
+
+/// Node → element incidence in compressed rows: the elements holding node a are
+/// `inc[inc_ptr[a]..inc_ptr[a + 1]]`, in increasing order; `elem_nodes[e]` lists the nodes of
+/// element e.
+pub fn incidence(n_nodes: usize, elem_nodes: &[Vec<usize>]) -> (Vec<usize>, Vec<u32>) {
+    let mut inc_ptr = vec![0usize; n_nodes + 1];
+    for nodes in elem_nodes {
+        for &a in nodes {
+            inc_ptr[a + 1] += 1;
+        }
+    }
+    for a in 0..n_nodes {
+        inc_ptr[a + 1] += inc_ptr[a];
+    }
+    let mut fill = inc_ptr.clone();
+    let mut inc = vec![0u32; inc_ptr[n_nodes]];
+    for (e, nodes) in elem_nodes.iter().enumerate() {
+        for &a in nodes {
+            inc[fill[a]] = e as u32;
+            fill[a] += 1;
+        }
+    }
+    (inc_ptr, inc)
 }
