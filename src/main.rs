@@ -121,6 +121,11 @@ const EXAMPLES: &[(&str, &str, &str)] = &[
         include_str!("../examples/viaduct-explicit.toml"),
     ),
     (
+        "viaduct-cantilever",
+        "three-span 60 + 100 + 60 m haunched box built by balanced cantilever ([viaduct] generator): erection, 30 years, LM1 influence lines, envelopes and combinations, design checks, failure",
+        include_str!("../examples/viaduct-cantilever.toml"),
+    ),
+    (
         "gmsh-tapered",
         "two segments meshed with Gmsh (prismatic and tapered), dry joint; -o also writes gmsh-tapered.msh",
         include_str!("../examples/gmsh-tapered.toml"),

@@ -88,6 +88,11 @@ fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
+/// A history column's name without its unit (names may hold spaces: "factor:traveller 0 [-]").
+fn name_of(h: &str) -> &str {
+    h.rsplit_once(" [").map_or(h, |p| p.0)
+}
+
 fn col(header: &[String], prefix: &str) -> usize {
     header.iter().position(|h| h.starts_with(prefix)).unwrap()
 }
@@ -604,12 +609,12 @@ fn every_example_report_has_headline_and_load_defaults() {
         let varying = header
             .iter()
             .filter(|h| h.starts_with("factor:"))
-            .any(|h| range(&column(h.split(' ').next().unwrap())) > 0.0);
+            .any(|h| range(&column(name_of(h))) > 0.0);
         if !control && varying {
             let best = header
                 .iter()
                 .filter(|h| h.starts_with("factor:"))
-                .map(|h| h.split(' ').next().unwrap().to_string())
+                .map(|h| name_of(h).to_string())
                 .max_by(|a, b| range(&column(a)).total_cmp(&range(&column(b))))
                 .unwrap();
             assert_eq!(

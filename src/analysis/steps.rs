@@ -332,7 +332,7 @@ impl increments::Stepper for LoadStepper<'_> {
         // steps that converge at once are not touched), comes in over the step.
         if target < 1.0 && self.step.kind == StepKind::Load && ctx.sys.stage_jump_pending() {
             let f0 = external_forces(ctx.sys.model.n_dofs(), ctx.cases, &self.start);
-            ctx.sys.set_thermal(&self.start);
+            ctx.sys.thermal.impose(&self.start, &mut ctx.sys.tendons);
             ctx.sys.begin_time_increment(TimeContext::at(self.clock));
             // A committed state that no longer assembles is left to the attempt to report.
             let _ = ctx.sys.ramp_stage_jump(&f0);
