@@ -272,3 +272,96 @@ fn cantilever_section_forces_follow_statics_at_every_stage() {
     // hardening.
     assert_eq!(checked, 4, "stages checked");
 }
+
+/// Segment lengths of the test girder, left to right [m]: end segment, closure, the arms and
+/// pier segments of P1 and P2 with the main span's closure between, closure, end segment.
+fn segment_lengths() -> Vec<f64> {
+    let mut l = vec![2.0, CLOSURE];
+    for p in 0..2 {
+        l.extend([SEG; PAIRS]);
+        l.push(PIER);
+        l.extend([SEG; PAIRS]);
+        l.push(if p == 0 { CLOSURE } else { 0.0 });
+    }
+    l.pop();
+    l.extend([CLOSURE, 2.0]);
+    l
+}
+
+/// The casting curve closes the profile: the deck's deflection at 30 years in a run without
+/// camber, taken as the camber c(x) = −u(x) (one point per element column) of a rerun,
+/// leaves the rerun's deck within 2 mm of its design level everywhere (the issue's
+/// tolerance; what remains is the change of geometry the camber makes — the raised girder
+/// is a slightly different structure), and within 5 % of the largest camber. The camber is
+/// 5.6 mm at most here (the deck without it misses its level by more than the tolerance);
+/// measured: the rerun's deck within 0.0074 mm of its level.
+#[test]
+fn casting_curve_closes_the_deck_profile_in_a_rerun() {
+    let tmp = TempDir::new("cantilever-camber");
+    let depth: f64 = BANDS.iter().map(|b| b.1).sum();
+    let mut xs = Vec::new();
+    let mut x = -0.5;
+    for len in segment_lengths() {
+        for k in 0..2 {
+            xs.push(x + len * k as f64 / 2.0);
+        }
+        x += len;
+    }
+    xs.push(x);
+    assert!(
+        (x - 66.5).abs() < 1e-9,
+        "the girder ends at 66.5 m, not {x}"
+    );
+    let monitors = |camber: &dyn Fn(f64) -> f64| -> String {
+        xs.iter()
+            .enumerate()
+            .map(|(i, x)| {
+                format!(
+                    "\n[[monitors]]\nname = \"u{i}\"\nkind = \"displacement\"\npoint = [{x}, {}]\ncomponent = \"y\"\n",
+                    depth + camber(*x)
+                )
+            })
+            .collect()
+    };
+    let years = "\n[[steps]]\nname = \"30 years\"\nkind = \"time\"\nto = 10958.0\n";
+    let deck = |out: &Path| -> Vec<f64> {
+        let (h, rows) = history(out);
+        let last = rows.last().unwrap();
+        (0..xs.len())
+            .map(|i| last[col(&h, &format!("u{i}"))])
+            .collect()
+    };
+    let plain = model(&format!("{}{years}", monitors(&|_| 0.0)));
+    let u0 = deck(&run(&tmp, "plain", &plain));
+    let camber: Vec<[f64; 2]> = xs.iter().zip(&u0).map(|(x, u)| [*x, -u]).collect();
+    let largest = u0.iter().fold(0.0_f64, |a, u| a.max(u.abs()));
+    // Without the camber the deck would miss its level by more than the tolerance.
+    assert!(
+        largest > 4e-3,
+        "the deck moves {largest} m at most: no test"
+    );
+    let c = |x: f64| {
+        let i = xs.iter().position(|&xi| (xi - x).abs() < 1e-9).unwrap();
+        camber[i][1]
+    };
+    let list: Vec<String> = camber
+        .iter()
+        .map(|p| format!("[{}, {}]", p[0], p[1]))
+        .collect();
+    let cambered = model(&format!("{}{years}", monitors(&c))).replace(
+        "segment_age = 60.0",
+        &format!("segment_age = 60.0\ncamber = [{}]", list.join(", ")),
+    );
+    let u1 = deck(&run(&tmp, "cambered", &cambered));
+    let mut worst = 0.0_f64;
+    for (i, x) in xs.iter().enumerate() {
+        let level = c(*x) + u1[i];
+        worst = worst.max(level.abs());
+        assert!(
+            level.abs() <= 2e-3 && level.abs() <= 0.05 * largest,
+            "x = {x}: the deck ends {:.2} mm off its design level (camber {:.2} mm)",
+            level * 1e3,
+            c(*x) * 1e3
+        );
+    }
+}
