@@ -234,15 +234,26 @@ impl CurveFigure {
                 continue;
             }
             let c = PALETTE[i % PALETTE.len()];
+            // A non-finite point breaks the line (a part of the girder not yet placed).
+            let finite = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite();
+            let runs = s.points.split(|p| !finite(p)).filter(|r| !r.is_empty());
+            for (k, run) in runs.enumerate() {
+                let drawn = chart
+                    .draw_series(LineSeries::new(run.iter().copied(), c.stroke_width(2)))
+                    .map_err(de)?;
+                if k == 0 {
+                    drawn.label(&s.label).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(2))
+                    });
+                }
+            }
             chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-                .map_err(de)?
-                .label(&s.label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(2))
-                });
-            chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .draw_series(
+                    s.points
+                        .iter()
+                        .filter(|p| finite(p))
+                        .map(|&p| Circle::new(p, 3, c.filled())),
+                )
                 .map_err(de)?;
         }
         for r in reference.clone() {

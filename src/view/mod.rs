@@ -8,6 +8,8 @@
 //! optionally `normal_stress` [Pa] and `joint` [-]).
 
 pub mod data;
+pub mod envelopes;
+pub mod erection;
 pub mod figures;
 pub mod glyphs;
 pub mod report;
@@ -642,6 +644,12 @@ pub fn plot(opts: &PlotOptions) -> Result<PlotOutcome, ViewError> {
     let mut outcome = PlotOutcome::default();
     outcome.files.extend(save(&curves, &out_dir, "curves")?);
     outcome.curves = Some(curves);
+    outcome
+        .files
+        .extend(envelopes::envelope_figures(&opts.dir, &out_dir)?);
+    outcome
+        .files
+        .extend(erection::erection_figure(&opts.dir, &out_dir)?);
     let (n, output) = match pick_output(&opts.dir, opts.step) {
         Ok(o) => o,
         Err(e) if opts.step.is_none() => {
