@@ -9,7 +9,7 @@
 //! permanent bearings, the continuity tendons stressed and the falsework struck.
 
 use super::viaduct::{
-    attach, bearing_name, check_materials, generated_regions, hold_down, mesh_in,
+    attach, bearing_name, bearings, check_materials, generated_regions, hold_down, mesh_in,
     no_generated_mesh, node_columns, section, self_weight, step, strand, tendon, Lists, ViaductIn,
     STRIKE_INCREMENTS,
 };
@@ -255,6 +255,7 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     file.mesh = Some(mesh);
 
     let supports = hold_down(v, supports(&geo), ctx)?;
+    let supports = bearings(v, supports, geo.g.bearings.len() - 1, ctx)?;
     let mut load_cases = vec![self_weight()];
     if traveller > 0.0 {
         load_cases.extend((0..=pairs).map(|j| traveller_case(&geo, c, j, traveller)));

@@ -56,7 +56,17 @@ pub struct ViaductIn {
     pub continuity_tendons: Option<ContinuityTendonsIn>,
     #[serde(default)]
     pub hold_down: Vec<String>,
+    /// Length of the permanent bearings along the span [m] (default
+    /// [`DEFAULT_BEARING`]; `0`: the reaction on the bearing's node alone).
+    pub bearing: Option<f64>,
 }
+
+/// Default length of the generated permanent bearings along the span [m]: an estimate of
+/// a pot bearing (EN 1337-5) for a reaction of about 10 MN at about 35 MPa on the
+/// concrete, √(10 MN / 35 MPa) ≈ 0.53 m, rounded up to the pot's outer size
+/// (docs/input.md, "[viaduct]"; docs/theory-prestress.md, "Anchor plates, bearings and
+/// local zones").
+pub const DEFAULT_BEARING: f64 = 0.6;
 
 /// One band of the box section, bottom up: a region of out-of-plane `width` [m].
 #[derive(Debug, Deserialize)]
@@ -237,6 +247,7 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
     file.mesh = Some(mesh_in(v, &layout.lengths, layout.x0, cast_days));
     let steps = erection_steps(v, &layout, start, strike, span_interval);
     let supports = hold_down(v, supports(&layout), ctx)?;
+    let supports = bearings(v, supports, v.spans.len(), ctx)?;
     let tendons = tendons(v, &layout, depth, file, ctx)?;
     let lists = Lists {
         supports,
@@ -315,6 +326,35 @@ pub(super) fn mesh_in(v: &ViaductIn, lengths: &[f64], x0: f64, cast_days: Vec<f6
         nodes: Vec::new(),
         blocks: Vec::new(),
     }
+}
+
+/// Give the permanent bearings of `n` spans (A1, P1 …, A2) the length `viaduct.bearing`
+/// [m]: the reaction still holds the bearing's node (a pin), and on `kind = "concrete"` the
+/// concrete over the bearing is a local zone (docs/theory-prestress.md, "Anchor plates,
+/// bearings and local zones").
+pub(super) fn bearings(
+    v: &ViaductIn,
+    mut supports: Vec<SupportIn>,
+    n: usize,
+    ctx: &Ctx,
+) -> R<Vec<SupportIn>> {
+    let b = v.bearing.unwrap_or(DEFAULT_BEARING);
+    if !(b.is_finite() && b >= 0.0) {
+        return Err(ctx.err(
+            "viaduct.bearing",
+            format!("must be a bearing length ≥ 0 in m (got {b})"),
+        ));
+    }
+    if b == 0.0 {
+        return Ok(supports);
+    }
+    let names: Vec<String> = (0..=n).map(|i| bearing_name(i, n)).collect();
+    for s in supports.iter_mut() {
+        if names.contains(&s.name) {
+            s.bearing = Some(b);
+        }
+    }
+    Ok(supports)
 }
 
 /// Make the supports named in `hold_down` two-way (an error for a name not generated).
