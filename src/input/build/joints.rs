@@ -218,3 +218,62 @@ pub(super) fn add(
     }
     Ok(())
 }
+
+/// A warning for every embedded bar or bonded tendon whose path crosses a joint: its pieces
+/// on either side load their own segments (the faces do not share nodes), so it carries no
+/// force across the joint — the joint opens as if the steel were not there, and a
+/// prestressed bar's force does not press it (docs/theory-joints-tendons.md). Match-cast
+/// joints are crossed by external tendons, not by embedded steel.
+pub(super) fn bars_across(ctx: &Ctx, model: &Model, warnings: &mut Vec<String>) {
+    if model.interfaces.is_empty() {
+        return;
+    }
+    let tol = 1e-6 * crate::input::locate::model_size(model);
+    // Face A of each contact element as a segment (its start and end nodes).
+    let faces: Vec<([f64; 2], [f64; 2], usize)> = model
+        .interfaces
+        .iter()
+        .map(|i| (model.nodes[i.nodes[0]], model.nodes[i.nodes[1]], i.joint))
+        .collect();
+    let on = |p: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l = dx.hypot(dy);
+        if l == 0.0 {
+            return false;
+        }
+        let off = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx).abs() / l;
+        let t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (l * l);
+        off <= tol && t >= -tol / l && t <= 1.0 + tol / l
+    };
+    for bar in model.bars.iter().filter(|b| !b.layer) {
+        // Inner piece ends: where the path passes from one host element to the next.
+        let inner = bar
+            .piece_ends
+            .iter()
+            .skip(1)
+            .map(|e| e[0])
+            .chain(bar.piece_ends.iter().rev().skip(1).map(|e| e[1]));
+        let mut crossed: Vec<usize> = Vec::new();
+        for p in inner {
+            for &(a, b, j) in &faces {
+                if on(p, a, b) && !crossed.contains(&j) {
+                    crossed.push(j);
+                }
+            }
+        }
+        if crossed.is_empty() {
+            continue;
+        }
+        crossed.sort_unstable();
+        let names: Vec<&str> = crossed
+            .iter()
+            .map(|&j| model.joints[j].name.as_str())
+            .collect();
+        warnings.push(format!(
+            "{}: '{}' is embedded steel crossing joint(s) {}: its pieces on either side load their own segments, so it carries no force across a joint (the joint opens as if it were not there) and its prestress, if any, does not press the joint; a tendon that crosses match-cast joints is an external one (kind = \"external\")",
+            ctx.file,
+            bar.name,
+            names.join(", ")
+        ));
+    }
+}

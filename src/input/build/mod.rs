@@ -122,6 +122,7 @@ pub fn build(file: File, ctx: &Ctx) -> R<Built> {
         &mut zones,
     )?;
     super::bar_layers::build(ctx, &file.bar_layers, &steels, &mut model)?;
+    joints::bars_across(ctx, &model, w);
     monitors::build(ctx, &file, &mut model, &used)?;
     controls::geometry(ctx, file.analysis.as_ref(), &mut model)?;
     steps::build(ctx, &file.steps, &mut model, &used)?;
