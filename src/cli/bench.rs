@@ -380,6 +380,22 @@ pub fn viaduct_concrete_case(refine: usize) -> Result<NonlinearRow, String> {
     )
 }
 
+/// The balanced-cantilever viaduct (examples/viaduct-cantilever.toml, issue 39 item 6):
+/// erection in 36 stages, 30 years, LM1 influence lines over 253 positions, the governing
+/// position to L/100. The example's mesh only (`refine` 1). Reports the final deflection at
+/// mid-span of the main span [m].
+pub fn viaduct_cantilever_case(refine: usize) -> Result<NonlinearRow, String> {
+    if refine > 1 {
+        return Err("viaduct-cantilever: --refine 1 only (the example's mesh)".into());
+    }
+    timed_row(
+        include_str!("../../examples/viaduct-cantilever.toml"),
+        "viaduct-cantilever.toml",
+        "viaduct-cantilever, 6 rows".into(),
+        110.0,
+    )
+}
+
 /// A viaduct example's text `example` (file name `name`.toml) with its mesh refined
 /// `refine` times, timed.
 fn refined_viaduct(example: &str, name: &str, refine: usize) -> Result<NonlinearRow, String> {
