@@ -516,61 +516,15 @@ pub fn run_file_opts(
     opts: &RunOptions,
 ) -> Result<Summary, RunError> {
     let t0 = Instant::now();
-    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
-    // is locked once its input is valid (bad input writes nothing, not even a directory).
-    let mut lock = None;
-    if opts.restart && out.is_dir() {
-        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
-    }
-    let saved = if opts.restart {
-        Some(checkpoint::read(out).map_err(RunError::Restart)?)
-    } else {
-        None
-    };
-    let path: PathBuf = match (path, &saved) {
-        (Some(p), _) => p.to_path_buf(),
-        (None, Some((o, _))) => PathBuf::from(&o.model_file),
-        (None, None) => {
-            return Err(RunError::Restart(
-                "no model file given and no checkpoint to take it from".into(),
-            ))
-        }
-    };
+    let Opened {
+        path,
+        built,
+        saved,
+        lock: _lock, // held until the run returns
+        digest,
+        input_s,
+    } = open(path, out, opts, t0)?;
     let path = path.as_path();
-    let mut built = input::load(path)?;
-    built.model.controls.verbose = opts.verbose;
-    let digest = std::fs::read(path)
-        .map(|b| checkpoint::digest(&b))
-        .unwrap_or(0);
-    if let Some((o, _)) = &saved {
-        if o.model_digest != digest {
-            built.warnings.push(format!(
-                "{}: the model file changed since the checkpoint was written; the restarted run equals an uninterrupted one only if the steps already done are unchanged",
-                path.display()
-            ));
-        }
-    }
-    let input_s = t0.elapsed().as_secs_f64();
-    if lock.is_none() {
-        std::fs::create_dir_all(out).map_err(|e| {
-            RunError::Io(format!(
-                "{}: cannot create the output directory: {e}",
-                out.display()
-            ))
-        })?;
-        lock = Some(lock::acquire(out, path).map_err(RunError::Busy)?);
-    }
-    // Held until the run returns (dropped with this binding).
-    let _lock = lock;
-    if saved.is_none() {
-        let n = clear_stale(out)?;
-        if n > 0 {
-            built.warnings.push(format!(
-                "{}: removed {n} files of an earlier run (history.csv, stages.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
-                out.display()
-            ));
-        }
-    }
     let model = built.model;
     let mut rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
         RunError::Io(format!(
@@ -721,56 +675,8 @@ pub fn run_file_opts(
             .collect::<Vec<_>>(),
     )
     .n_eq;
-    let (status, resume_step) = match &error {
-        None if failures.is_empty() && !plausibility.is_empty() => ("implausible", None),
-        None if failures.is_empty() => ("completed", None),
-        None | Some(AnalysisError::NotConverged(_)) => ("failed", None),
-        Some(AnalysisError::Stopped {
-            reason,
-            resume_step,
-            ..
-        }) => (
-            match reason {
-                StopReason::Signal(_) => "interrupted",
-                StopReason::AfterStep(_) | StopReason::Caller => "stopped",
-            },
-            Some(resume_step + 1),
-        ),
-        Some(_) => ("failed", None),
-    };
-    let error_text = match (&error, failures.len()) {
-        (
-            Some(
-                e @ AnalysisError::Stopped {
-                    reason: StopReason::Caller,
-                    ..
-                },
-            ),
-            _,
-        ) => Some(format!(
-            "{e}: {}",
-            caller_reason(&opts.caller_stop).unwrap_or_default()
-        )),
-        (Some(e), _) => Some(e.to_string()),
-        (None, 0) if !plausibility.is_empty() => Some(format!(
-            "every step converged but the result is not physically meaningful:\n{}",
-            plausibility.join("\n")
-        )),
-        (None, 0) => None,
-        (None, n) => Some(format!(
-            "{n} step(s) did not converge (the run went on): {}\n{}",
-            failures
-                .iter()
-                .map(|f| format!("'{}'", f.step))
-                .collect::<Vec<_>>()
-                .join(", "),
-            failures
-                .iter()
-                .map(|f| f.to_string())
-                .collect::<Vec<_>>()
-                .join("\n")
-        )),
-    };
+    let (status, resume_step, error_text) =
+        status_of(&error, &failures, &plausibility, &opts.caller_stop);
     let ultimate = watch.finish(
         &model,
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
@@ -811,6 +717,81 @@ pub fn run_file_opts(
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_atomic(&out.join("summary.json"), json.as_bytes())
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("summary.json").display())))?;
+    outcome(error, summary, error_text, path, out, opts)
+}
+
+/// The run's status word (summary.json `status`), the step a restart continues with, and
+/// the error text of summary.json, from how the analysis ended (`error`), the steps that
+/// did not converge (`failures`) and the plausibility findings.
+fn status_of(
+    error: &Option<AnalysisError>,
+    failures: &[FailureReport],
+    plausibility: &[String],
+    caller_stop: &Option<Arc<std::sync::Mutex<Option<String>>>>,
+) -> (&'static str, Option<usize>, Option<String>) {
+    let (status, resume_step) = match error {
+        None if failures.is_empty() && !plausibility.is_empty() => ("implausible", None),
+        None if failures.is_empty() => ("completed", None),
+        None | Some(AnalysisError::NotConverged(_)) => ("failed", None),
+        Some(AnalysisError::Stopped {
+            reason,
+            resume_step,
+            ..
+        }) => (
+            match reason {
+                StopReason::Signal(_) => "interrupted",
+                StopReason::AfterStep(_) | StopReason::Caller => "stopped",
+            },
+            Some(resume_step + 1),
+        ),
+        Some(_) => ("failed", None),
+    };
+    let error_text = match (error, failures.len()) {
+        (
+            Some(
+                e @ AnalysisError::Stopped {
+                    reason: StopReason::Caller,
+                    ..
+                },
+            ),
+            _,
+        ) => Some(format!(
+            "{e}: {}",
+            caller_reason(caller_stop).unwrap_or_default()
+        )),
+        (Some(e), _) => Some(e.to_string()),
+        (None, 0) if !plausibility.is_empty() => Some(format!(
+            "every step converged but the result is not physically meaningful:\n{}",
+            plausibility.join("\n")
+        )),
+        (None, 0) => None,
+        (None, n) => Some(format!(
+            "{n} step(s) did not converge (the run went on): {}\n{}",
+            failures
+                .iter()
+                .map(|f| format!("'{}'", f.step))
+                .collect::<Vec<_>>()
+                .join(", "),
+            failures
+                .iter()
+                .map(|f| f.to_string())
+                .collect::<Vec<_>>()
+                .join("\n")
+        )),
+    };
+    (status, resume_step, error_text)
+}
+
+/// What `run_file_opts` returns once summary.json is written: the summary, or the error
+/// that says how the run ended (model file `path`, output directory `out`).
+fn outcome(
+    error: Option<AnalysisError>,
+    summary: Summary,
+    error_text: Option<String>,
+    path: &Path,
+    out: &Path,
+    opts: &RunOptions,
+) -> Result<Summary, RunError> {
     let file = path.display();
     match error {
         None if summary.failures.is_empty() && !summary.plausibility.is_empty() => {
@@ -870,6 +851,92 @@ pub fn run_file_opts(
         Some(AnalysisError::Restore(m)) => Err(RunError::Restart(format!("{file}: {m}"))),
         Some(AnalysisError::Output(e)) => Err(RunError::Io(format!("{}: {e}", out.display()))),
     }
+}
+
+/// A run's start: the model file read and checked, a restart's checkpoint, the output
+/// directory locked and, for a fresh run, cleared of an earlier run's files.
+struct Opened {
+    /// The model file (given, or the one the checkpoint names).
+    path: PathBuf,
+    /// The built model and its warnings.
+    built: input::Built,
+    /// A restart's checkpoint.
+    saved: Option<(Origin, checkpoint::Checkpoint)>,
+    /// The output directory's lock, held until the run returns.
+    lock: Option<lock::DirLock>,
+    /// Digest of the model file's bytes (0 if unreadable).
+    digest: u64,
+    /// Time to read and check the input [s].
+    input_s: f64,
+}
+
+/// Open a run as [`run_file_opts`] does (`t0`: when the run started).
+fn open(
+    path: Option<&Path>,
+    out: &Path,
+    opts: &RunOptions,
+    t0: Instant,
+) -> Result<Opened, RunError> {
+    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
+    // is locked once its input is valid (bad input writes nothing, not even a directory).
+    let mut lock = None;
+    if opts.restart && out.is_dir() {
+        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
+    }
+    let saved = if opts.restart {
+        Some(checkpoint::read(out).map_err(RunError::Restart)?)
+    } else {
+        None
+    };
+    let path_buf: PathBuf = match (path, &saved) {
+        (Some(p), _) => p.to_path_buf(),
+        (None, Some((o, _))) => PathBuf::from(&o.model_file),
+        (None, None) => {
+            return Err(RunError::Restart(
+                "no model file given and no checkpoint to take it from".into(),
+            ))
+        }
+    };
+    let mut built = input::load(&path_buf)?;
+    built.model.controls.verbose = opts.verbose;
+    let digest = std::fs::read(&path_buf)
+        .map(|b| checkpoint::digest(&b))
+        .unwrap_or(0);
+    if let Some((o, _)) = &saved {
+        if o.model_digest != digest {
+            built.warnings.push(format!(
+                "{}: the model file changed since the checkpoint was written; the restarted run equals an uninterrupted one only if the steps already done are unchanged",
+                path_buf.display()
+            ));
+        }
+    }
+    let input_s = t0.elapsed().as_secs_f64();
+    if lock.is_none() {
+        std::fs::create_dir_all(out).map_err(|e| {
+            RunError::Io(format!(
+                "{}: cannot create the output directory: {e}",
+                out.display()
+            ))
+        })?;
+        lock = Some(lock::acquire(out, &path_buf).map_err(RunError::Busy)?);
+    }
+    if saved.is_none() {
+        let n = clear_stale(out)?;
+        if n > 0 {
+            built.warnings.push(format!(
+                "{}: removed {n} files of an earlier run (history.csv, stages.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
+                out.display()
+            ));
+        }
+    }
+    Ok(Opened {
+        path: path_buf,
+        built,
+        saved,
+        lock,
+        digest,
+        input_s,
+    })
 }
 
 fn signal_name(s: i32) -> String {

@@ -319,6 +319,108 @@ pub struct Assembled {
     pub force_scale: f64,
 }
 
+/// The solver's fill-reducing order of the equations (`None` below the nested-dissection
+/// size: the solver's AMD) and the time it took [s].
+fn equation_order(
+    model: &Model,
+    asm: &Assembler,
+    elem_nodes: &[Vec<usize>],
+    dofs: &DofMap,
+) -> (Option<Vec<usize>>, f64) {
+    let t_order = std::time::Instant::now();
+    // Nested dissection on large systems: on meshes of 4-node elements split
+    // along node coordinates; with Q8/Q9 elements (whose mid-side nodes a line
+    // through the nodes would cut off) split along element edges.
+    let all_q4 = model
+        .elements
+        .iter()
+        .all(|e| e.kind == crate::model::QuadKind::Q4);
+    let ordering = if all_q4 {
+        (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS).then(|| {
+            crate::linalg::ordering::nested_dissection(
+                &asm.node_ptr,
+                &asm.node_adj,
+                &model.nodes,
+                &dofs.eq,
+                dofs.n_eq,
+            )
+        })
+    } else {
+        (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
+            crate::linalg::ordering::element_dissection(
+                &asm.node_ptr,
+                &asm.node_adj,
+                &model.nodes,
+                &elem_nodes[..model.elements.len()],
+                &dofs.eq,
+                dofs.n_eq,
+            )
+        })
+    };
+    let ordering_s = t_order.elapsed().as_secs_f64();
+    (ordering, ordering_s)
+}
+
+/// The continuum points' initial states: each element's first point (`gp_offset`), the
+/// material-point states, the Gauss outputs and, for a nonlinear model, the Gauss-geometry
+/// cache.
+#[allow(clippy::type_complexity)]
+fn initial_points(
+    model: &Model,
+    linear: bool,
+) -> (
+    Vec<usize>,
+    Staged<Vec<PointState>>,
+    Staged<Vec<GaussOutput>>,
+    Option<responses::GeometryCache>,
+) {
+    let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
+    // Sized at once: grown point by point, the states were copied ~twice over.
+    let mut committed = Vec::with_capacity(
+        model
+            .elements
+            .iter()
+            .map(|e| continuum::rule_points(e.kind, e.integration).len())
+            .sum(),
+    );
+    gp_offset.push(0);
+    for e in &model.elements {
+        let ngp = continuum::rule_points(e.kind, e.integration).len();
+        let mat = &model.materials[model.regions[e.region].material].law;
+        for _ in 0..ngp {
+            committed.push(mat.initial_state());
+        }
+        gp_offset.push(committed.len());
+    }
+    let n_gp = committed.len();
+    (
+        gp_offset,
+        Staged::new(committed),
+        Staged::new(vec![GaussOutput::default(); n_gp]),
+        (!linear).then(|| responses::GeometryCache::new(model)),
+    )
+}
+
+/// Embedded-bar points grouped by host element (stable: path order within an element) and
+/// each element's offset into them (`System::bar_gps`, `System::bar_offset`).
+fn bar_points(model: &Model) -> (Vec<(usize, usize)>, Vec<usize>) {
+    let mut bar_gps: Vec<(usize, usize)> = model
+        .bars
+        .iter()
+        .enumerate()
+        .flat_map(|(b, bar)| (0..bar.points.len()).map(move |p| (b, p)))
+        .collect();
+    bar_gps.sort_by_key(|&(b, p)| model.bars[b].points[p].element);
+    let mut bar_offset = vec![0; model.elements.len() + 1];
+    for &(b, p) in &bar_gps {
+        bar_offset[model.bars[b].points[p].element + 1] += 1;
+    }
+    for e in 0..model.elements.len() {
+        bar_offset[e + 1] += bar_offset[e];
+    }
+    (bar_gps, bar_offset)
+}
+
 impl<'m> System<'m> {
     /// Build dof map, pattern and initial states.
     pub fn new(model: &'m Model) -> Self {
@@ -366,66 +468,10 @@ impl<'m> System<'m> {
         let ((asm, ordering, ordering_s), (gp_offset, points, gauss, geometry)) = rayon::join(
             || {
                 let asm = Assembler::new(model.nodes.len(), &elem_nodes, &dofs);
-                let t_order = std::time::Instant::now();
-                // Nested dissection on large systems: on meshes of 4-node elements split
-                // along node coordinates; with Q8/Q9 elements (whose mid-side nodes a line
-                // through the nodes would cut off) split along element edges.
-                let all_q4 = model
-                    .elements
-                    .iter()
-                    .all(|e| e.kind == crate::model::QuadKind::Q4);
-                let ordering = if all_q4 {
-                    (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS).then(|| {
-                        crate::linalg::ordering::nested_dissection(
-                            &asm.node_ptr,
-                            &asm.node_adj,
-                            &model.nodes,
-                            &dofs.eq,
-                            dofs.n_eq,
-                        )
-                    })
-                } else {
-                    (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS_QUADRATIC).then(|| {
-                        crate::linalg::ordering::element_dissection(
-                            &asm.node_ptr,
-                            &asm.node_adj,
-                            &model.nodes,
-                            &elem_nodes[..model.elements.len()],
-                            &dofs.eq,
-                            dofs.n_eq,
-                        )
-                    })
-                };
-                let ordering_s = t_order.elapsed().as_secs_f64();
+                let (ordering, ordering_s) = equation_order(model, &asm, &elem_nodes, &dofs);
                 (asm, ordering, ordering_s)
             },
-            || {
-                let mut gp_offset = Vec::with_capacity(model.elements.len() + 1);
-                // Sized at once: grown point by point, the states were copied ~twice over.
-                let mut committed = Vec::with_capacity(
-                    model
-                        .elements
-                        .iter()
-                        .map(|e| continuum::rule_points(e.kind, e.integration).len())
-                        .sum(),
-                );
-                gp_offset.push(0);
-                for e in &model.elements {
-                    let ngp = continuum::rule_points(e.kind, e.integration).len();
-                    let mat = &model.materials[model.regions[e.region].material].law;
-                    for _ in 0..ngp {
-                        committed.push(mat.initial_state());
-                    }
-                    gp_offset.push(committed.len());
-                }
-                let n_gp = committed.len();
-                (
-                    gp_offset,
-                    Staged::new(committed),
-                    Staged::new(vec![GaussOutput::default(); n_gp]),
-                    (!linear).then(|| responses::GeometryCache::new(model)),
-                )
-            },
+            || initial_points(model, linear),
         );
         let interfaces: Vec<InterfaceElement> = model
             .interfaces
@@ -441,21 +487,7 @@ impl<'m> System<'m> {
             .zip(&model.interfaces)
             .map(|(el, i)| el.initial_states(&i.params))
             .collect();
-        // Bar points grouped by host element (stable: path order within an element).
-        let mut bar_gps: Vec<(usize, usize)> = model
-            .bars
-            .iter()
-            .enumerate()
-            .flat_map(|(b, bar)| (0..bar.points.len()).map(move |p| (b, p)))
-            .collect();
-        bar_gps.sort_by_key(|&(b, p)| model.bars[b].points[p].element);
-        let mut bar_offset = vec![0; model.elements.len() + 1];
-        for &(b, p) in &bar_gps {
-            bar_offset[model.bars[b].points[p].element + 1] += 1;
-        }
-        for e in 0..model.elements.len() {
-            bar_offset[e + 1] += bar_offset[e];
-        }
+        let (bar_gps, bar_offset) = bar_points(model);
         let n_bp = bar_gps.len();
         let n_tendons = model.tendons.len();
         let thermal = super::thermal::Thermal::new(model, &bar_gps);
