@@ -1,6 +1,7 @@
 //! The main job: read a model file, run its steps, write history, fields and a summary.
 
 use crate::analysis::failure::FailureReport;
+use crate::analysis::state::{DriverState, SystemState};
 use crate::analysis::steps::{
     self, AnalysisError, Observer, Snapshot, StepEnd, StopReason, Timings,
 };
@@ -532,31 +533,7 @@ pub fn run_file_opts(
             out.display()
         ))
     })?;
-    let (resume, failures, restarted_from_step) = match saved {
-        Some((_, cp)) => {
-            // The history goes on with the same columns, or not at all.
-            if let Some(r) = cp.recorder.rows.first() {
-                if r.monitors.len() != model.monitors.len()
-                    || r.factors.len() != model.load_cases.len()
-                {
-                    return Err(RunError::Restart(format!(
-                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
-                        path.display(),
-                        r.factors.len(),
-                        r.monitors.len(),
-                        model.load_cases.len(),
-                        model.monitors.len()
-                    )));
-                }
-            }
-            rec.restore(cp.recorder);
-            let from = cp.driver.next_step + 1;
-            // Without a saved state (the checkpoint before the first step) the run starts
-            // from the model's initial state, as a fresh run does.
-            (cp.system.map(|s| (cp.driver, s)), cp.failures, Some(from))
-        }
-        None => (None, Vec::new(), None),
-    };
+    let (resume, failures, restarted_from_step) = resume_from(saved, &mut rec, &model, path)?;
     let model_file = std::fs::canonicalize(path)
         .unwrap_or_else(|_| path.to_path_buf())
         .display()
@@ -635,46 +612,7 @@ pub fn run_file_opts(
     // History is written whatever happened: every converged increment is kept.
     rec.write_history()
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("history.csv").display())))?;
-    let stages = stage_results::stage_results(&model, &rec.rows, &rec.openings, &rec.lifted);
-    // Every lift-off and touch-down of a one-way support, staged model or not.
-    warnings.extend(
-        stage_results::support_events(&model, &rec.rows, &rec.lifted)
-            .into_iter()
-            .map(|(i, e)| format!("step '{}': {e}", model.steps[i].name)),
-    );
-    if timings.support_chatter > 0 {
-        warnings.push(format!(
-            "{} increments kept with one-way support statuses that still changed after {} rounds (a support point lifting off and touching down in turn): smaller increments settle them",
-            timings.support_chatter,
-            crate::analysis::one_way::MAX_ROUNDS
-        ));
-    }
-    if !stages.is_empty() {
-        let p = out.join("stages.csv");
-        write_atomic(&p, stage_results::render_csv(&stages).as_bytes())
-            .map_err(|e| RunError::Io(format!("{}: {e}", p.display())))?;
-    }
-    let final_monitors = rec
-        .rows
-        .last()
-        .map(|r| {
-            model
-                .monitors
-                .iter()
-                .map(|m| m.name.clone())
-                .zip(r.monitors.iter().copied())
-                .collect()
-        })
-        .unwrap_or_default();
-    let equations = crate::fem::dofs::DofMap::new(
-        model.nodes.len(),
-        &model
-            .supports
-            .iter()
-            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
-            .collect::<Vec<_>>(),
-    )
-    .n_eq;
+    let stages = stage_outputs(&model, &rec, &timings, out, &mut warnings)?;
     let (status, resume_step, error_text) =
         status_of(&error, &failures, &plausibility, &opts.caller_stop);
     let ultimate = watch.finish(
@@ -696,12 +634,12 @@ pub fn run_file_opts(
         failures,
         resume_step,
         restarted_from_step,
-        size: size_of(&model, equations),
+        size: size_of(&model, equation_count(&model)),
         wall_s: t0.elapsed().as_secs_f64(),
         input_s,
         timings,
         peak_memory_bytes: peak_memory(),
-        final_monitors,
+        final_monitors: final_monitors(&model, &rec.rows),
         monitors: monitor_info(&model),
         load_cases: load_case_info(&model),
         regions: model.regions.iter().map(|r| r.name.clone()).collect(),
@@ -937,6 +875,109 @@ fn open(
         digest,
         input_s,
     })
+}
+
+/// What a restart goes on from (`saved`: the checkpoint, whose history `rec` takes up):
+/// the driver and system state (None: from the model's initial state), the failures so
+/// far and the step it restarts from (1-based); all None and empty for a fresh run.
+#[allow(clippy::type_complexity)]
+fn resume_from(
+    saved: Option<(Origin, checkpoint::Checkpoint)>,
+    rec: &mut Recorder,
+    model: &Model,
+    path: &Path,
+) -> Result<
+    (
+        Option<(DriverState, SystemState)>,
+        Vec<FailureReport>,
+        Option<usize>,
+    ),
+    RunError,
+> {
+    Ok(match saved {
+        Some((_, cp)) => {
+            // The history goes on with the same columns, or not at all.
+            if let Some(r) = cp.recorder.rows.first() {
+                if r.monitors.len() != model.monitors.len()
+                    || r.factors.len() != model.load_cases.len()
+                {
+                    return Err(RunError::Restart(format!(
+                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
+                        path.display(),
+                        r.factors.len(),
+                        r.monitors.len(),
+                        model.load_cases.len(),
+                        model.monitors.len()
+                    )));
+                }
+            }
+            rec.restore(cp.recorder);
+            let from = cp.driver.next_step + 1;
+            // Without a saved state (the checkpoint before the first step) the run starts
+            // from the model's initial state, as a fresh run does.
+            (cp.system.map(|s| (cp.driver, s)), cp.failures, Some(from))
+        }
+        None => (None, Vec::new(), None),
+    })
+}
+
+/// Every monitor's name and value at the last history row (empty without rows).
+fn final_monitors(model: &Model, rows: &[crate::results::recorder::Row]) -> Vec<(String, f64)> {
+    rows.last()
+        .map(|r| {
+            model
+                .monitors
+                .iter()
+                .map(|m| m.name.clone())
+                .zip(r.monitors.iter().copied())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The number of equations of `model` (dofs less those its supports hold).
+fn equation_count(model: &Model) -> usize {
+    crate::fem::dofs::DofMap::new(
+        model.nodes.len(),
+        &model
+            .supports
+            .iter()
+            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+            .collect::<Vec<_>>(),
+    )
+    .n_eq
+}
+
+/// The per-stage results of the run (written to `out`/stages.csv when there are any), and
+/// the warnings of one-way supports: every lift-off and touch-down, and increments kept with
+/// statuses still changing.
+fn stage_outputs(
+    model: &Model,
+    rec: &Recorder,
+    timings: &Timings,
+    out: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<StageResult>, RunError> {
+    let stages = stage_results::stage_results(model, &rec.rows, &rec.openings, &rec.lifted);
+    // Every lift-off and touch-down of a one-way support, staged model or not.
+    warnings.extend(
+        stage_results::support_events(model, &rec.rows, &rec.lifted)
+            .into_iter()
+            .map(|(i, e)| format!("step '{}': {e}", model.steps[i].name)),
+    );
+    if timings.support_chatter > 0 {
+        warnings.push(format!(
+            "{} increments kept with one-way support statuses that still changed after {} rounds (a support point lifting off and touching down in turn): smaller increments settle them",
+            timings.support_chatter,
+            crate::analysis::one_way::MAX_ROUNDS
+        ));
+    }
+    if !stages.is_empty() {
+        let p = out.join("stages.csv");
+        write_atomic(&p, stage_results::render_csv(&stages).as_bytes())
+            .map_err(|e| RunError::Io(format!("{}: {e}", p.display())))?;
+    }
+    Ok(stages)
 }
 
 fn signal_name(s: i32) -> String {

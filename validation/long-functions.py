@@ -7,8 +7,8 @@ tests (the first `#[cfg(test)]` at column 0; a file under a `tests/` folder of s
 `tests.rs` is all test code and is skipped, as is everything after that line).
 
 A long function or file may carry its reason in a comment `// long: <reason>`: for a
-function on a line of the comments and attributes just above its `fn` line, for a file on
-any line before its tests. Such items are listed with their reason; the others are marked
+function on a line of the comments and attributes just above its `fn` line, for a file in
+the comment lines at its head. Such items are listed with their reason; the others are marked
 `NO REASON`. With --check the exit status is 1 when any item has no reason.
 
 It reads the source text only (no segfem, no compiler): braces are matched after string,
@@ -188,8 +188,11 @@ def main():
                 if end > args.file_lines:
                     reason = None
                     for line in lines[:end]:
-                        m = REASON_RE.search(line)
-                        if m and line.lstrip().startswith("//"):
+                        t = line.strip()
+                        if t and not t.startswith("//") and not t.startswith("#!["):
+                            break  # past the file's head
+                        m = REASON_RE.search(t)
+                        if m:
                             reason = m.group(1).strip()
                             break
                     files.append((end, rel, reason))

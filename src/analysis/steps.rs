@@ -24,6 +24,7 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
 
 /// Run the steps of the model with `options` (continue on failure, resume from a saved
 /// state), reporting to `obs`. Returns the timings.
+// long: the run loop threads the system, solver, load vectors, factors, clock and placed loads through every step, stage and influence table
 pub fn run_with(
     model: &Model,
     obs: &mut dyn Observer,
