@@ -1,6 +1,7 @@
 //! The main job: read a model file, run its steps, write history, fields and a summary.
 
 use crate::analysis::failure::FailureReport;
+use crate::analysis::state::{DriverState, SystemState};
 use crate::analysis::steps::{
     self, AnalysisError, Observer, Snapshot, StepEnd, StopReason, Timings,
 };
@@ -516,61 +517,15 @@ pub fn run_file_opts(
     opts: &RunOptions,
 ) -> Result<Summary, RunError> {
     let t0 = Instant::now();
-    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
-    // is locked once its input is valid (bad input writes nothing, not even a directory).
-    let mut lock = None;
-    if opts.restart && out.is_dir() {
-        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
-    }
-    let saved = if opts.restart {
-        Some(checkpoint::read(out).map_err(RunError::Restart)?)
-    } else {
-        None
-    };
-    let path: PathBuf = match (path, &saved) {
-        (Some(p), _) => p.to_path_buf(),
-        (None, Some((o, _))) => PathBuf::from(&o.model_file),
-        (None, None) => {
-            return Err(RunError::Restart(
-                "no model file given and no checkpoint to take it from".into(),
-            ))
-        }
-    };
+    let Opened {
+        path,
+        built,
+        saved,
+        lock: _lock, // held until the run returns
+        digest,
+        input_s,
+    } = open(path, out, opts, t0)?;
     let path = path.as_path();
-    let mut built = input::load(path)?;
-    built.model.controls.verbose = opts.verbose;
-    let digest = std::fs::read(path)
-        .map(|b| checkpoint::digest(&b))
-        .unwrap_or(0);
-    if let Some((o, _)) = &saved {
-        if o.model_digest != digest {
-            built.warnings.push(format!(
-                "{}: the model file changed since the checkpoint was written; the restarted run equals an uninterrupted one only if the steps already done are unchanged",
-                path.display()
-            ));
-        }
-    }
-    let input_s = t0.elapsed().as_secs_f64();
-    if lock.is_none() {
-        std::fs::create_dir_all(out).map_err(|e| {
-            RunError::Io(format!(
-                "{}: cannot create the output directory: {e}",
-                out.display()
-            ))
-        })?;
-        lock = Some(lock::acquire(out, path).map_err(RunError::Busy)?);
-    }
-    // Held until the run returns (dropped with this binding).
-    let _lock = lock;
-    if saved.is_none() {
-        let n = clear_stale(out)?;
-        if n > 0 {
-            built.warnings.push(format!(
-                "{}: removed {n} files of an earlier run (history.csv, stages.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
-                out.display()
-            ));
-        }
-    }
     let model = built.model;
     let mut rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
         RunError::Io(format!(
@@ -578,31 +533,7 @@ pub fn run_file_opts(
             out.display()
         ))
     })?;
-    let (resume, failures, restarted_from_step) = match saved {
-        Some((_, cp)) => {
-            // The history goes on with the same columns, or not at all.
-            if let Some(r) = cp.recorder.rows.first() {
-                if r.monitors.len() != model.monitors.len()
-                    || r.factors.len() != model.load_cases.len()
-                {
-                    return Err(RunError::Restart(format!(
-                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
-                        path.display(),
-                        r.factors.len(),
-                        r.monitors.len(),
-                        model.load_cases.len(),
-                        model.monitors.len()
-                    )));
-                }
-            }
-            rec.restore(cp.recorder);
-            let from = cp.driver.next_step + 1;
-            // Without a saved state (the checkpoint before the first step) the run starts
-            // from the model's initial state, as a fresh run does.
-            (cp.system.map(|s| (cp.driver, s)), cp.failures, Some(from))
-        }
-        None => (None, Vec::new(), None),
-    };
+    let (resume, failures, restarted_from_step) = resume_from(saved, &mut rec, &model, path)?;
     let model_file = std::fs::canonicalize(path)
         .unwrap_or_else(|_| path.to_path_buf())
         .display()
@@ -681,47 +612,62 @@ pub fn run_file_opts(
     // History is written whatever happened: every converged increment is kept.
     rec.write_history()
         .map_err(|e| RunError::Io(format!("{}: {e}", out.join("history.csv").display())))?;
-    let stages = stage_results::stage_results(&model, &rec.rows, &rec.openings, &rec.lifted);
-    // Every lift-off and touch-down of a one-way support, staged model or not.
-    warnings.extend(
-        stage_results::support_events(&model, &rec.rows, &rec.lifted)
-            .into_iter()
-            .map(|(i, e)| format!("step '{}': {e}", model.steps[i].name)),
+    let stages = stage_outputs(&model, &rec, &timings, out, &mut warnings)?;
+    let (status, resume_step, error_text) =
+        status_of(&error, &failures, &plausibility, &opts.caller_stop);
+    let ultimate = watch.finish(
+        &model,
+        !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
-    if timings.support_chatter > 0 {
-        warnings.push(format!(
-            "{} increments kept with one-way support statuses that still changed after {} rounds (a support point lifting off and touching down in turn): smaller increments settle them",
-            timings.support_chatter,
-            crate::analysis::one_way::MAX_ROUNDS
-        ));
+    let strength_exceeded = watch.strength_findings(&model);
+    warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
+    warnings.extend(strength_exceeded.iter().map(|f| f.text.clone()));
+    warnings.extend(sustained);
+    if error.is_some() || !failures.is_empty() {
+        // A failed or stopped run says why it failed; the findings still go with it.
+        warnings.extend(plausibility.iter().cloned());
     }
-    if !stages.is_empty() {
-        let p = out.join("stages.csv");
-        write_atomic(&p, stage_results::render_csv(&stages).as_bytes())
-            .map_err(|e| RunError::Io(format!("{}: {e}", p.display())))?;
-    }
-    let final_monitors = rec
-        .rows
-        .last()
-        .map(|r| {
-            model
-                .monitors
-                .iter()
-                .map(|m| m.name.clone())
-                .zip(r.monitors.iter().copied())
-                .collect()
-        })
-        .unwrap_or_default();
-    let equations = crate::fem::dofs::DofMap::new(
-        model.nodes.len(),
-        &model
-            .supports
-            .iter()
-            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
-            .collect::<Vec<_>>(),
-    )
-    .n_eq;
-    let (status, resume_step) = match &error {
+    let summary = Summary {
+        title: model.title.clone(),
+        status: status.into(),
+        error: error_text.clone(),
+        failures,
+        resume_step,
+        restarted_from_step,
+        size: size_of(&model, equation_count(&model)),
+        wall_s: t0.elapsed().as_secs_f64(),
+        input_s,
+        timings,
+        peak_memory_bytes: peak_memory(),
+        final_monitors: final_monitors(&model, &rec.rows),
+        monitors: monitor_info(&model),
+        load_cases: load_case_info(&model),
+        regions: model.regions.iter().map(|r| r.name.clone()).collect(),
+        joints: model.joints.iter().map(|j| j.name.clone()).collect(),
+        stages,
+        ultimate,
+        plausibility,
+        strength_exceeded,
+        design_checks,
+        influence,
+        warnings,
+    };
+    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    write_atomic(&out.join("summary.json"), json.as_bytes())
+        .map_err(|e| RunError::Io(format!("{}: {e}", out.join("summary.json").display())))?;
+    outcome(error, summary, error_text, path, out, opts)
+}
+
+/// The run's status word (summary.json `status`), the step a restart continues with, and
+/// the error text of summary.json, from how the analysis ended (`error`), the steps that
+/// did not converge (`failures`) and the plausibility findings.
+fn status_of(
+    error: &Option<AnalysisError>,
+    failures: &[FailureReport],
+    plausibility: &[String],
+    caller_stop: &Option<Arc<std::sync::Mutex<Option<String>>>>,
+) -> (&'static str, Option<usize>, Option<String>) {
+    let (status, resume_step) = match error {
         None if failures.is_empty() && !plausibility.is_empty() => ("implausible", None),
         None if failures.is_empty() => ("completed", None),
         None | Some(AnalysisError::NotConverged(_)) => ("failed", None),
@@ -738,7 +684,7 @@ pub fn run_file_opts(
         ),
         Some(_) => ("failed", None),
     };
-    let error_text = match (&error, failures.len()) {
+    let error_text = match (error, failures.len()) {
         (
             Some(
                 e @ AnalysisError::Stopped {
@@ -749,7 +695,7 @@ pub fn run_file_opts(
             _,
         ) => Some(format!(
             "{e}: {}",
-            caller_reason(&opts.caller_stop).unwrap_or_default()
+            caller_reason(caller_stop).unwrap_or_default()
         )),
         (Some(e), _) => Some(e.to_string()),
         (None, 0) if !plausibility.is_empty() => Some(format!(
@@ -771,46 +717,19 @@ pub fn run_file_opts(
                 .join("\n")
         )),
     };
-    let ultimate = watch.finish(
-        &model,
-        !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
-    );
-    let strength_exceeded = watch.strength_findings(&model);
-    warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
-    warnings.extend(strength_exceeded.iter().map(|f| f.text.clone()));
-    warnings.extend(sustained);
-    if error.is_some() || !failures.is_empty() {
-        // A failed or stopped run says why it failed; the findings still go with it.
-        warnings.extend(plausibility.iter().cloned());
-    }
-    let summary = Summary {
-        title: model.title.clone(),
-        status: status.into(),
-        error: error_text.clone(),
-        failures,
-        resume_step,
-        restarted_from_step,
-        size: size_of(&model, equations),
-        wall_s: t0.elapsed().as_secs_f64(),
-        input_s,
-        timings,
-        peak_memory_bytes: peak_memory(),
-        final_monitors,
-        monitors: monitor_info(&model),
-        load_cases: load_case_info(&model),
-        regions: model.regions.iter().map(|r| r.name.clone()).collect(),
-        joints: model.joints.iter().map(|j| j.name.clone()).collect(),
-        stages,
-        ultimate,
-        plausibility,
-        strength_exceeded,
-        design_checks,
-        influence,
-        warnings,
-    };
-    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
-    write_atomic(&out.join("summary.json"), json.as_bytes())
-        .map_err(|e| RunError::Io(format!("{}: {e}", out.join("summary.json").display())))?;
+    (status, resume_step, error_text)
+}
+
+/// What `run_file_opts` returns once summary.json is written: the summary, or the error
+/// that says how the run ended (model file `path`, output directory `out`).
+fn outcome(
+    error: Option<AnalysisError>,
+    summary: Summary,
+    error_text: Option<String>,
+    path: &Path,
+    out: &Path,
+    opts: &RunOptions,
+) -> Result<Summary, RunError> {
     let file = path.display();
     match error {
         None if summary.failures.is_empty() && !summary.plausibility.is_empty() => {
@@ -870,6 +789,195 @@ pub fn run_file_opts(
         Some(AnalysisError::Restore(m)) => Err(RunError::Restart(format!("{file}: {m}"))),
         Some(AnalysisError::Output(e)) => Err(RunError::Io(format!("{}: {e}", out.display()))),
     }
+}
+
+/// A run's start: the model file read and checked, a restart's checkpoint, the output
+/// directory locked and, for a fresh run, cleared of an earlier run's files.
+struct Opened {
+    /// The model file (given, or the one the checkpoint names).
+    path: PathBuf,
+    /// The built model and its warnings.
+    built: input::Built,
+    /// A restart's checkpoint.
+    saved: Option<(Origin, checkpoint::Checkpoint)>,
+    /// The output directory's lock, held until the run returns.
+    lock: Option<lock::DirLock>,
+    /// Digest of the model file's bytes (0 if unreadable).
+    digest: u64,
+    /// Time to read and check the input [s].
+    input_s: f64,
+}
+
+/// Open a run as [`run_file_opts`] does (`t0`: when the run started).
+fn open(
+    path: Option<&Path>,
+    out: &Path,
+    opts: &RunOptions,
+    t0: Instant,
+) -> Result<Opened, RunError> {
+    // A restart's directory holds the checkpoint: locked before it is read. A fresh run's
+    // is locked once its input is valid (bad input writes nothing, not even a directory).
+    let mut lock = None;
+    if opts.restart && out.is_dir() {
+        lock = Some(lock::acquire(out, path.unwrap_or(Path::new("?"))).map_err(RunError::Busy)?);
+    }
+    let saved = if opts.restart {
+        Some(checkpoint::read(out).map_err(RunError::Restart)?)
+    } else {
+        None
+    };
+    let path_buf: PathBuf = match (path, &saved) {
+        (Some(p), _) => p.to_path_buf(),
+        (None, Some((o, _))) => PathBuf::from(&o.model_file),
+        (None, None) => {
+            return Err(RunError::Restart(
+                "no model file given and no checkpoint to take it from".into(),
+            ))
+        }
+    };
+    let mut built = input::load(&path_buf)?;
+    built.model.controls.verbose = opts.verbose;
+    let digest = std::fs::read(&path_buf)
+        .map(|b| checkpoint::digest(&b))
+        .unwrap_or(0);
+    if let Some((o, _)) = &saved {
+        if o.model_digest != digest {
+            built.warnings.push(format!(
+                "{}: the model file changed since the checkpoint was written; the restarted run equals an uninterrupted one only if the steps already done are unchanged",
+                path_buf.display()
+            ));
+        }
+    }
+    let input_s = t0.elapsed().as_secs_f64();
+    if lock.is_none() {
+        std::fs::create_dir_all(out).map_err(|e| {
+            RunError::Io(format!(
+                "{}: cannot create the output directory: {e}",
+                out.display()
+            ))
+        })?;
+        lock = Some(lock::acquire(out, &path_buf).map_err(RunError::Busy)?);
+    }
+    if saved.is_none() {
+        let n = clear_stale(out)?;
+        if n > 0 {
+            built.warnings.push(format!(
+                "{}: removed {n} files of an earlier run (history.csv, stages.csv, results.pvd, .vtu fields, summary.json, checkpoint, report.html); other files are kept",
+                out.display()
+            ));
+        }
+    }
+    Ok(Opened {
+        path: path_buf,
+        built,
+        saved,
+        lock,
+        digest,
+        input_s,
+    })
+}
+
+/// What a restart goes on from (`saved`: the checkpoint, whose history `rec` takes up):
+/// the driver and system state (None: from the model's initial state), the failures so
+/// far and the step it restarts from (1-based); all None and empty for a fresh run.
+#[allow(clippy::type_complexity)]
+fn resume_from(
+    saved: Option<(Origin, checkpoint::Checkpoint)>,
+    rec: &mut Recorder,
+    model: &Model,
+    path: &Path,
+) -> Result<
+    (
+        Option<(DriverState, SystemState)>,
+        Vec<FailureReport>,
+        Option<usize>,
+    ),
+    RunError,
+> {
+    Ok(match saved {
+        Some((_, cp)) => {
+            // The history goes on with the same columns, or not at all.
+            if let Some(r) = cp.recorder.rows.first() {
+                if r.monitors.len() != model.monitors.len()
+                    || r.factors.len() != model.load_cases.len()
+                {
+                    return Err(RunError::Restart(format!(
+                        "{}: the checkpoint's history has {} load cases and {} monitors, the model {} and {}: the model changed since the checkpoint was written",
+                        path.display(),
+                        r.factors.len(),
+                        r.monitors.len(),
+                        model.load_cases.len(),
+                        model.monitors.len()
+                    )));
+                }
+            }
+            rec.restore(cp.recorder);
+            let from = cp.driver.next_step + 1;
+            // Without a saved state (the checkpoint before the first step) the run starts
+            // from the model's initial state, as a fresh run does.
+            (cp.system.map(|s| (cp.driver, s)), cp.failures, Some(from))
+        }
+        None => (None, Vec::new(), None),
+    })
+}
+
+/// Every monitor's name and value at the last history row (empty without rows).
+fn final_monitors(model: &Model, rows: &[crate::results::recorder::Row]) -> Vec<(String, f64)> {
+    rows.last()
+        .map(|r| {
+            model
+                .monitors
+                .iter()
+                .map(|m| m.name.clone())
+                .zip(r.monitors.iter().copied())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The number of equations of `model` (dofs less those its supports hold).
+fn equation_count(model: &Model) -> usize {
+    crate::fem::dofs::DofMap::new(
+        model.nodes.len(),
+        &model
+            .supports
+            .iter()
+            .flat_map(|s| s.dofs.iter().map(|(n, d, v)| (2 * n + d.index(), *v)))
+            .collect::<Vec<_>>(),
+    )
+    .n_eq
+}
+
+/// The per-stage results of the run (written to `out`/stages.csv when there are any), and
+/// the warnings of one-way supports: every lift-off and touch-down, and increments kept with
+/// statuses still changing.
+fn stage_outputs(
+    model: &Model,
+    rec: &Recorder,
+    timings: &Timings,
+    out: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<StageResult>, RunError> {
+    let stages = stage_results::stage_results(model, &rec.rows, &rec.openings, &rec.lifted);
+    // Every lift-off and touch-down of a one-way support, staged model or not.
+    warnings.extend(
+        stage_results::support_events(model, &rec.rows, &rec.lifted)
+            .into_iter()
+            .map(|(i, e)| format!("step '{}': {e}", model.steps[i].name)),
+    );
+    if timings.support_chatter > 0 {
+        warnings.push(format!(
+            "{} increments kept with one-way support statuses that still changed after {} rounds (a support point lifting off and touching down in turn): smaller increments settle them",
+            timings.support_chatter,
+            crate::analysis::one_way::MAX_ROUNDS
+        ));
+    }
+    if !stages.is_empty() {
+        let p = out.join("stages.csv");
+        write_atomic(&p, stage_results::render_csv(&stages).as_bytes())
+            .map_err(|e| RunError::Io(format!("{}: {e}", p.display())))?;
+    }
+    Ok(stages)
 }
 
 fn signal_name(s: i32) -> String {

@@ -13,6 +13,7 @@ mod newton;
 pub mod one_way;
 pub mod path;
 mod responses;
+mod scatter;
 pub mod staged;
 pub mod stages;
 pub mod state;

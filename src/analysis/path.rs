@@ -646,6 +646,7 @@ struct ArcIncrement {
     iterations: usize,
 }
 
+// long: the arc-length loop keeps its own arc, pair and one-way state (its end is found on the way, so it is no `increments::Stepper`); sizing is `ArcSizing`, the arc itself `arc_increment`
 fn arc_length_step(
     ctx: &mut PathContext,
     si: usize,

@@ -10,7 +10,7 @@ use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{self, external_forces, Controller, Growth, PairNorm};
 use super::loads::load_vector;
 use super::newton::newton;
-use super::state::DriverState;
+use super::state::{DriverState, SystemState};
 use super::system::System;
 use crate::linalg::solver::{SolverError, SparseCholesky};
 use crate::materials::point::TimeContext;
@@ -24,6 +24,7 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<Timings, AnalysisErr
 
 /// Run the steps of the model with `options` (continue on failure, resume from a saved
 /// state), reporting to `obs`. Returns the timings.
+// long: the run loop threads the system, solver, load vectors, factors, clock and placed loads through every step, stage and influence table
 pub fn run_with(
     model: &Model,
     obs: &mut dyn Observer,
@@ -41,47 +42,14 @@ pub fn run_with(
     // The ordering is part of the symbolic analysis, wherever it is computed.
     solver.stats.symbolic_s += sys.ordering_s;
     let mut timings = Timings::default();
-    // Analysis clock [d]: steps before the first time step act at its start.
-    let mut driver = DriverState {
-        next_step: 0,
-        factors: vec![0.0; model.load_cases.len()],
-        clock: model
-            .steps
-            .iter()
-            .find_map(|s| s.time.map(|t| t.from))
-            .unwrap_or(DEFAULT_START_DAY),
-        neg_pivots: 0,
-        solver_negative_pivots: 0,
-        increments: 0,
-        iterations: 0,
-        limit_points: Vec::new(),
-    };
-    match options.resume {
-        Some((d, s)) => {
-            if d.factors.len() != driver.factors.len() || d.next_step > model.steps.len() {
-                return Err(AnalysisError::Restore(format!(
-                    "the checkpoint has {} load cases and {} steps done, the model {} load cases and {} steps: the model changed since the checkpoint was written",
-                    d.factors.len(),
-                    d.next_step,
-                    driver.factors.len(),
-                    model.steps.len()
-                )));
-            }
-            sys.restore(s).map_err(AnalysisError::Restore)?;
-            // The checkpoint leaves the elastic points' outputs out.
-            sys.recover_elastic_outputs(&d.factors)
-                .map_err(AnalysisError::Restore)?;
-            solver.negative_pivots = d.solver_negative_pivots;
-            timings.increments = d.increments;
-            timings.iterations = d.iterations;
-            timings.limit_points = d.limit_points.clone();
-            driver = d;
-        }
-        None => obs.step_end(&StepEnd {
-            system: &sys,
-            driver: &driver,
-        })?,
-    }
+    let mut driver = start(
+        model,
+        &mut sys,
+        &mut solver,
+        &mut timings,
+        obs,
+        options.resume,
+    )?;
     timings.setup_s = t0.elapsed().as_secs_f64();
     let mut factors = driver.factors.clone();
     let mut neg_pivots = driver.neg_pivots;
@@ -94,16 +62,6 @@ pub fn run_with(
     let mut factored_linear = false;
     // Load cases given their loads by influence lines (`[[influence.place]]`).
     let mut placed: Vec<(usize, Vec<f64>)> = Vec::new();
-    if let Some(inf) = model
-        .influence
-        .iter()
-        .find(|i| !i.place.is_empty() && i.after_step < driver.next_step)
-    {
-        return Err(AnalysisError::Restore(format!(
-            "influence '{}' placed load case '{}' after step '{}', which the checkpoint has done; restart from a checkpoint before it",
-            inf.name, model.load_cases[inf.place[0].case].name, model.steps[inf.after_step].name
-        )));
-    }
     for si in driver.next_step..model.steps.len() {
         let step = &model.steps[si];
         if sys.stages.is_some() {
@@ -224,6 +182,72 @@ pub fn run_with(
     }
     timings.solver = solver.stats.clone();
     Ok(timings)
+}
+
+/// The driver state the run starts from: the model's initial state (reported to `obs` as
+/// the end of "step 0"), or a checkpoint's (`resume`: its driver state and system state,
+/// restored into `sys`, `solver` and `timings`). A checkpoint past an influence table that
+/// places load cases is refused: the placed loads are not saved.
+fn start(
+    model: &Model,
+    sys: &mut System,
+    solver: &mut SparseCholesky,
+    timings: &mut Timings,
+    obs: &mut dyn Observer,
+    resume: Option<(DriverState, SystemState)>,
+) -> Result<DriverState, AnalysisError> {
+    // Analysis clock [d]: steps before the first time step act at its start.
+    let mut driver = DriverState {
+        next_step: 0,
+        factors: vec![0.0; model.load_cases.len()],
+        clock: model
+            .steps
+            .iter()
+            .find_map(|s| s.time.map(|t| t.from))
+            .unwrap_or(DEFAULT_START_DAY),
+        neg_pivots: 0,
+        solver_negative_pivots: 0,
+        increments: 0,
+        iterations: 0,
+        limit_points: Vec::new(),
+    };
+    match resume {
+        Some((d, s)) => {
+            if d.factors.len() != driver.factors.len() || d.next_step > model.steps.len() {
+                return Err(AnalysisError::Restore(format!(
+                    "the checkpoint has {} load cases and {} steps done, the model {} load cases and {} steps: the model changed since the checkpoint was written",
+                    d.factors.len(),
+                    d.next_step,
+                    driver.factors.len(),
+                    model.steps.len()
+                )));
+            }
+            sys.restore(s).map_err(AnalysisError::Restore)?;
+            // The checkpoint leaves the elastic points' outputs out.
+            sys.recover_elastic_outputs(&d.factors)
+                .map_err(AnalysisError::Restore)?;
+            solver.negative_pivots = d.solver_negative_pivots;
+            timings.increments = d.increments;
+            timings.iterations = d.iterations;
+            timings.limit_points = d.limit_points.clone();
+            driver = d;
+        }
+        None => obs.step_end(&StepEnd {
+            system: sys,
+            driver: &driver,
+        })?,
+    }
+    if let Some(inf) = model
+        .influence
+        .iter()
+        .find(|i| !i.place.is_empty() && i.after_step < driver.next_step)
+    {
+        return Err(AnalysisError::Restore(format!(
+            "influence '{}' placed load case '{}' after step '{}', which the checkpoint has done; restart from a checkpoint before it",
+            inf.name, model.load_cases[inf.place[0].case].name, model.steps[inf.after_step].name
+        )));
+    }
+    Ok(driver)
 }
 
 /// Run one load, linear or time step: increments of the load-case factors (and of the clock

@@ -116,6 +116,7 @@ fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
 /// Force and condensed tangent of a Q4 with incompatible modes; arguments as
 /// [`super::continuum::response_at`].
 #[allow(clippy::too_many_arguments)]
+// long: the local Newton on the modes α and the static condensation share the per-point stresses and tangents it fills; split, they would pass them all
 pub fn response_at(
     coords: &[[f64; 2]],
     thickness: f64,

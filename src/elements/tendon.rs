@@ -509,52 +509,10 @@ impl ExternalTendon {
                 for i in 0..m {
                     dndl[i * m + i] = kdiag[i];
                 }
-                if !active.is_empty() {
-                    let na = active.len();
-                    // G (na × m) and C_a (m × na).
-                    let mut g = vec![0.0; na * m];
-                    let mut ca = vec![0.0; m * na];
-                    for (r, &j) in active.iter().enumerate() {
-                        let dev = j + 1; // deviator point index; spans dev−1 (left), dev (right)
-                        let ratio = (mu * self.deviation[j]).exp();
-                        if ratio != 1.0 {
-                            symmetric = false;
-                        }
-                        let (a, b) = if slipping[j] > 0 {
-                            (1.0, ratio)
-                        } else {
-                            (ratio, 1.0)
-                        };
-                        g[r * m + dev - 1] = a;
-                        g[r * m + dev] = -b;
-                        // s_j enters span dev−1 with −1/L and span dev with +1/L (×L in D).
-                        ca[(dev - 1) * na + r] = -1.0;
-                        ca[dev * na + r] = 1.0;
-                    }
-                    // GD (na × m), GDC (na × na).
-                    let gd: Vec<f64> = (0..na * m).map(|x| g[x] * kdiag[x % m]).collect();
-                    let mut gdc = vec![0.0; na * na];
-                    for r in 0..na {
-                        for c in 0..na {
-                            gdc[r * na + c] = (0..m).map(|i| gd[r * m + i] * ca[i * na + c]).sum();
-                        }
-                    }
-                    // X = (GDC)⁻¹ GD  (na × m), column by column.
-                    let mut x = vec![0.0; na * m];
-                    for col in 0..m {
-                        let rhs: Vec<f64> = (0..na).map(|r| gd[r * m + col]).collect();
-                        let sol = dense_solve(gdc.clone(), rhs);
-                        for r in 0..na {
-                            x[r * m + col] = sol[r];
-                        }
-                    }
-                    // dN/dℓ = D − D C_a X.
-                    for i in 0..m {
-                        for k in 0..m {
-                            let cx: f64 = (0..na).map(|r| ca[i * na + r] * x[r * m + k]).sum();
-                            dndl[i * m + k] -= kdiag[i] * cx;
-                        }
-                    }
+                if !active.is_empty()
+                    && !self.condense_slips(mu, &active, &slipping, &kdiag, &mut dndl)
+                {
+                    symmetric = false;
                 }
                 for i in 0..m {
                     spans.push(SpanState {
@@ -567,52 +525,7 @@ impl ExternalTendon {
                 }
             }
         }
-        // Assembly.
-        let nd = 2 * np;
-        let mut f = vec![0.0; nd];
-        let mut k = vec![0.0; nd * nd];
-        // b_i: −e_i at point i, +e_i at point i+1.
-        let bvec = |i: usize| -> Vec<(usize, f64)> {
-            vec![
-                (2 * i, -dir[i][0]),
-                (2 * i + 1, -dir[i][1]),
-                (2 * i + 2, dir[i][0]),
-                (2 * i + 3, dir[i][1]),
-            ]
-        };
-        for i in 0..m {
-            let n = spans[i].force;
-            for (a, v) in bvec(i) {
-                f[a] += n * v;
-            }
-            for kk in 0..m {
-                let c = dndl[i * m + kk];
-                if c == 0.0 {
-                    continue;
-                }
-                for (a, va) in bvec(i) {
-                    for (b, vb) in bvec(kk) {
-                        k[a * nd + b] += va * c * vb;
-                    }
-                }
-            }
-            // Geometric stiffness N/ℓ (I − e eᵀ) on [−I, I].
-            let e = dir[i];
-            let p = [
-                [1.0 - e[0] * e[0], -e[0] * e[1]],
-                [-e[0] * e[1], 1.0 - e[1] * e[1]],
-            ];
-            let g = n / len[i];
-            for (pa, sa) in [(i, -1.0), (i + 1, 1.0)] {
-                for (pb, sb) in [(i, -1.0), (i + 1, 1.0)] {
-                    for da in 0..2 {
-                        for db in 0..2 {
-                            k[(2 * pa + da) * nd + 2 * pb + db] += sa * sb * g * p[da][db];
-                        }
-                    }
-                }
-            }
-        }
+        let (f, k) = span_assembly(&dir, &len, &spans, &dndl);
         TendonResponse {
             f_int: f,
             k,
@@ -623,6 +536,68 @@ impl ExternalTendon {
                 slipping,
             },
         }
+    }
+
+    /// The tangent dN/dℓ = D (I − C_a (G D C_a)⁻¹ G D) of friction deviators with the
+    /// slipping deviators `active` (`slipping`: their directions): `dndl` holds D (the span
+    /// stiffnesses `kdiag` [N/m] on its diagonal) on entry. Returns whether it stayed
+    /// symmetric (no capstan ratio other than 1).
+    fn condense_slips(
+        &self,
+        mu: f64,
+        active: &[usize],
+        slipping: &[i8],
+        kdiag: &[f64],
+        dndl: &mut [f64],
+    ) -> bool {
+        let m = kdiag.len();
+        let mut symmetric = true;
+        let na = active.len();
+        // G (na × m) and C_a (m × na).
+        let mut g = vec![0.0; na * m];
+        let mut ca = vec![0.0; m * na];
+        for (r, &j) in active.iter().enumerate() {
+            let dev = j + 1; // deviator point index; spans dev−1 (left), dev (right)
+            let ratio = (mu * self.deviation[j]).exp();
+            if ratio != 1.0 {
+                symmetric = false;
+            }
+            let (a, b) = if slipping[j] > 0 {
+                (1.0, ratio)
+            } else {
+                (ratio, 1.0)
+            };
+            g[r * m + dev - 1] = a;
+            g[r * m + dev] = -b;
+            // s_j enters span dev−1 with −1/L and span dev with +1/L (×L in D).
+            ca[(dev - 1) * na + r] = -1.0;
+            ca[dev * na + r] = 1.0;
+        }
+        // GD (na × m), GDC (na × na).
+        let gd: Vec<f64> = (0..na * m).map(|x| g[x] * kdiag[x % m]).collect();
+        let mut gdc = vec![0.0; na * na];
+        for r in 0..na {
+            for c in 0..na {
+                gdc[r * na + c] = (0..m).map(|i| gd[r * m + i] * ca[i * na + c]).sum();
+            }
+        }
+        // X = (GDC)⁻¹ GD  (na × m), column by column.
+        let mut x = vec![0.0; na * m];
+        for col in 0..m {
+            let rhs: Vec<f64> = (0..na).map(|r| gd[r * m + col]).collect();
+            let sol = dense_solve(gdc.clone(), rhs);
+            for r in 0..na {
+                x[r * m + col] = sol[r];
+            }
+        }
+        // dN/dℓ = D − D C_a X.
+        for i in 0..m {
+            for k in 0..m {
+                let cx: f64 = (0..na).map(|r| ca[i * na + r] * x[r * m + k]).sum();
+                dndl[i * m + k] -= kdiag[i] * cx;
+            }
+        }
+        symmetric
     }
 
     /// Capstan stick/slip return mapping: returns slips, slip flags and per span
@@ -762,6 +737,65 @@ fn capstan_residual(
             (a * area * st[j].0 - b * area * st[j + 1].0).abs()
         })
         .fold(0.0, f64::max)
+}
+
+/// Internal forces and tangent [N, N/m] of a tendon's points (x, y per point) from its
+/// spans: unit directions `dir`, current lengths `len` [m], span forces (`spans`) and
+/// dN/dℓ (`dndl`, m × m row-major, N/m), with the geometric stiffness N/ℓ (I − e eᵀ).
+fn span_assembly(
+    dir: &[[f64; 2]],
+    len: &[f64],
+    spans: &[SpanState],
+    dndl: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let m = len.len();
+    let np = m + 1;
+    let nd = 2 * np;
+    let mut f = vec![0.0; nd];
+    let mut k = vec![0.0; nd * nd];
+    // b_i: −e_i at point i, +e_i at point i+1.
+    let bvec = |i: usize| -> Vec<(usize, f64)> {
+        vec![
+            (2 * i, -dir[i][0]),
+            (2 * i + 1, -dir[i][1]),
+            (2 * i + 2, dir[i][0]),
+            (2 * i + 3, dir[i][1]),
+        ]
+    };
+    for i in 0..m {
+        let n = spans[i].force;
+        for (a, v) in bvec(i) {
+            f[a] += n * v;
+        }
+        for kk in 0..m {
+            let c = dndl[i * m + kk];
+            if c == 0.0 {
+                continue;
+            }
+            for (a, va) in bvec(i) {
+                for (b, vb) in bvec(kk) {
+                    k[a * nd + b] += va * c * vb;
+                }
+            }
+        }
+        // Geometric stiffness N/ℓ (I − e eᵀ) on [−I, I].
+        let e = dir[i];
+        let p = [
+            [1.0 - e[0] * e[0], -e[0] * e[1]],
+            [-e[0] * e[1], 1.0 - e[1] * e[1]],
+        ];
+        let g = n / len[i];
+        for (pa, sa) in [(i, -1.0), (i + 1, 1.0)] {
+            for (pb, sb) in [(i, -1.0), (i + 1, 1.0)] {
+                for da in 0..2 {
+                    for db in 0..2 {
+                        k[(2 * pa + da) * nd + 2 * pb + db] += sa * sb * g * p[da][db];
+                    }
+                }
+            }
+        }
+    }
+    (f, k)
 }
 
 /// Dense Gaussian elimination with partial pivoting (small systems: active deviators).

@@ -209,6 +209,7 @@ pub struct SplitCholesky {
 impl SplitCholesky {
     /// The split analysis of `pattern` eliminated in the order `order` (`inverse`: its
     /// inverse), or None when the order has no top-level split.
+    // long: one pass over the pattern building both halves' border matrices and the separator block from the same transpose
     pub fn new(
         pattern: &LowerPattern,
         order: &[usize],

@@ -441,145 +441,7 @@ impl<'m> Recorder<'m> {
         let model = self.model;
         let ready = self.prepared.take().and_then(|p| p.take());
         let (buffer, file) = ready.map_or((Vec::new(), None), |r| (r.buffer, r.file));
-        let f = recover(snap.system);
-        let cells: Vec<&[usize]> = model.elements.iter().map(|e| e.nodes.as_slice()).collect();
-        let types: Vec<u8> = model
-            .elements
-            .iter()
-            .map(|e| e.kind.vtk_cell_type())
-            .collect();
-        let disp: Vec<f64> = snap
-            .system
-            .u
-            .chunks(2)
-            .flat_map(|d| [d[0], d[1], 0.0])
-            .collect();
-        // The recovered fields' own memory, viewed flat (no copies: 24 MB at 5e5 dofs).
-        let ns = f.node_stress.as_flattened();
-        let ne = f.node_strain.as_flattened();
-        let np: Vec<f64> = f
-            .node_stress
-            .iter()
-            .flat_map(|s| {
-                let (a, b) = principal(s);
-                [a, b]
-            })
-            .collect();
-        let cs = f.cell_stress.as_flattened();
-        let ce = f.cell_strain.as_flattened();
-        let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
-        let mut reaction = vec![0.0; 3 * model.nodes.len()];
-        for s in &model.supports {
-            for &(n, d, _) in &s.dofs {
-                let k = 2 * n + d.index();
-                reaction[3 * n + d.index()] = snap.f_int[k] - snap.f_ext[k];
-            }
-        }
-        // The concrete state per cell only where a material can crack or crush: an elastic
-        // model's zeros would be a fifth of a large .vtu.
-        let concrete = (super::gauss_points::wanted(model)).then(|| {
-            let st = cell_states(snap);
-            // Unit normal of the widest crack of each cell, as a vector for ParaView glyphs
-            // (zero for uncracked cells); crack_angle holds the same in degrees from x.
-            let crack_normal: Vec<f64> = st
-                .angle
-                .iter()
-                .zip(&st.cracks)
-                .flat_map(|(deg, n)| {
-                    let t = deg.to_radians();
-                    if *n > 0 {
-                        [t.cos(), t.sin(), 0.0]
-                    } else {
-                        [0.0; 3]
-                    }
-                })
-                .collect();
-            (st, crack_normal)
-        });
-        let mut cell_data = vec![
-            Array::I32 {
-                name: "region",
-                values: &region,
-            },
-            Array::F64 {
-                name: "stress",
-                components: 3,
-                values: cs,
-            },
-            Array::F64 {
-                name: "strain",
-                components: 3,
-                values: ce,
-            },
-        ];
-        if let Some((st, crack_normal)) = &concrete {
-            cell_data.extend([
-                Array::I32 {
-                    name: "cracks",
-                    values: &st.cracks,
-                },
-                Array::F64 {
-                    name: "crack_angle",
-                    components: 1,
-                    values: &st.angle,
-                },
-                Array::F64 {
-                    name: "crack_strain",
-                    components: 1,
-                    values: &st.crack_strain,
-                },
-                Array::F64 {
-                    name: "crack_normal",
-                    components: 3,
-                    values: crack_normal,
-                },
-                Array::F64 {
-                    name: "plastic_strain",
-                    components: 1,
-                    values: &st.plastic,
-                },
-                Array::I32 {
-                    name: "crushed",
-                    values: &st.crushed,
-                },
-            ]);
-        }
-        let doc = render_into(
-            buffer,
-            &Grid {
-                points: &model.nodes,
-                cells: &cells,
-                types: &types,
-            },
-            &[
-                Array::F64 {
-                    name: "displacement",
-                    components: 3,
-                    values: &disp,
-                },
-                Array::F64 {
-                    name: "reaction",
-                    components: 3,
-                    values: &reaction,
-                },
-                Array::F64 {
-                    name: "stress",
-                    components: 3,
-                    values: ns,
-                },
-                Array::F64 {
-                    name: "principal_stress",
-                    components: 2,
-                    values: &np,
-                },
-                Array::F64 {
-                    name: "strain",
-                    components: 3,
-                    values: ne,
-                },
-            ],
-            &cell_data,
-        );
+        let (doc, disp) = continuum_vtu(model, snap, buffer);
         let tag = field_tag(model, snap.step);
         let name = format!("{tag}_inc{:04}.vtu", snap.increment);
         let mut files = vec![(self.dir.join(&name), doc)];
@@ -945,6 +807,153 @@ struct CellStates {
     plastic: Vec<f64>,
     /// Number of crushed points [-].
     crushed: Vec<i32>,
+}
+
+/// The .vtu document of the continuum of `model` at `snap` (nodal displacements, reactions, recovered
+/// stresses and strains; per cell the region, stresses, strains and, where a material can
+/// crack or crush, the concrete state), rendered into `buffer`, and the nodal displacements
+/// (x, y, 0) [m] the line cells reuse.
+fn continuum_vtu(model: &Model, snap: &Snapshot, buffer: Vec<u8>) -> (Vec<u8>, Vec<f64>) {
+    let f = recover(snap.system);
+    let cells: Vec<&[usize]> = model.elements.iter().map(|e| e.nodes.as_slice()).collect();
+    let types: Vec<u8> = model
+        .elements
+        .iter()
+        .map(|e| e.kind.vtk_cell_type())
+        .collect();
+    let disp: Vec<f64> = snap
+        .system
+        .u
+        .chunks(2)
+        .flat_map(|d| [d[0], d[1], 0.0])
+        .collect();
+    // The recovered fields' own memory, viewed flat (no copies: 24 MB at 5e5 dofs).
+    let ns = f.node_stress.as_flattened();
+    let ne = f.node_strain.as_flattened();
+    let np: Vec<f64> = f
+        .node_stress
+        .iter()
+        .flat_map(|s| {
+            let (a, b) = principal(s);
+            [a, b]
+        })
+        .collect();
+    let cs = f.cell_stress.as_flattened();
+    let ce = f.cell_strain.as_flattened();
+    let region: Vec<i32> = model.elements.iter().map(|e| e.region as i32).collect();
+    let mut reaction = vec![0.0; 3 * model.nodes.len()];
+    for s in &model.supports {
+        for &(n, d, _) in &s.dofs {
+            let k = 2 * n + d.index();
+            reaction[3 * n + d.index()] = snap.f_int[k] - snap.f_ext[k];
+        }
+    }
+    // The concrete state per cell only where a material can crack or crush: an elastic
+    // model's zeros would be a fifth of a large .vtu.
+    let concrete = (super::gauss_points::wanted(model)).then(|| {
+        let st = cell_states(snap);
+        // Unit normal of the widest crack of each cell, as a vector for ParaView glyphs
+        // (zero for uncracked cells); crack_angle holds the same in degrees from x.
+        let crack_normal: Vec<f64> = st
+            .angle
+            .iter()
+            .zip(&st.cracks)
+            .flat_map(|(deg, n)| {
+                let t = deg.to_radians();
+                if *n > 0 {
+                    [t.cos(), t.sin(), 0.0]
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
+        (st, crack_normal)
+    });
+    let mut cell_data = vec![
+        Array::I32 {
+            name: "region",
+            values: &region,
+        },
+        Array::F64 {
+            name: "stress",
+            components: 3,
+            values: cs,
+        },
+        Array::F64 {
+            name: "strain",
+            components: 3,
+            values: ce,
+        },
+    ];
+    if let Some((st, crack_normal)) = &concrete {
+        cell_data.extend([
+            Array::I32 {
+                name: "cracks",
+                values: &st.cracks,
+            },
+            Array::F64 {
+                name: "crack_angle",
+                components: 1,
+                values: &st.angle,
+            },
+            Array::F64 {
+                name: "crack_strain",
+                components: 1,
+                values: &st.crack_strain,
+            },
+            Array::F64 {
+                name: "crack_normal",
+                components: 3,
+                values: crack_normal,
+            },
+            Array::F64 {
+                name: "plastic_strain",
+                components: 1,
+                values: &st.plastic,
+            },
+            Array::I32 {
+                name: "crushed",
+                values: &st.crushed,
+            },
+        ]);
+    }
+    let doc = render_into(
+        buffer,
+        &Grid {
+            points: &model.nodes,
+            cells: &cells,
+            types: &types,
+        },
+        &[
+            Array::F64 {
+                name: "displacement",
+                components: 3,
+                values: &disp,
+            },
+            Array::F64 {
+                name: "reaction",
+                components: 3,
+                values: &reaction,
+            },
+            Array::F64 {
+                name: "stress",
+                components: 3,
+                values: ns,
+            },
+            Array::F64 {
+                name: "principal_stress",
+                components: 2,
+                values: &np,
+            },
+            Array::F64 {
+                name: "strain",
+                components: 3,
+                values: ne,
+            },
+        ],
+        &cell_data,
+    );
+    (doc, disp)
 }
 
 fn cell_states(snap: &Snapshot) -> CellStates {

@@ -1,6 +1,7 @@
 //! Figures drawn with plotters, each renderable as PNG (file) or SVG (file or string):
 //! history curves, the mesh, the deformed shape, colour maps of stress fields, crack
 //! patterns and joint diagrams.
+// long: one figure type per kind (curves, mesh, deformed shape, contours, cracks, joints, stages) over the shared frame, legend, tick and colour helpers of this file; none over 150 lines
 
 use super::data::{bounds, Grid};
 use super::glyphs::GlyphText;

@@ -123,8 +123,9 @@ impl Girder {
     }
 }
 
-/// Expand a balanced-cantilever `[viaduct]` into the model's tables.
-pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
+/// The keys a balanced-cantilever `[viaduct]` must and must not have: its
+/// `[viaduct.cantilever]` and the precast segments' `segment_age` [d], checked.
+fn cantilever_table<'v>(v: &'v ViaductIn, ctx: &Ctx) -> R<(&'v CantileverIn, f64)> {
     let k = |f: &str| format!("viaduct.{f}");
     for (key, given) in [
         ("cast_start", !v.cast_start.is_empty()),
@@ -158,6 +159,13 @@ pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
             format!("must be a positive number of days (got {age})"),
         ));
     }
+    Ok((c, age))
+}
+
+/// Expand a balanced-cantilever `[viaduct]` into the model's tables.
+pub fn expand(v: &ViaductIn, file: &mut File, ctx: &Ctx) -> R<Generated> {
+    let (c, age) = cantilever_table(v, ctx)?;
+    let k = |f: &str| format!("viaduct.{f}");
     no_generated_mesh(file, ctx)?;
     node_columns(v, ctx)?;
     let depth = section(v, ctx)?;

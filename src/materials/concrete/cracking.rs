@@ -388,6 +388,7 @@ fn direction(
 }
 
 /// Stress update of a cracked point (`committed.n_cracks` ≥ 1).
+// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit, shear cap) read as one table of cases against docs/theory-concrete.md
 pub fn update_cracked(
     p: &ConcreteParams,
     committed: &ConcreteState,

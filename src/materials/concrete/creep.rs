@@ -163,6 +163,7 @@ pub fn nonlinear_factor(creep: &ConcreteCreep, s: &[f64; 3]) -> f64 {
 /// (analysis clock [d]) at total strain `strain`; `char_length` [m] and the IMPL-EX `ratio`
 /// as in [`update_full`]. See the module documentation for the formulation.
 #[allow(clippy::too_many_arguments)]
+// long: one local Newton solve (latching, crushing holds, backtracking) whose tangent and chain update use its last iterate; split, they would pass a dozen locals
 pub fn update(
     p: &ConcreteParams,
     creep: &ConcreteCreep,
