@@ -10,8 +10,8 @@
 
 use super::viaduct::{
     attach, bearing_name, bearings, check_materials, generated_regions, hold_down, mesh_in,
-    no_generated_mesh, node_columns, section, self_weight, step, strand, tendon, Lists, ViaductIn,
-    STRIKE_INCREMENTS,
+    no_generated_mesh, node_columns, section, self_weight, step, strand, stressing, tendon, Lists,
+    ViaductIn, STRIKE_INCREMENTS,
 };
 use super::Generated;
 use crate::input::error::{Ctx, InputError};
@@ -823,12 +823,13 @@ fn tendons(
                 let (a, z) = (g.start(s - j), g.start(s + j + 1));
                 let points = [a, z].map(|x| [x, t.height + (geo.camber)(x)]).to_vec();
                 let mut tn = tendon(format!("P{}-{j}", pier + 1), points, t.area, steel);
-                tn.jacking_stress = Some(t.jacking_stress);
-                tn.jacking = t.jacking.clone();
-                tn.friction = t.friction;
-                tn.wobble = t.wobble;
-                tn.anchorage_set = t.anchorage_set;
-                tn.relaxation_class = t.relaxation_class;
+                stressing(
+                    &mut tn,
+                    t.jacking_stress,
+                    &t.jacking,
+                    [t.friction, t.wobble, t.anchorage_set],
+                    t.relaxation_class,
+                );
                 tn.stressed_in_step = Some(pair_step(j));
                 list.push(tn);
             }
@@ -859,12 +860,13 @@ fn tendons(
                 .map(|x| [x, geo.bottom(x) + t.height])
                 .collect();
             let mut tn = tendon(format!("C{}", span + 1), points, t.area, steel);
-            tn.jacking_stress = Some(t.jacking_stress);
-            tn.jacking = t.jacking.clone();
-            tn.friction = t.friction;
-            tn.wobble = t.wobble;
-            tn.anchorage_set = t.anchorage_set;
-            tn.relaxation_class = t.relaxation_class;
+            stressing(
+                &mut tn,
+                t.jacking_stress,
+                &t.jacking,
+                [t.friction, t.wobble, t.anchorage_set],
+                t.relaxation_class,
+            );
             tn.stressed_in_step = Some(CONTINUITY_STEP.into());
             list.push(tn);
         }

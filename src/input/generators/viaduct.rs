@@ -877,6 +877,23 @@ pub(super) fn tendon(
     }
 }
 
+/// Set a generated tendon's stressing: jacking stress [Pa] and end(s), friction μ, wobble
+/// [rad/m] and anchorage set [m] (in that order, each optional), relaxation class.
+pub(super) fn stressing(
+    tn: &mut TendonIn,
+    jacking_stress: f64,
+    jacking: &Option<String>,
+    [friction, wobble, anchorage_set]: [Option<f64>; 3],
+    relaxation_class: Option<i64>,
+) {
+    tn.jacking_stress = Some(jacking_stress);
+    tn.jacking = jacking.clone();
+    tn.friction = friction;
+    tn.wobble = wobble;
+    tn.anchorage_set = anchorage_set;
+    tn.relaxation_class = relaxation_class;
+}
+
 /// Span tendons T1 … Tn (anchored at the girder ends and on the pier axes, through the
 /// deviators of each span; stressed when the span is placed) and continuity tendons
 /// C1 … C(n−1) over the piers (stressed with the span after the pier).
@@ -946,12 +963,13 @@ fn tendons(v: &ViaductIn, layout: &Layout, depth: f64, file: &File, ctx: &Ctx) -
             }
             points.push(last);
             let mut tn = tendon(format!("T{}", i + 1), points, t.area, steel);
-            tn.jacking_stress = Some(t.jacking_stress);
-            tn.jacking = t.jacking.clone();
-            tn.friction = t.friction;
-            tn.wobble = t.wobble;
-            tn.anchorage_set = t.anchorage_set;
-            tn.relaxation_class = t.relaxation_class;
+            stressing(
+                &mut tn,
+                t.jacking_stress,
+                &t.jacking,
+                [t.friction, t.wobble, t.anchorage_set],
+                t.relaxation_class,
+            );
             tn.deviators = t.deviator_mode.clone();
             tn.deviator_friction = t.deviator_friction;
             tn.stressed_in_step = Some(place_step(i + 1));
@@ -989,12 +1007,13 @@ fn tendons(v: &ViaductIn, layout: &Layout, depth: f64, file: &File, ctx: &Ctx) -
                 ));
             }
             let mut tn = tendon(format!("C{i}"), vec![[a, h], [z, h]], c.area, steel);
-            tn.jacking_stress = Some(c.jacking_stress);
-            tn.jacking = c.jacking.clone();
-            tn.friction = c.friction;
-            tn.wobble = c.wobble;
-            tn.anchorage_set = c.anchorage_set;
-            tn.relaxation_class = c.relaxation_class;
+            stressing(
+                &mut tn,
+                c.jacking_stress,
+                &c.jacking,
+                [c.friction, c.wobble, c.anchorage_set],
+                c.relaxation_class,
+            );
             tn.stressed_in_step = Some(place_step(i + 1));
             list.push(tn);
         }
