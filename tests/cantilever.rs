@@ -277,14 +277,13 @@ fn cantilever_section_forces_follow_statics_at_every_stage() {
 /// pier segments of P1 and P2 with the main span's closure between, closure, end segment.
 fn segment_lengths() -> Vec<f64> {
     let mut l = vec![2.0, CLOSURE];
-    for p in 0..2 {
+    for _ in 0..2 {
         l.extend([SEG; PAIRS]);
         l.push(PIER);
         l.extend([SEG; PAIRS]);
-        l.push(if p == 0 { CLOSURE } else { 0.0 });
+        l.push(CLOSURE);
     }
-    l.pop();
-    l.extend([CLOSURE, 2.0]);
+    l.push(2.0);
     l
 }
 
