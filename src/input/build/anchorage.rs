@@ -143,6 +143,116 @@ pub struct LocalZone {
     pub axis: [f64; 2],
     /// Plate or bearing length [m] (the zone's width).
     pub plate: f64,
+    /// What stands on the plate: a tendon's anchorage or a bearing.
+    pub kind: ZoneKind,
+}
+
+/// What a local zone is behind: its end-block pairing ([`end_blocks`]) joins an anchorage
+/// with a bearing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ZoneKind {
+    /// A tendon's anchor plate.
+    Anchor,
+    /// A support's or a point load's bearing.
+    Bearing,
+}
+
+impl LocalZone {
+    /// The zone's box: corners [m] of the rectangle `plate` wide and
+    /// [`LOCAL_ZONE_DEPTH`] × `plate` deep behind the plate, counter-clockwise.
+    fn corners(&self) -> [[f64; 2]; 4] {
+        let (c, a) = (self.centre, self.axis);
+        let t = [-a[1], a[0]];
+        let (h, d) = (0.5 * self.plate, LOCAL_ZONE_DEPTH * self.plate);
+        let at = |s: f64, u: f64| [c[0] + s * a[0] + u * t[0], c[1] + s * a[1] + u * t[1]];
+        [at(0.0, -h), at(d, -h), at(d, h), at(0.0, h)]
+    }
+}
+
+/// End blocks: the convex hull of an anchorage's zone and a bearing's zone whose boxes come
+/// closer than the bearing's length. Between them the anchorage's spread meets the
+/// reaction; a real member has its end diaphragm there, reinforced for both, so the
+/// concrete between the two zones is no plain concrete either. Without it a row of
+/// elements between the boxes carries the crossing flows as unreinforced concrete and
+/// crushes, one mesh row or another depending on the element size (docs/theory-prestress.md,
+/// "End blocks").
+pub(super) fn end_blocks(zones: &[LocalZone]) -> Vec<Vec<[f64; 2]>> {
+    let mut blocks = Vec::new();
+    for a in zones.iter().filter(|z| z.kind == ZoneKind::Anchor) {
+        for b in zones.iter().filter(|z| z.kind == ZoneKind::Bearing) {
+            let (pa, pb) = (a.corners(), b.corners());
+            if polygon_gap(&pa, &pb) < b.plate {
+                let mut pts: Vec<[f64; 2]> = pa.iter().chain(pb.iter()).copied().collect();
+                blocks.push(convex_hull(&mut pts));
+            }
+        }
+    }
+    blocks
+}
+
+/// Distance between two convex polygons [m] (0 where they overlap).
+fn polygon_gap(p: &[[f64; 2]], q: &[[f64; 2]]) -> f64 {
+    if p.iter().any(|&x| inside_convex(q, x, 0.0)) || q.iter().any(|&x| inside_convex(p, x, 0.0)) {
+        return 0.0;
+    }
+    let seg = |x: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((x[0] - a[0]) * dx + (x[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (x[0] - a[0] - t * dx).hypot(x[1] - a[1] - t * dy)
+    };
+    let one_way = |p: &[[f64; 2]], q: &[[f64; 2]]| {
+        let mut d = f64::INFINITY;
+        for &x in p {
+            for i in 0..q.len() {
+                d = d.min(seg(x, q[i], q[(i + 1) % q.len()]));
+            }
+        }
+        d
+    };
+    // Two convex polygons that do not overlap are nearest at a vertex of one.
+    one_way(p, q).min(one_way(q, p))
+}
+
+/// Counter-clockwise convex hull of `pts` (Andrew's monotone chain).
+fn convex_hull(pts: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
+    pts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &[f64; 2]>> = if pass == 0 {
+            Box::new(pts.iter())
+        } else {
+            Box::new(pts.iter().rev())
+        };
+        for &x in iter {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], x) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(x);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// Whether `x` lies in the counter-clockwise convex polygon `p`, within `tol` [m] of it.
+fn inside_convex(p: &[[f64; 2]], x: [f64; 2], tol: f64) -> bool {
+    (0..p.len()).all(|i| {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l = dx.hypot(dy);
+        l == 0.0 || (dx * (x[1] - a[1]) - dy * (x[0] - a[0])) / l >= -tol
+    })
 }
 
 /// Depth of a local zone per plate length [-]: AASHTO LRFD 5.8.4.1 takes the local zone
@@ -158,28 +268,27 @@ pub const LOCAL_ZONE_DEPTH: f64 = 1.0;
 /// density. Elastic and creep regions are left alone (they cannot fail locally). The copy
 /// keeps the region's construction stage and thermal coefficient.
 pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[bool]) {
-    let n_regions = model.regions.len();
-    // Copy of region r (index into model.regions), made on first use.
-    let mut copy_of: Vec<Option<usize>> = vec![None; n_regions];
+    let centroid = |model: &Model, e: &crate::model::Element| {
+        let k = e.nodes.len().min(4) as f64;
+        e.nodes.iter().take(4).fold([0.0, 0.0], |c, &n| {
+            [c[0] + model.nodes[n][0] / k, c[1] + model.nodes[n][1] / k]
+        })
+    };
+    let tol = 1e-9 * locate::model_size(model);
+    // The elements of each zone, then of each end block, in that order.
+    let mut sets: Vec<Vec<usize>> = Vec::new();
     for z in zones {
         let n = locate::nearest_node(model, used, z.centre);
-        let centroid = |e: &crate::model::Element| {
-            let k = e.nodes.len().min(4) as f64;
-            e.nodes.iter().take(4).fold([0.0, 0.0], |c, &n| {
-                [c[0] + model.nodes[n][0] / k, c[1] + model.nodes[n][1] / k]
-            })
-        };
         let local = |p: [f64; 2]| {
             let d = [p[0] - z.centre[0], p[1] - z.centre[1]];
             let s = d[0] * z.axis[0] + d[1] * z.axis[1];
             let t = -d[0] * z.axis[1] + d[1] * z.axis[0];
             (s, t)
         };
-        let tol = 1e-9 * locate::model_size(model);
         let depth = LOCAL_ZONE_DEPTH * z.plate;
         let mut hits: Vec<usize> = (0..model.elements.len())
             .filter(|&e| {
-                let (s, t) = local(centroid(&model.elements[e]));
+                let (s, t) = local(centroid(model, &model.elements[e]));
                 s >= -tol && s <= depth + tol && t.abs() <= 0.5 * z.plate + tol
             })
             .collect();
@@ -187,10 +296,23 @@ pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[
             hits = (0..model.elements.len())
                 .filter(|&e| {
                     model.elements[e].nodes.contains(&n)
-                        && local(centroid(&model.elements[e])).0 > 0.0
+                        && local(centroid(model, &model.elements[e])).0 > 0.0
                 })
                 .collect();
         }
+        sets.push(hits);
+    }
+    for block in end_blocks(zones) {
+        sets.push(
+            (0..model.elements.len())
+                .filter(|&e| inside_convex(&block, centroid(model, &model.elements[e]), tol))
+                .collect(),
+        );
+    }
+    let n_regions = model.regions.len();
+    // Copy of region r (index into model.regions), made on first use.
+    let mut copy_of: Vec<Option<usize>> = vec![None; n_regions];
+    for hits in sets {
         for e in hits {
             let r = model.elements[e].region;
             let r = if r < n_regions { r } else { continue };
@@ -269,5 +391,71 @@ pub fn support_zone(model: &Model, node: usize, held: [f64; 2], bearing: f64) ->
         centre: c,
         axis,
         plate: bearing,
+        kind: ZoneKind::Bearing,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn zone(centre: [f64; 2], axis: [f64; 2], plate: f64, kind: ZoneKind) -> LocalZone {
+        LocalZone {
+            centre,
+            axis,
+            plate,
+            kind,
+        }
+    }
+
+    fn area(p: &[[f64; 2]]) -> f64 {
+        (0..p.len())
+            .map(|i| {
+                let (a, b) = (p[i], p[(i + 1) % p.len()]);
+                0.5 * (a[0] * b[1] - b[0] * a[1])
+            })
+            .sum()
+    }
+
+    /// An anchor plate 1.2 m high centred 1.0 m up the end face x = 0 (box x 0…1.2,
+    /// y 0.4…1.6) and a 0.6 m bearing at x = 0.5 on the soffit (box x 0.2…0.8, y 0…0.6):
+    /// the boxes overlap, so they form an end block, the hull of their eight corners —
+    /// the union (1.44 + 0.36 − 0.12 overlap of 0.6 × 0.2) plus the two triangles that
+    /// fill the notches: (0, 0.4)–(0.2, 0)–(0.2, 0.4), 0.04, and (0.8, 0)–(1.2, 0.4)–
+    /// (0.8, 0.4), 0.08; area 1.80 m² in all (closed form, round-off only).
+    #[test]
+    fn overlapping_anchor_and_bearing_make_one_block_the_hull_of_both() {
+        let a = zone([0.0, 1.0], [1.0, 0.0], 1.2, ZoneKind::Anchor);
+        let b = zone([0.5, 0.0], [0.0, 1.0], 0.6, ZoneKind::Bearing);
+        let blocks = end_blocks(&[a, b]);
+        assert_eq!(blocks.len(), 1);
+        let expect = 1.44 + 0.36 - 0.12 + 0.04 + 0.08;
+        assert!(
+            (area(&blocks[0]) - expect).abs() < 1e-12,
+            "{}",
+            area(&blocks[0])
+        );
+        // The notch corner between them is in the block; a point beyond it is not.
+        assert!(inside_convex(&blocks[0], [0.15, 0.35], 0.0));
+        assert!(!inside_convex(&blocks[0], [0.05, 0.1], 0.0));
+    }
+
+    /// The gap rule: an anchor box starting 0.5 m above a 0.6 m bearing's box (gap 0.5 <
+    /// 0.6) joins it; 0.7 m above (gap 0.7 > 0.6) it does not; two anchors or two bearings
+    /// never join (an end block pairs an anchorage with a bearing).
+    #[test]
+    fn zones_join_only_an_anchor_to_a_bearing_closer_than_the_bearing() {
+        let b = zone([0.5, 0.0], [0.0, 1.0], 0.6, ZoneKind::Bearing);
+        let near = zone([0.0, 1.1 + 0.6], [1.0, 0.0], 1.2, ZoneKind::Anchor);
+        let far = zone([0.0, 1.3 + 0.6], [1.0, 0.0], 1.2, ZoneKind::Anchor);
+        assert!((polygon_gap(&near.corners(), &b.corners()) - 0.5).abs() < 1e-12);
+        assert!((polygon_gap(&far.corners(), &b.corners()) - 0.7).abs() < 1e-12);
+        assert_eq!(end_blocks(&[near, b]).len(), 1);
+        let b = zone([0.5, 0.0], [0.0, 1.0], 0.6, ZoneKind::Bearing);
+        let far = zone([0.0, 1.9], [1.0, 0.0], 1.2, ZoneKind::Anchor);
+        assert!(end_blocks(&[far, b]).is_empty());
+        let a1 = zone([0.0, 1.0], [1.0, 0.0], 1.2, ZoneKind::Anchor);
+        let a2 = zone([0.0, 1.0], [1.0, 0.0], 0.4, ZoneKind::Anchor);
+        assert!(end_blocks(&[a1, a2]).is_empty());
     }
 }

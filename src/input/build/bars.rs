@@ -439,6 +439,7 @@ fn bonded_anchor_zones(
         centre: [p.x[0] - p.s * d[0], p.x[1] - p.s * d[1]],
         axis: d,
         plate,
+        kind: super::anchorage::ZoneKind::Anchor,
     });
     let (p, d) = (&last.point, last.point.dir);
     let rest = length - p.s;
@@ -446,6 +447,7 @@ fn bonded_anchor_zones(
         centre: [p.x[0] + rest * d[0], p.x[1] + rest * d[1]],
         axis: [-d[0], -d[1]],
         plate,
+        kind: super::anchorage::ZoneKind::Anchor,
     });
     Ok(())
 }

@@ -137,6 +137,7 @@ fn bearing(
             centre: model.nodes[n],
             axis,
             plate: b,
+            kind: super::anchorage::ZoneKind::Bearing,
         });
     }
     Ok(Some(s.weights))

@@ -550,6 +550,7 @@ fn anchor_ties(
                 centre: a,
                 axis,
                 plate,
+                kind: super::anchorage::ZoneKind::Anchor,
             });
         }
     }
