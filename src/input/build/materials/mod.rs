@@ -5,7 +5,7 @@
 //! The generic part is here: reading a table (every key typed by the kinds' key lists, so a
 //! misspelt key or a wrong type is refused by the parser with its line), the `kind`
 //! dispatch, and the refusal of a key that is not one of the table's kind. A new kind is a
-//! file with its [`Schema`] and one line in the [`kinds!`] list below.
+//! file with its [`Schema`] (a `SCHEMA` constant) and one line in the `kinds!` list below.
 
 use super::R;
 use crate::input::error::{Ctx, InputError};
@@ -16,12 +16,6 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
 use std::fmt;
-
-mod concrete;
-mod elastic;
-mod elastic_creep;
-mod prestressing_steel;
-mod rebar;
 
 /// The type of a key's value.
 #[derive(Debug, Clone, Copy)]
@@ -127,10 +121,12 @@ pub struct Schema {
     pub build: fn(&Table, &mut Vec<String>) -> R<Law>,
 }
 
-/// The kinds: one line each (a doc comment, the variant, its module). Generates
-/// [`MaterialKind`], `ALL` and `schema`.
+/// The kinds: one line each (a doc comment, the variant, its module's file). Generates
+/// the `mod` lines, [`MaterialKind`], `ALL` and `schema`.
 macro_rules! kinds {
     ($($(#[$doc:meta])* $variant:ident => $module:ident,)+) => {
+        $(mod $module;)+
+
         /// The kinds of `[[materials]]` (`kind = "..."`), one per material law the model
         /// file offers; each owns its [`Schema`].
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
