@@ -144,6 +144,15 @@ macro_rules! kinds {
                     $(MaterialKind::$variant => &$module::SCHEMA,)+
                 }
             }
+
+            /// The source of the kind's file, for the test that its builder reads only
+            /// keys its schema declares.
+            #[cfg(test)]
+            fn source(self) -> &'static str {
+                match self {
+                    $(MaterialKind::$variant => include_str!(concat!(stringify!($module), ".rs")),)+
+                }
+            }
         }
     };
 }
@@ -540,6 +549,61 @@ mod tests {
                 assert_eq!(ty(first), ty(k), "{} of {}", k.name, a.name());
             }
             assert!(keys.iter().any(|k| k.name == THERMAL_EXPANSION.name));
+            for (r, _) in a.schema().refused {
+                assert!(
+                    !keys.iter().any(|k| k.name == *r),
+                    "{} refuses its own {r}",
+                    a.name()
+                );
+                assert!(find_key(None, r).is_some(), "{r} is no kind's key");
+            }
         }
+    }
+
+    /// Every key a kind's file reads through its `Table` (`t.num("E")`, `t.text(..)`, …,
+    /// `t.err("E", ..)`) is declared in that kind's schema (inline tables' keys included), with
+    /// the type the accessor reads: an accessor of the wrong type would read None, silently.
+    #[test]
+    fn builders_read_only_keys_their_schema_declares() {
+        let mut reads = 0;
+        for kind in MaterialKind::ALL {
+            let mut declared: Vec<(&str, String)> = Vec::new();
+            for k in kind.schema().keys {
+                declared.push((k.name, format!("{:?}", k.ty)));
+                if let KeyType::Table(sub) = k.ty {
+                    declared.extend(sub.iter().map(|x| (x.name, format!("{:?}", x.ty))));
+                }
+            }
+            let src = kind.source();
+            for (call, ty) in [
+                ("t.num(\"", Some("Number")),
+                ("t.need(\"", Some("Number")),
+                ("t.count(\"", Some("Count")),
+                ("t.text(\"", Some("Text")),
+                ("t.flag(\"", Some("Flag")),
+                ("t.sub(\"", Some("Table")),
+                ("t.has(\"", None),
+                ("t.err(\"", None),
+                ("t.key(\"", None),
+            ] {
+                for (at, _) in src.match_indices(call) {
+                    let rest = &src[at + call.len()..];
+                    let key = &rest[..rest.find('"').unwrap()];
+                    reads += 1;
+                    let found = declared.iter().find(|(n, _)| *n == key);
+                    let Some((_, declared_ty)) = found else {
+                        panic!("{}.rs reads {key}, not a key of its schema", kind.name());
+                    };
+                    if let Some(ty) = ty {
+                        assert!(
+                            declared_ty.starts_with(ty),
+                            "{}.rs reads {key} with {call}…), declared {declared_ty}",
+                            kind.name()
+                        );
+                    }
+                }
+            }
+        }
+        assert!(reads > 100, "{reads} key reads found");
     }
 }
