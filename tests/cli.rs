@@ -1029,8 +1029,9 @@ fn doc_sections(docs: &str) -> Vec<(String, usize, String)> {
 
 /// Every key of every material kind, from the kinds' own schemas (src/input/build/materials/),
 /// appears as `key` in the docs/input.md section whose heading names the kind
-/// (`kind = "concrete"`), keys of inline tables (`viscoplastic`) included; and that
-/// section's `thermal_expansion` line gives the kind's default (10e-6, 12e-6, or none).
+/// (`kind = "concrete"`), keys of inline tables (`viscoplastic`) included; a number's own
+/// table row gives its schema unit; and the section's `thermal_expansion` line gives the kind's
+/// default (10e-6, 12e-6, or none).
 #[test]
 fn every_material_key_is_documented_for_its_kind() {
     use segfem::input::build::{KeyType, MaterialKind};
@@ -1039,6 +1040,8 @@ fn every_material_key_is_documented_for_its_kind() {
     let sections = doc_sections(&docs);
     let mut checked = 0;
     let mut missing = Vec::new();
+    let mut wrong_units = Vec::new();
+    let mut units_checked = 0;
     for kind in MaterialKind::ALL {
         let schema = kind.schema();
         let tag = format!("`kind = \"{}\"`", schema.name);
@@ -1062,6 +1065,31 @@ fn every_material_key_is_documented_for_its_kind() {
                 missing.push(format!("{}.{k}", schema.name));
             }
         }
+        // A number with a row of its own (`| `key` | ...`) gives the schema's unit in a cell
+        // (`-` and `–` both mean none; the concrete table gives the type of other keys there).
+        let mut rows = Vec::new();
+        for k in schema.keys {
+            rows.push(k);
+            if let KeyType::Table(sub) = k.ty {
+                rows.extend(sub.iter());
+            }
+        }
+        for k in rows.into_iter().filter(|k| matches!(k.ty, KeyType::Number)) {
+            let head = format!("| `{}`", k.name);
+            let own_row = |l: &&str| {
+                l.strip_prefix(&head)
+                    .is_some_and(|rest| rest.trim_start().starts_with('|'))
+            };
+            for row in body.lines().filter(own_row) {
+                units_checked += 1;
+                let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+                let unit_cell =
+                    |c: &&str| *c == k.unit || (k.unit == "-" && (*c == "-" || *c == "–"));
+                if !cells.iter().any(unit_cell) {
+                    wrong_units.push(format!("{}.{} [{}]: {row}", schema.name, k.name, k.unit));
+                }
+            }
+        }
         let alpha = body
             .lines()
             .find(|l| l.contains("`thermal_expansion`"))
@@ -1080,6 +1108,12 @@ fn every_material_key_is_documented_for_its_kind() {
     assert!(
         missing.is_empty(),
         "material keys missing from their kind's section of docs/input.md: {missing:?}"
+    );
+    // 6 elastic, 7 elastic_creep, 24 concrete rows (viscoplastic's included).
+    assert!(units_checked >= 35, "{units_checked} unit cells checked");
+    assert!(
+        wrong_units.is_empty(),
+        "docs/input.md rows without the schema's unit: {wrong_units:#?}"
     );
 }
 
