@@ -962,7 +962,7 @@ fn table_keys(text: &str) -> Vec<String> {
 fn every_schema_key_is_documented() {
     // Each field of every model-file table (under its TOML name) appears as `key` in
     // docs/input.md: the tables of schema.rs and those kept beside their builders (the
-    // material table, the [viaduct] generator, …): every source file under src/input/.
+    // [viaduct] generator, …): every source file under src/input/.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let docs = read(&root.join("docs/input.md"));
     let mut files = Vec::new();
@@ -981,10 +981,11 @@ fn every_schema_key_is_documented() {
     for f in &files {
         keys.extend(table_keys(&read(f)));
     }
-    // schema.rs alone holds more than 40; the material table adds about 50.
+    // schema.rs alone holds more than 40, the generators more than 80 (the material keys
+    // are the kinds' schemas, checked by `every_material_key_is_documented_for_its_kind`).
     assert!(keys.len() > 120, "table fields found: {keys:?}");
-    // One key of each kind of file: schema.rs, the material table, the generator.
-    for k in ["relaxation_class", "fcm", "segment_length"] {
+    // One key of each kind of file: schema.rs, the generator.
+    for k in ["relaxation_class", "segment_length"] {
         assert!(keys.iter().any(|x| x == k), "{k} not found among {keys:?}");
     }
     let missing: Vec<&String> = keys
@@ -997,6 +998,122 @@ fn every_schema_key_is_documented() {
     assert!(
         missing.is_empty(),
         "keys missing from docs/input.md: {missing:?}"
+    );
+}
+
+/// The sections of docs/input.md (`#` headings outside code blocks): (heading line, level,
+/// text up to the next heading of the same or a higher level).
+fn doc_sections(docs: &str) -> Vec<(String, usize, String)> {
+    let mut heads = Vec::new();
+    let mut fenced = false;
+    let lines: Vec<&str> = docs.lines().collect();
+    for (n, l) in lines.iter().enumerate() {
+        if l.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && l.starts_with('#') {
+            let level = l.chars().take_while(|c| *c == '#').count();
+            heads.push((n, level));
+        }
+    }
+    heads
+        .iter()
+        .map(|&(n, level)| {
+            let end = heads
+                .iter()
+                .find(|&&(m, l)| m > n && l <= level)
+                .map_or(lines.len(), |&(m, _)| m);
+            (lines[n].to_string(), level, lines[n..end].join("\n"))
+        })
+        .collect()
+}
+
+/// Every key of every material kind, from the kinds' own schemas (src/input/build/materials/),
+/// appears as `key` in the docs/input.md section whose heading names the kind
+/// (`kind = "concrete"`), keys of inline tables (`viscoplastic`) included; a number's own
+/// table row gives its schema unit; and the section's `thermal_expansion` line gives the kind's
+/// default (10e-6, 12e-6, or none).
+#[test]
+fn every_material_key_is_documented_for_its_kind() {
+    use segfem::input::build::{KeyType, MaterialKind};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let docs = read(&root.join("docs/input.md"));
+    let sections = doc_sections(&docs);
+    let mut checked = 0;
+    let mut missing = Vec::new();
+    let mut wrong_units = Vec::new();
+    let mut units_checked = 0;
+    for kind in MaterialKind::ALL {
+        let schema = kind.schema();
+        let tag = format!("`kind = \"{}\"`", schema.name);
+        let body: Vec<&str> = sections
+            .iter()
+            .filter(|(head, _, _)| head.contains(&tag))
+            .map(|(_, _, text)| text.as_str())
+            .collect();
+        assert!(!body.is_empty(), "no docs/input.md heading names {tag}");
+        let body = body.join("\n");
+        let mut keys: Vec<&str> = Vec::new();
+        for k in schema.keys {
+            keys.push(k.name);
+            if let KeyType::Table(sub) = k.ty {
+                keys.extend(sub.iter().map(|s| s.name));
+            }
+        }
+        for k in keys {
+            checked += 1;
+            if !body.contains(&format!("`{k}`")) {
+                missing.push(format!("{}.{k}", schema.name));
+            }
+        }
+        // A number with a row of its own (`| `key` | ...`) gives the schema's unit in a cell
+        // (`-` and `–` both mean none; the concrete table gives the type of other keys there).
+        let mut rows = Vec::new();
+        for k in schema.keys {
+            rows.push(k);
+            if let KeyType::Table(sub) = k.ty {
+                rows.extend(sub.iter());
+            }
+        }
+        for k in rows.into_iter().filter(|k| matches!(k.ty, KeyType::Number)) {
+            let head = format!("| `{}`", k.name);
+            let own_row = |l: &&str| {
+                l.strip_prefix(&head)
+                    .is_some_and(|rest| rest.trim_start().starts_with('|'))
+            };
+            for row in body.lines().filter(own_row) {
+                units_checked += 1;
+                let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+                let unit_cell =
+                    |c: &&str| *c == k.unit || (k.unit == "-" && (*c == "-" || *c == "–"));
+                if !cells.iter().any(unit_cell) {
+                    wrong_units.push(format!("{}.{} [{}]: {row}", schema.name, k.name, k.unit));
+                }
+            }
+        }
+        let alpha = body
+            .lines()
+            .find(|l| l.contains("`thermal_expansion`"))
+            .unwrap_or("");
+        let want = match schema.thermal_expansion {
+            Some(a) => format!("{}e-6", (a * 1e6).round()),
+            None => "none".to_string(),
+        };
+        assert!(
+            alpha.contains(&want),
+            "{tag}: its thermal_expansion line should give the default {want}: {alpha:?}"
+        );
+    }
+    // elastic 7, elastic_creep 10, concrete 43 + 7 viscoplastic, the steels 4 each.
+    assert!(checked >= 75, "{checked} keys checked");
+    assert!(
+        missing.is_empty(),
+        "material keys missing from their kind's section of docs/input.md: {missing:?}"
+    );
+    // 6 elastic, 7 elastic_creep, 24 concrete rows (viscoplastic's included).
+    assert!(units_checked >= 35, "{units_checked} unit cells checked");
+    assert!(
+        wrong_units.is_empty(),
+        "docs/input.md rows without the schema's unit: {wrong_units:#?}"
     );
 }
 

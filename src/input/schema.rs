@@ -67,7 +67,7 @@ pub struct CheckIn {
 }
 
 // The material table lives with its kinds and builders (one file per material law's input).
-pub use super::build::{MaterialIn, ViscoplasticIn};
+pub use super::build::MaterialIn;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

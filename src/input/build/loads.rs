@@ -294,15 +294,15 @@ fn alpha_value(ctx: &Ctx, key: &str, v: f64) -> R<f64> {
 }
 
 /// The expansion coefficients of the thermal load cases, once regions, bars, tendons and
-/// steps are built: α per region's material (concrete kinds default to [`ALPHA_CONCRETE`];
-/// an `elastic` material has no default: it could be concrete or steel), per bar (its
-/// steel, default [`ALPHA_STEEL`]) and per external tendon. Tendons must be stressed and
+/// steps are built: α per region's material (default: its kind's, `Schema::thermal_expansion`
+/// of build/materials/: [`ALPHA_CONCRETE`] for the concrete kinds, none for `elastic`, which
+/// could be concrete or steel), per bar (its steel, default [`ALPHA_STEEL`]) and per external tendon. Tendons must be stressed and
 /// grouted while no temperature is held (their reference length is taken stress-free at
 /// stressing); an arc-length step cannot scale a thermal case.
 pub(super) fn thermal_coefficients(ctx: &Ctx, file: &File, model: &mut Model) -> R<()> {
     // Values given are checked whether or not a thermal case uses them.
     for (i, m) in file.materials.iter().enumerate() {
-        if let Some(a) = m.thermal_expansion {
+        if let Some(a) = m.number("thermal_expansion") {
             alpha_value(ctx, &format!("materials[{i}].thermal_expansion"), a)?;
         }
     }
@@ -331,10 +331,10 @@ pub(super) fn thermal_coefficients(ctx: &Ctx, file: &File, model: &mut Model) ->
                 format!("internal error: material '{name}' not in the file"),
             ));
         };
-        region_alpha.push(match (m.thermal_expansion, m.kind.as_str()) {
-            (Some(a), _) => a,
-            (None, "concrete" | "elastic_creep") => ALPHA_CONCRETE,
-            (None, _) => {
+        // The value given, else the kind's default (its schema's).
+        region_alpha.push(match m.thermal_expansion() {
+            Some(a) => a,
+            None => {
                 return Err(ctx.err(
                     format!("materials[{i}].thermal_expansion"),
                     format!("missing: the thermal load case '{first_name}' heats region '{}', and an elastic material has no default coefficient (1.0e-5 1/K for concrete)", r.name),
@@ -344,7 +344,7 @@ pub(super) fn thermal_coefficients(ctx: &Ctx, file: &File, model: &mut Model) ->
     }
     let steel_alpha = |name: &str| {
         material(name)
-            .and_then(|(_, m)| m.thermal_expansion)
+            .and_then(|(_, m)| m.thermal_expansion())
             .unwrap_or(ALPHA_STEEL)
     };
     let tendon_alpha = |name: &str| {

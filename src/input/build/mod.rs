@@ -23,7 +23,7 @@ mod supports;
 mod tendons;
 mod time;
 
-pub use materials::{MaterialIn, MaterialKind, ViscoplasticIn};
+pub use materials::{Key, KeyType, MaterialIn, MaterialKind, Schema};
 pub(in crate::input) use mesh::integration;
 pub use stages::table as stage_table;
 pub use time::{DEFAULT_FIRST_SUBSTEP, SUBSTEPS_PER_DECADE};

@@ -8,6 +8,7 @@
 //! continue the analysis (finishes, 30 years, traffic …).
 
 use super::Generated;
+use crate::input::build::MaterialKind;
 use crate::input::error::{Ctx, InputError};
 use crate::input::schema::{
     BandIn, File, LoadCaseIn, MeshIn, RegionIn, StepIn, SupportIn, TendonIn,
@@ -820,7 +821,7 @@ pub(super) fn strand(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<(f64, f64, Opti
                 ),
             )
         })?;
-    if m.kind != "prestressing_steel" {
+    if MaterialKind::from_name(&m.kind) != Some(MaterialKind::PrestressingSteel) {
         return Err(ctx.err(
             "viaduct.strand",
             format!(
@@ -837,7 +838,11 @@ pub(super) fn strand(v: &ViaductIn, file: &File, ctx: &Ctx) -> R<(f64, f64, Opti
             )
         })
     };
-    Ok((need("Ep", m.ep)?, need("fptk", m.fptk)?, m.eps_uk))
+    Ok((
+        need("Ep", m.number("Ep"))?,
+        need("fptk", m.number("fptk"))?,
+        m.number("eps_uk"),
+    ))
 }
 
 /// A tendon of the strand with every optional key left out.
