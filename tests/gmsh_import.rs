@@ -4,18 +4,18 @@
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::mesh::banded::Band;
 use segfem::mesh::segmental::generate_segments;
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use std::fmt::Write;
 
 /// Write a Gmsh 2.2 ASCII file of the decompression example's mesh: Q8 elements in the
 /// physical surface "web", joint faces as 3-node lines in curves "J1a"/"J1b", "J2a"/"J2b".
 fn msh_text() -> String {
-    msh_text_of(QuadKind::Q8)
+    msh_text_of(ElementKind::Q8)
 }
 
 /// As [`msh_text`] with elements of `kind` (Gmsh types 3, 16, 10; joint faces as 2-node
 /// lines, type 1, for Q4 and 3-node lines, type 8, otherwise).
-fn msh_text_of(kind: QuadKind) -> String {
+fn msh_text_of(kind: ElementKind) -> String {
     let bands = [Band {
         depth: 0.5,
         rows: 8,
@@ -23,9 +23,9 @@ fn msh_text_of(kind: QuadKind) -> String {
     }];
     let m = generate_segments(0.0, 0.0, &[2.0, 2.0, 2.0], &[8, 8, 8], &bands, kind);
     let (quad_type, line_type) = match kind {
-        QuadKind::Q4 => (3, 1),
-        QuadKind::Q8 => (16, 8),
-        QuadKind::Q9 => (10, 8),
+        ElementKind::Q4 => (3, 1),
+        ElementKind::Q8 => (16, 8),
+        ElementKind::Q9 => (10, 8),
     };
     let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n5\n");
     s.push_str(
@@ -103,12 +103,12 @@ fn tmp_dir(name: &str) -> std::path::PathBuf {
 /// equations; only the text coordinates' round-off differs).
 #[test]
 fn generated_and_gmsh_meshes_give_the_same_results() {
-    for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+    for kind in [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9] {
         same_results(kind);
     }
 }
 
-fn same_results(kind: QuadKind) {
+fn same_results(kind: ElementKind) {
     let name = format!("{kind:?}");
     let dir = tmp_dir(&format!("same-{name}"));
     std::fs::write(dir.join("beam.msh"), msh_text_of(kind)).unwrap();
@@ -121,7 +121,7 @@ fn same_results(kind: QuadKind) {
         "/examples/segmental-decompression.toml"
     ))
     .unwrap();
-    let text = if kind == QuadKind::Q8 {
+    let text = if kind == ElementKind::Q8 {
         text
     } else {
         let t = text.replace("element = \"Q8\"", &format!("element = \"{name}\""));

@@ -6,7 +6,7 @@ use segfem::elements::continuum::{rule, Integration};
 use segfem::fem::shape::jacobian;
 use segfem::materials::point::Material;
 use segfem::mesh::banded::{generate, Band};
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use segfem::model::*;
 
 /// Keeps the last converged displacements, internal and external forces, and Gauss stresses.
@@ -37,7 +37,7 @@ impl Observer for Last {
 }
 
 fn model_from_mesh(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
     nodes: Vec<[f64; 2]>,
     elements: Vec<(Vec<usize>, usize)>,
@@ -116,7 +116,7 @@ fn linear_field(p: [f64; 2]) -> [f64; 2] {
 /// must reproduce it to round-off.
 #[test]
 fn patch_tests_reproduce_constant_strain() {
-    for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+    for kind in [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9] {
         let bands = [Band {
             depth: 1.0,
             rows: 2,
@@ -233,11 +233,16 @@ impl Tg {
 
 /// Solve the T&G cantilever on an nx × ny mesh; return (L2 displacement error / L2 norm of
 /// the exact field, tip deflection v(0, 0)).
-fn cantilever(kind: QuadKind, nx: usize, ny: usize) -> (f64, f64) {
+fn cantilever(kind: ElementKind, nx: usize, ny: usize) -> (f64, f64) {
     cantilever_with(kind, Integration::Full, nx, ny)
 }
 
-fn cantilever_with(kind: QuadKind, integration: Integration, nx: usize, ny: usize) -> (f64, f64) {
+fn cantilever_with(
+    kind: ElementKind,
+    integration: Integration,
+    nx: usize,
+    ny: usize,
+) -> (f64, f64) {
     let t = 0.1;
     let tg = Tg::new(t);
     let g = generate(
@@ -347,9 +352,9 @@ fn cantilever_matches_timoshenko_goodier_and_converges_at_the_expected_rate() {
     let tg = Tg::new(0.1);
     let exact_tip = tg.disp(0.0, 0.0)[1];
     for (kind, expected_rate, tip_tol) in [
-        (QuadKind::Q4, 2.0, 2e-2),
-        (QuadKind::Q8, 3.0, 1e-4),
-        (QuadKind::Q9, 3.0, 1e-4),
+        (ElementKind::Q4, 2.0, 2e-2),
+        (ElementKind::Q8, 3.0, 1e-4),
+        (ElementKind::Q9, 3.0, 1e-4),
     ] {
         let errs: Vec<(f64, f64)> = [(8, 2), (16, 4), (32, 8)]
             .iter()
@@ -381,8 +386,8 @@ fn incompatible_q4_cantilever_does_not_lock() {
     let tg = Tg::new(0.1);
     let exact_tip = tg.disp(0.0, 0.0)[1];
     for (nx, ny) in [(8, 2), (4, 2), (2, 2)] {
-        let plain = cantilever_with(QuadKind::Q4, Integration::Full, nx, ny).1;
-        let qm6 = cantilever_with(QuadKind::Q4, Integration::Incompatible, nx, ny).1;
+        let plain = cantilever_with(ElementKind::Q4, Integration::Full, nx, ny).1;
+        let qm6 = cantilever_with(ElementKind::Q4, Integration::Incompatible, nx, ny).1;
         let (e_plain, e_qm6) = (
             (plain - exact_tip) / exact_tip,
             (qm6 - exact_tip) / exact_tip,
@@ -478,7 +483,7 @@ fn reactions_of_the_simply_supported_box_beam_match_statics() {
 fn banded_generator_reproduces_section_properties() {
     let depths = [0.10, 0.40, 0.10];
     let widths = [0.70, 0.20, 1.20];
-    for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+    for kind in [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9] {
         let bands: Vec<Band> = depths
             .iter()
             .enumerate()

@@ -16,7 +16,7 @@
 
 use super::continuum::{GaussOutput, NodeBlocks};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
 /// `h[i][j] = ∂u_i/∂X_j` [-].
@@ -50,7 +50,7 @@ pub fn displacement_gradient(dn: &[[f64; 2]], u: &[f64], n: usize) -> [[f64; 2];
 /// formed (the others are zero; see [`NodeBlocks`]).
 #[allow(clippy::too_many_arguments)]
 pub fn response_tl(
-    kind: QuadKind,
+    kind: ElementKind,
     geometry: &super::continuum::GaussGeometry,
     thickness: f64,
     mat: &Material,
@@ -178,11 +178,11 @@ mod tests {
     use crate::elements::continuum::{gauss_geometry, response_at, rule_points, Integration};
     use crate::fem::shape::NODE_XI;
 
-    const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];
+    const KINDS: [ElementKind; 3] = [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9];
 
     /// A distorted element: the natural node positions mapped through a skewed, stretched map
     /// with a quadratic term (curved edges for Q8/Q9) [m].
-    fn coords(kind: QuadKind) -> Vec<[f64; 2]> {
+    fn coords(kind: ElementKind) -> Vec<[f64; 2]> {
         (0..kind.n_nodes())
             .map(|a| {
                 let [x, y] = NODE_XI[a];
@@ -210,7 +210,7 @@ mod tests {
         }
     }
 
-    fn tl(kind: QuadKind, u: &[f64], tangent: bool) -> (Vec<f64>, Vec<f64>, Vec<GaussOutput>) {
+    fn tl(kind: ElementKind, u: &[f64], tangent: bool) -> (Vec<f64>, Vec<f64>, Vec<GaussOutput>) {
         let nd = 2 * kind.n_nodes();
         let c = coords(kind);
         let mat = elastic();

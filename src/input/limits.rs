@@ -121,20 +121,16 @@ pub fn check_size(
 }
 
 /// Number of nodes of a structured grid of `nx` × `ny` quadrilaterals of `kind` (f64: the
-/// count is checked before anything is allocated).
-pub fn grid_nodes(kind: crate::model::QuadKind, nx: f64, ny: f64) -> f64 {
-    use crate::model::QuadKind;
-    match kind {
-        QuadKind::Q4 => (nx + 1.0) * (ny + 1.0),
-        QuadKind::Q9 => (2.0 * nx + 1.0) * (2.0 * ny + 1.0),
-        QuadKind::Q8 => (2.0 * nx + 1.0) * (2.0 * ny + 1.0) - nx * ny,
-    }
+/// count is checked before anything is allocated; the kind's descriptor gives its grid
+/// layout). 0 for a kind the generators cannot make (refused before this is asked).
+pub fn grid_nodes(kind: crate::model::ElementKind, nx: f64, ny: f64) -> f64 {
+    kind.grid_nodes(nx, ny).unwrap_or(0.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::QuadKind;
+    use crate::model::ElementKind;
 
     fn ctx() -> Ctx {
         Ctx {
@@ -145,9 +141,9 @@ mod tests {
     /// Node counts of small grids counted by hand: 2 × 1 Q4 → 6, Q8 → 13, Q9 → 15.
     #[test]
     fn grid_node_counts() {
-        assert_eq!(grid_nodes(QuadKind::Q4, 2.0, 1.0), 6.0);
-        assert_eq!(grid_nodes(QuadKind::Q8, 2.0, 1.0), 13.0);
-        assert_eq!(grid_nodes(QuadKind::Q9, 2.0, 1.0), 15.0);
+        assert_eq!(grid_nodes(ElementKind::Q4, 2.0, 1.0), 6.0);
+        assert_eq!(grid_nodes(ElementKind::Q8, 2.0, 1.0), 13.0);
+        assert_eq!(grid_nodes(ElementKind::Q9, 2.0, 1.0), 15.0);
     }
 
     /// Above the dof limit always an error; below it, an error only when the estimate

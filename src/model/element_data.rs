@@ -5,9 +5,12 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The quadrilateral element kinds.
+/// The continuum element kinds. Each kind's properties (nodes, edges, reference domain,
+/// shape functions, quadrature, extrapolation, VTK and Gmsh ids, name) are one descriptor in
+/// `crate::fem::kinds` (`ElementKind::info`); a new kind is a variant here, its descriptor
+/// file there and its line in `crate::fem::kinds::ALL`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum QuadKind {
+pub enum ElementKind {
     /// 4-node bilinear quadrilateral.
     Q4,
     /// 8-node serendipity quadrilateral.
