@@ -9,6 +9,7 @@ use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
 use crate::mesh::gmsh::{parse_msh, GmshElementKind, GmshMesh};
 use crate::mesh::segmental::{Joint, JointFace};
 use crate::model::Element;
+use crate::model::ElementKind;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -153,7 +154,7 @@ fn map(
                 .position(|r| r == name)
                 .expect("checked above");
             let coords: Vec<[f64; 2]> = ids.iter().map(|&i| nodes[i]).collect();
-            if let Some(m) = degenerate(&coords, &el.nodes, size) {
+            if let Some(m) = degenerate(&coords, kind.n_corners(), &el.nodes, size) {
                 return Err(ctx.err("mesh.file", format!("{file}: element {}: {m}", el.tag)));
             }
             if integ == Integration::Incompatible && !kind.info().incompatible_modes {
@@ -207,7 +208,10 @@ fn map(
     if elements.is_empty() {
         return Err(ctx.err(
             "mesh.file",
-            format!("{file}: no quadrilateral elements (Q4, Q8 or Q9) found"),
+            format!(
+                "{file}: no continuum elements ({}) found",
+                ElementKind::names()
+            ),
         ));
     }
     for v in groups.nodes.values_mut() {

@@ -182,32 +182,34 @@ pub fn extent(nodes: &[[f64; 2]]) -> f64 {
 
 /// Why an element is degenerate, if it is: a corner edge shorter than 1e-9 of the model size
 /// `size` [m], or a corner polygon of area below 1e-12 size² (both far below any meshing
-/// intent, far above round-off). `ids` are the element's node numbers as the user knows them.
-pub fn degenerate(coords: &[[f64; 2]], ids: &[u64], size: f64) -> Option<String> {
+/// intent, far above round-off). The first `nc` nodes are the corners (the kind's
+/// descriptor); `ids` are the element's node numbers as the user knows them.
+pub fn degenerate(coords: &[[f64; 2]], nc: usize, ids: &[u64], size: f64) -> Option<String> {
     let tol = 1e-9 * size;
-    for k in 0..4 {
-        let (a, b) = (coords[k], coords[(k + 1) % 4]);
+    for k in 0..nc {
+        let (a, b) = (coords[k], coords[(k + 1) % nc]);
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         if len.is_nan() || len <= tol {
             return Some(format!(
                 "the edge from node {} to node {} has (nearly) zero length: {len:.3e} m in a model {size:.3e} m across",
                 ids[k],
-                ids[(k + 1) % 4]
+                ids[(k + 1) % nc]
             ));
         }
     }
     // Shoelace area of the corner polygon.
-    let area: f64 = (0..4)
+    let area: f64 = (0..nc)
         .map(|k| {
-            let (a, b) = (coords[k], coords[(k + 1) % 4]);
+            let (a, b) = (coords[k], coords[(k + 1) % nc]);
             a[0] * b[1] - b[0] * a[1]
         })
         .sum::<f64>()
         * 0.5;
     if area.is_nan() || area.abs() <= 1e-12 * size * size {
+        let corners: Vec<String> = ids[..nc].iter().map(|i| i.to_string()).collect();
         return Some(format!(
-            "zero area ({area:.3e} m²): its corners (nodes {}, {}, {}, {}) are collinear",
-            ids[0], ids[1], ids[2], ids[3]
+            "zero area ({area:.3e} m²): its corners (nodes {}) are collinear",
+            corners.join(", ")
         ));
     }
     None
@@ -223,15 +225,15 @@ mod geometry_tests {
     fn degenerate_elements() {
         let ids = [1, 2, 3, 4];
         let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert_eq!(degenerate(&sq, &ids, 10.0), None);
+        assert_eq!(degenerate(&sq, 4, &ids, 10.0), None);
         let pinched = [[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-        let m = degenerate(&pinched, &ids, 10.0).unwrap();
+        let m = degenerate(&pinched, 4, &ids, 10.0).unwrap();
         assert!(m.contains("node 2 to node 3"), "{m}");
         let flat = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]];
-        let m = degenerate(&flat, &ids, 10.0).unwrap();
+        let m = degenerate(&flat, 4, &ids, 10.0).unwrap();
         assert!(m.contains("zero area"), "{m}");
         let nan = [[f64::NAN, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert!(degenerate(&nan, &ids, 10.0).is_some());
+        assert!(degenerate(&nan, 4, &ids, 10.0).is_some());
     }
 }
 

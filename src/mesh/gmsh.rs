@@ -2,10 +2,12 @@
 //!
 //! Sections read: `$MeshFormat`, `$PhysicalNames`, `$Entities` (4.1: maps entity tags to
 //! physical tags), `$Nodes`, `$Elements`; any other section is skipped. Element types accepted:
-//! 15 (point), 1 (2-node line), 8 (3-node line), 3 (4-node quad), 16 (8-node quad), 10 (9-node
-//! quad); any other type is an error naming the type. Node lists are returned in VTK order
-//! (quads: corners counter-clockwise as in the file, mid-edges 0–1, 1–2, 2–3, 3–0, centre; lines:
-//! start, end, middle), which for these types coincides with Gmsh's order. Coordinates are in the
+//! 15 (point), 1 (2-node line), 8 (3-node line) and the continuum kinds' types (their
+//! descriptors, `crate::fem::kinds`: 3 4-node quad, 16 8-node quad, 10 9-node quad, 9 6-node
+//! triangle); any other type is an error naming the type. Node lists are returned in VTK order
+//! (quads: corners counter-clockwise as in the file, mid-edges 0–1, 1–2, 2–3, 3–0, centre; T6:
+//! corners, mid-edges 0–1, 1–2, 2–0; lines: start, end, middle), which for these types
+//! coincides with Gmsh's order. Coordinates are in the
 //! file's units (metres by project convention); z is ignored.
 //!
 //! Errors name the file, the line (ASCII) or byte offset (binary) and what is wrong; malformed
@@ -209,7 +211,7 @@ pub enum GmshError {
         message: String,
     },
     /// An element type the solver does not support.
-    #[error("{file}, {location}: element type {type_id} ({name}) is not supported; use quadrangles (types 3, 16, 10), lines (1, 8) and points (15) — e.g. Mesh.RecombineAll = 1")]
+    #[error("{file}, {location}: element type {type_id} ({name}) is not supported; use quadrangles (types 3, 16, 10), 6-node triangles (9), lines (1, 8) and points (15) — e.g. Mesh.RecombineAll = 1, or Mesh.ElementOrder = 2 for 6-node triangles")]
     UnsupportedElement {
         /// File name.
         file: String,

@@ -17,6 +17,8 @@ pub enum ElementKind {
     Q8,
     /// 9-node Lagrange quadrilateral.
     Q9,
+    /// 6-node quadratic triangle.
+    T6,
 }
 
 /// Integration rule of a continuum element.

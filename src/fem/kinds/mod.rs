@@ -10,6 +10,7 @@
 mod q4;
 mod q8;
 mod q9;
+mod t6;
 
 use super::quadrature::{gauss, gauss_square, Point2};
 use super::shape::{ShapeValues, MAX_NODES};
@@ -17,7 +18,12 @@ use crate::model::element_data::Integration;
 use crate::model::ElementKind;
 
 /// Every continuum element kind, in the order of their variants.
-pub const ALL: [ElementKind; 3] = [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9];
+pub const ALL: [ElementKind; 4] = [
+    ElementKind::Q4,
+    ElementKind::Q8,
+    ElementKind::Q9,
+    ElementKind::T6,
+];
 
 /// The reference domain of an element kind's natural coordinates (ξ, η).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -150,6 +156,7 @@ impl ElementKind {
             ElementKind::Q4 => &q4::Q4,
             ElementKind::Q8 => &q8::Q8,
             ElementKind::Q9 => &q9::Q9,
+            ElementKind::T6 => &t6::T6,
         }
     }
 
@@ -159,7 +166,7 @@ impl ElementKind {
             .find(|k| k.info().name.eq_ignore_ascii_case(s))
     }
 
-    /// The names of all kinds, "Q4, Q8 or Q9", for messages.
+    /// The names of all kinds, "Q4, Q8, Q9 or T6", for messages.
     pub fn names() -> String {
         let n: Vec<&str> = ALL.iter().map(|k| k.info().name).collect();
         match n.split_last() {
@@ -360,6 +367,7 @@ mod tests {
                 Domain::Square => 4.0,
                 Domain::Triangle => 0.5,
             };
+            // A kind without a reduced rule integrates "reduced" by its full rule.
             for rule in [Integration::Full, Integration::Reduced] {
                 let w: f64 = k.rule(rule).iter().map(|p| p.2).sum();
                 assert!((w - area).abs() < 1e-14, "{k:?} {rule:?}");

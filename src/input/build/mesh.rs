@@ -207,7 +207,7 @@ fn banded_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
         limits::available_memory(),
     )?;
     let g = banded::generate(origin, length, nx, &bands, kind);
-    check_generated(ctx, &g.nodes, &g.elements)?;
+    check_generated(ctx, kind, &g.nodes, &g.elements)?;
     let elements = g
         .elements
         .into_iter()
@@ -317,7 +317,7 @@ fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                 nodes.push(n);
             }
             let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.nodes[n]).collect();
-            if let Some(m) = limits::degenerate(&coords, &ids_of(conn), size) {
+            if let Some(m) = limits::degenerate(&coords, kind.n_corners(), &ids_of(conn), size) {
                 return Err(ctx.err(&key, m));
             }
             let detj = min_jacobian(kind, &coords, integ);
@@ -410,7 +410,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         .into_iter()
         .map(|(nodes, region, _segment)| (nodes, region))
         .collect::<Vec<_>>();
-    check_generated(ctx, &g.nodes, &elements)?;
+    check_generated(ctx, kind, &g.nodes, &elements)?;
     let elements = elements
         .into_iter()
         .map(|(nodes, region)| Element {
@@ -529,6 +529,7 @@ fn shape_segmental(
 /// zero-length edges.
 pub(super) fn check_generated(
     ctx: &Ctx,
+    kind: ElementKind,
     nodes: &[[f64; 2]],
     elements: &[(Vec<usize>, usize)],
 ) -> R<()> {
@@ -551,7 +552,7 @@ pub(super) fn check_generated(
     for (i, (conn, _)) in elements.iter().enumerate() {
         let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();
         let ids: Vec<u64> = conn.iter().map(|&n| n as u64 + 1).collect();
-        if let Some(m) = limits::degenerate(&c, &ids, size) {
+        if let Some(m) = limits::degenerate(&c, kind.n_corners(), &ids, size) {
             return Err(ctx.err(
                 "mesh",
                 format!(
