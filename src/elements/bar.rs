@@ -370,20 +370,29 @@ mod tests {
             let mut c = coords_of(&nodes, &elems).remove(0);
             c[2][0] += 0.15;
             c[2][1] += 0.1;
-            if kind != ElementKind::Q4 {
-                c[5] = [0.5 * (c[1][0] + c[2][0]) + 0.03, 0.5 * (c[1][1] + c[2][1])];
-                c[6] = [0.5 * (c[2][0] + c[3][0]), 0.5 * (c[2][1] + c[3][1]) - 0.02];
+            // Quadratic kinds: the mid-side nodes of edges 1 and 2 off their edges' middles.
+            if kind.info().order == 2 {
+                let (e1, e2) = (kind.edge_nodes(1), kind.edge_nodes(2));
+                let mid = |e: &[usize]| {
+                    [
+                        0.5 * (c[e[0]][0] + c[e[1]][0]),
+                        0.5 * (c[e[0]][1] + c[e[1]][1]),
+                    ]
+                };
+                let (m1, m2) = (mid(e1), mid(e2));
+                c[e1[2]] = [m1[0] + 0.03, m1[1]];
+                c[e2[2]] = [m2[0], m2[1] - 0.02];
             }
             if kind == ElementKind::Q9 {
                 c[8] = [0.62, 0.48];
             }
             let hosts = [HostElement { kind, coords: &c }];
-            let pieces = embed(
-                &BarPath::Quadratic([[0.1, 0.2], [0.6, 0.5], [1.1, 0.6]]),
-                &hosts,
-                3,
-            )
-            .unwrap();
+            // A curved path inside the host (a triangle: the cell's lower-right half).
+            let path = match kind.info().domain {
+                crate::fem::kinds::Domain::Square => [[0.1, 0.2], [0.6, 0.5], [1.1, 0.6]],
+                crate::fem::kinds::Domain::Triangle => [[0.3, 0.05], [0.8, 0.25], [1.2, 0.5]],
+            };
+            let pieces = embed(&BarPath::Quadratic(path), &hosts, 3).unwrap();
             let m = 2 * kind.n_nodes();
             let force = |u: &[f64]| -> (Vec<f64>, Vec<f64>) {
                 let mut f = vec![0.0; m];

@@ -176,16 +176,21 @@ pub fn response_tl(
 mod tests {
     use super::*;
     use crate::elements::continuum::{gauss_geometry, response_at, rule_points, Integration};
-    use crate::fem::shape::NODE_XI;
 
-    const KINDS: [ElementKind; 3] = [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9];
+    const KINDS: [ElementKind; 4] = crate::fem::kinds::ALL;
 
     /// A distorted element: the natural node positions mapped through a skewed, stretched map
-    /// with a quadratic term (curved edges for Q8/Q9) [m].
+    /// with a quadratic term (curved edges for the quadratic kinds) [m].
     fn coords(kind: ElementKind) -> Vec<[f64; 2]> {
         (0..kind.n_nodes())
             .map(|a| {
-                let [x, y] = NODE_XI[a];
+                // A triangle's (ξ, η) ∈ [0, 1] stretched to the quadrilaterals' [−1, 1].
+                let [x, y] = match kind.info().domain {
+                    crate::fem::kinds::Domain::Square => kind.info().node_xi[a],
+                    crate::fem::kinds::Domain::Triangle => {
+                        kind.info().node_xi[a].map(|v| 2.0 * v - 1.0)
+                    }
+                };
                 [
                     0.6 * x + 0.1 * y + 0.03 * y * y + 1.0,
                     0.25 * y - 0.05 * x + 0.02 * x * x - 0.4,
