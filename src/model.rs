@@ -9,7 +9,7 @@ pub mod thermal;
 
 use crate::materials::mc90_time::RelaxationClass;
 use crate::materials::point::Material;
-pub use element_data::{BarPoint, DeviatorMode, Integration, InterfaceParams, QuadKind};
+pub use element_data::{BarPoint, DeviatorMode, ElementKind, Integration, InterfaceParams};
 pub use influence::{Combination, Influence, Placement};
 use serde::Serialize;
 pub use stages::{Lifetime, Push, Staging};
@@ -19,7 +19,7 @@ pub use thermal::ThermalAction;
 #[derive(Debug, Clone, Serialize)]
 pub struct Element {
     /// Element kind.
-    pub kind: QuadKind,
+    pub kind: ElementKind,
     /// Node indices (0-based), VTK order.
     pub nodes: Vec<usize>,
     /// Region index.

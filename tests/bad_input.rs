@@ -400,7 +400,7 @@ fn unknown_element_type_explicit() {
     rejects(
         &model,
         "mesh.blocks[0].element",
-        &["unknown element type 'T3'", "Q4, Q8 or Q9"],
+        &["unknown element type 'T3'", "Q4, Q8, Q9 or T6"],
     );
 }
 

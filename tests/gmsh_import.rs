@@ -4,29 +4,26 @@
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::mesh::banded::Band;
 use segfem::mesh::segmental::generate_segments;
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use std::fmt::Write;
 
 /// Write a Gmsh 2.2 ASCII file of the decompression example's mesh: Q8 elements in the
 /// physical surface "web", joint faces as 3-node lines in curves "J1a"/"J1b", "J2a"/"J2b".
 fn msh_text() -> String {
-    msh_text_of(QuadKind::Q8)
+    msh_text_of(ElementKind::Q8)
 }
 
 /// As [`msh_text`] with elements of `kind` (Gmsh types 3, 16, 10; joint faces as 2-node
 /// lines, type 1, for Q4 and 3-node lines, type 8, otherwise).
-fn msh_text_of(kind: QuadKind) -> String {
+fn msh_text_of(kind: ElementKind) -> String {
     let bands = [Band {
         depth: 0.5,
         rows: 8,
         region: 0,
     }];
     let m = generate_segments(0.0, 0.0, &[2.0, 2.0, 2.0], &[8, 8, 8], &bands, kind);
-    let (quad_type, line_type) = match kind {
-        QuadKind::Q4 => (3, 1),
-        QuadKind::Q8 => (16, 8),
-        QuadKind::Q9 => (10, 8),
-    };
+    let quad_type = kind.info().gmsh_type;
+    let line_type = if kind.info().order == 1 { 1 } else { 8 };
     let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n5\n");
     s.push_str(
         "1 1 \"J1a\"\n1 2 \"J1b\"\n1 3 \"J2a\"\n1 4 \"J2b\"\n2 10 \"web\"\n$EndPhysicalNames\n",
@@ -103,12 +100,12 @@ fn tmp_dir(name: &str) -> std::path::PathBuf {
 /// equations; only the text coordinates' round-off differs).
 #[test]
 fn generated_and_gmsh_meshes_give_the_same_results() {
-    for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+    for kind in [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9] {
         same_results(kind);
     }
 }
 
-fn same_results(kind: QuadKind) {
+fn same_results(kind: ElementKind) {
     let name = format!("{kind:?}");
     let dir = tmp_dir(&format!("same-{name}"));
     std::fs::write(dir.join("beam.msh"), msh_text_of(kind)).unwrap();
@@ -121,7 +118,7 @@ fn same_results(kind: QuadKind) {
         "/examples/segmental-decompression.toml"
     ))
     .unwrap();
-    let text = if kind == QuadKind::Q8 {
+    let text = if kind == ElementKind::Q8 {
         text
     } else {
         let t = text.replace("element = \"Q8\"", &format!("element = \"{name}\""));
@@ -148,6 +145,146 @@ fn same_results(kind: QuadKind) {
         }
     }
     let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A Gmsh 2.2 file mixing Q9 (type 10) and T6 (type 9) elements: a 2 m × 1 m block of 2 × 2
+/// cells, the left column Q9, each cell of the right column split along its diagonal into
+/// two T6 (the cell's centre node their shared mid-side node), every interior node moved.
+/// Boundary nodes carry a linear displacement field (point supports): the free interior
+/// nodes, on the conforming Q9–T6 interface too, and every Gauss-point stress reproduce it
+/// (patch test; tolerances as in tests/verification.rs: 1e-12 m on 1e-3 m, 1e-9 of E ε).
+#[test]
+fn gmsh_mixed_q9_and_t6_mesh_passes_the_patch_test() {
+    let (nx, ny, lx, ly) = (2usize, 2usize, 2.0, 1.0);
+    let (gx, gy) = (2 * nx + 1, 2 * ny + 1);
+    let id = |i: usize, j: usize| j * gx + i;
+    let on_boundary = |i: usize, j: usize| i == 0 || j == 0 || i == gx - 1 || j == gy - 1;
+    let mut nodes = Vec::new();
+    for j in 0..gy {
+        for i in 0..gx {
+            let mut p = [
+                lx * i as f64 / (gx - 1) as f64,
+                ly * j as f64 / (gy - 1) as f64,
+            ];
+            if !on_boundary(i, j) {
+                let k = id(i, j) as f64;
+                p[0] += 0.04 * (1.7 * k).sin();
+                p[1] += 0.03 * (2.3 * k).cos();
+            }
+            nodes.push(p);
+        }
+    }
+    let mut elements: Vec<(i64, Vec<usize>)> = Vec::new();
+    for r in 0..ny {
+        for c in 0..nx {
+            let (i, j) = (2 * c, 2 * r);
+            let q = [
+                id(i, j),
+                id(i + 2, j),
+                id(i + 2, j + 2),
+                id(i, j + 2),
+                id(i + 1, j),
+                id(i + 2, j + 1),
+                id(i + 1, j + 2),
+                id(i, j + 1),
+                id(i + 1, j + 1),
+            ];
+            if c == 0 {
+                elements.push((ElementKind::Q9.info().gmsh_type, q.to_vec()));
+            } else {
+                let t6 = ElementKind::T6.info().gmsh_type;
+                elements.push((t6, vec![q[0], q[1], q[2], q[4], q[5], q[8]]));
+                elements.push((t6, vec![q[0], q[2], q[3], q[8], q[6], q[7]]));
+            }
+        }
+    }
+    let mut msh = String::from(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 10 \"web\"\n$EndPhysicalNames\n",
+    );
+    let _ = writeln!(msh, "$Nodes\n{}", nodes.len());
+    for (k, p) in nodes.iter().enumerate() {
+        let _ = writeln!(msh, "{} {:.17e} {:.17e} 0", k + 1, p[0], p[1]);
+    }
+    let _ = writeln!(msh, "$EndNodes\n$Elements\n{}", elements.len());
+    for (k, (t, ns)) in elements.iter().enumerate() {
+        let ids: Vec<String> = ns.iter().map(|n| (n + 1).to_string()).collect();
+        let _ = writeln!(msh, "{} {t} 2 10 1 {}", k + 1, ids.join(" "));
+    }
+    msh.push_str("$EndElements\n");
+    let field = |p: [f64; 2]| {
+        [
+            1e-3 + 2e-3 * p[0] - 1e-3 * p[1],
+            -5e-4 + 0.5e-3 * p[0] + 1.5e-3 * p[1],
+        ]
+    };
+    let (e, nu) = (30e9, 0.2);
+    let mut text = format!(
+        "[[materials]]\nname = \"c\"\nkind = \"elastic\"\nE = {e}\nnu = {nu}\n\n[[regions]]\nname = \"web\"\nmaterial = \"c\"\nthickness = 0.3\n\n[mesh]\ntype = \"gmsh\"\nfile = \"mixed.msh\"\n\n"
+    );
+    for j in 0..gy {
+        for i in 0..gx {
+            if on_boundary(i, j) {
+                let p = nodes[id(i, j)];
+                let u = field(p);
+                let _ = writeln!(
+                    text,
+                    "[[supports]]\nname = \"b{i}_{j}\"\npoint = [{:.17e}, {:.17e}]\nux = {:.17e}\nuy = {:.17e}\n",
+                    p[0], p[1], u[0], u[1]
+                );
+            }
+        }
+    }
+    text.push_str("[[load_cases]]\nname = \"none\"\n\n[[steps]]\nname = \"s\"\nkind = \"linear\"\nloads = { none = 1.0 }\n");
+    let dir = tmp_dir("mixed-t6");
+    std::fs::write(dir.join("mixed.msh"), msh).unwrap();
+    let path = dir.join("mixed.toml");
+    std::fs::write(&path, text).unwrap();
+    let model = segfem::input::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model;
+    let kinds: Vec<ElementKind> = model.elements.iter().map(|e| e.kind).collect();
+    assert_eq!(kinds.iter().filter(|k| **k == ElementKind::Q9).count(), 2);
+    assert_eq!(kinds.iter().filter(|k| **k == ElementKind::T6).count(), 4);
+    let mut last = Last::default();
+    steps::run(&model, &mut last).unwrap();
+    for (k, p) in model.nodes.iter().enumerate() {
+        let u = field(*p);
+        assert!(
+            (last.u[2 * k] - u[0]).abs() < 1e-12 && (last.u[2 * k + 1] - u[1]).abs() < 1e-12,
+            "node {k} at {p:?}: {:?} vs {u:?}",
+            &last.u[2 * k..2 * k + 2]
+        );
+    }
+    let eps = [2e-3, 1.5e-3, -1e-3 + 0.5e-3];
+    let c = e / (1.0 - nu * nu);
+    let sig = [
+        c * (eps[0] + nu * eps[1]),
+        c * (eps[1] + nu * eps[0]),
+        c * (1.0 - nu) / 2.0 * eps[2],
+    ];
+    assert_eq!(last.stress.len(), 2 * 9 + 4 * 3);
+    for s in &last.stress {
+        for k in 0..3 {
+            assert!((s[k] - sig[k]).abs() < 1e-9 * c * 2e-3, "{s:?} vs {sig:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Last converged displacements and Gauss-point stresses.
+#[derive(Default)]
+struct Last {
+    u: Vec<f64>,
+    stress: Vec<[f64; 3]>,
+}
+
+impl Observer for Last {
+    fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
+        self.u = s.system.u.clone();
+        let g = &s.system.families.continuum.gauss.committed;
+        self.stress = g.iter().map(|p| p.stress).collect();
+        Ok(())
+    }
 }
 
 #[test]

@@ -21,7 +21,7 @@ use segfem::elements::tendon::{DeviatorMode, ExternalTendon, TendonLaw};
 use segfem::materials::concrete::{self, ConcreteParams, ConcreteState};
 use segfem::materials::point::{update, Material, PointState};
 use segfem::materials::steel::{update_uniaxial, HardeningRule, SteelParams, SteelState};
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use std::cell::Cell;
 
 // ------------------------------------------------------------------------------------------
@@ -92,7 +92,7 @@ fn rot_stress(a: f64, t: [f64; 3]) -> [f64; 3] {
 /// up to 15 % of the size (`d` in [−1, 1]), mid-edge nodes on the straight edges moved along
 /// the edge by up to 10 % (`m`), centre at the corner mean (Q9). Convex by construction, so
 /// det J > 0.
-fn quad_nodes(kind: QuadKind, w: f64, h: f64, d: &[f64; 8], m: &[f64; 4]) -> Vec<[f64; 2]> {
+fn quad_nodes(kind: ElementKind, w: f64, h: f64, d: &[f64; 8], m: &[f64; 4]) -> Vec<[f64; 2]> {
     let c0 = [[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
     let c: Vec<[f64; 2]> = (0..4)
         .map(|i| {
@@ -103,14 +103,14 @@ fn quad_nodes(kind: QuadKind, w: f64, h: f64, d: &[f64; 8], m: &[f64; 4]) -> Vec
         })
         .collect();
     let mut x = c.clone();
-    if kind != QuadKind::Q4 {
+    if kind != ElementKind::Q4 {
         for i in 0..4 {
             let (a, b) = (c[i], c[(i + 1) % 4]);
             let t = 0.5 + 0.1 * m[i];
             x.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
         }
     }
-    if kind == QuadKind::Q9 {
+    if kind == ElementKind::Q9 {
         let mut ctr = [0.0; 2];
         for p in &c {
             ctr[0] += 0.25 * p[0];
@@ -121,8 +121,12 @@ fn quad_nodes(kind: QuadKind, w: f64, h: f64, d: &[f64; 8], m: &[f64; 4]) -> Vec
     x
 }
 
-fn kinds() -> impl Strategy<Value = QuadKind> {
-    prop_oneof![Just(QuadKind::Q4), Just(QuadKind::Q8), Just(QuadKind::Q9)]
+fn kinds() -> impl Strategy<Value = ElementKind> {
+    prop_oneof![
+        Just(ElementKind::Q4),
+        Just(ElementKind::Q8),
+        Just(ElementKind::Q9)
+    ]
 }
 
 fn integrations() -> impl Strategy<Value = Integration> {
@@ -156,7 +160,7 @@ fn concrete() -> Material {
 
 /// Element response (f, K row-major) from the given committed states.
 fn element(
-    kind: QuadKind,
+    kind: ElementKind,
     integ: Integration,
     x: &[[f64; 2]],
     mat: &Material,
@@ -175,7 +179,7 @@ fn element(
     (f, k, trial, out)
 }
 
-fn fresh_states(kind: QuadKind, integ: Integration, mat: &Material) -> Vec<PointState> {
+fn fresh_states(kind: ElementKind, integ: Integration, mat: &Material) -> Vec<PointState> {
     let n = segfem::elements::continuum::rule_points(kind, integ).len();
     vec![mat.initial_state(); n]
 }

@@ -82,7 +82,7 @@ pub(super) fn crack_band_width(model: &Model, cache: Option<&GeometryCache>, e: 
         coords[a] = model.nodes[n];
     }
     let (kind, rule) = match el.integration {
-        Integration::Incompatible => (crate::model::QuadKind::Q4, Integration::Full),
+        Integration::Incompatible => (crate::model::ElementKind::Q4, Integration::Full),
         i => (el.kind, i),
     };
     gauss_geometry(kind, rule, &coords[..el.nodes.len()]).h

@@ -128,14 +128,11 @@ fn equation_order(
     dofs: &DofMap,
 ) -> (Option<Vec<usize>>, f64) {
     let t_order = std::time::Instant::now();
-    // Nested dissection on large systems: on meshes of 4-node elements split
-    // along node coordinates; with Q8/Q9 elements (whose mid-side nodes a line
+    // Nested dissection on large systems: on meshes of linear elements (Q4) split
+    // along node coordinates; with quadratic elements (whose mid-side nodes a line
     // through the nodes would cut off) split along element edges.
-    let all_q4 = model
-        .elements
-        .iter()
-        .all(|e| e.kind == crate::model::QuadKind::Q4);
-    let ordering = if all_q4 {
+    let all_linear = model.elements.iter().all(|e| e.kind.info().order == 1);
+    let ordering = if all_linear {
         (dofs.n_eq >= crate::linalg::ordering::ND_MIN_EQUATIONS).then(|| {
             crate::linalg::ordering::nested_dissection(
                 &asm.node_ptr,

@@ -6,8 +6,8 @@
 
 use crate::elements::continuum::rule_points;
 use crate::elements::tendon::ExternalTendon;
+use crate::model::ElementKind;
 use crate::model::Model;
-use crate::model::QuadKind;
 use crate::model::ThermalAction;
 
 /// Unit-factor imposed strains of one thermal load case.
@@ -36,7 +36,7 @@ pub struct Thermal {
 }
 
 /// Global height y [m] of the point at natural coordinates (ξ, η) of an element.
-fn height(kind: QuadKind, coords: &[[f64; 2]], xi: f64, eta: f64) -> f64 {
+fn height(kind: ElementKind, coords: &[[f64; 2]], xi: f64, eta: f64) -> f64 {
     let s = kind.eval(xi, eta);
     coords
         .iter()

@@ -5,19 +5,16 @@ use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::elements::continuum::Integration;
 use segfem::materials::point::Material;
 use segfem::mesh::banded::{generate, Band};
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use segfem::model::*;
 use std::time::Instant;
 
 /// A simply supported-free cantilever-like banded beam (three bands: flange, web, flange)
 /// with about `target_dofs` degrees of freedom, clamped at x = 0, loaded at the free end.
-pub fn banded_beam(kind: QuadKind, target_dofs: usize) -> Model {
+pub fn banded_beam(kind: ElementKind, target_dofs: usize) -> Model {
     // Mesh with nx = 4 ny: dofs ≈ 2 (nx+1)(ny+1) for Q4, ≈ 6 nx ny for Q8/Q9 (8 for Q9).
-    let per_cell = match kind {
-        QuadKind::Q4 => 2.0,
-        QuadKind::Q8 => 6.0,
-        QuadKind::Q9 => 8.0,
-    };
+    // Dofs per cell: 2 × the nodes per element of a large grid (1 Q4, 3 Q8, 4 Q9).
+    let per_cell = 2.0 * kind.grid_nodes(1e4, 1e4).map_or(1.0, |n| (n / 1e8).round());
     let ny = ((target_dofs as f64 / (4.0 * per_cell)).sqrt().round() as usize).max(3);
     let nx = 4 * ny;
     let r1 = ny / 5;
@@ -177,7 +174,7 @@ pub struct BenchRow {
 }
 
 /// Run one benchmark case.
-pub fn run_case(kind: QuadKind, target_dofs: usize) -> Result<BenchRow, steps::AnalysisError> {
+pub fn run_case(kind: ElementKind, target_dofs: usize) -> Result<BenchRow, steps::AnalysisError> {
     let t0 = Instant::now();
     let model = banded_beam(kind, target_dofs);
     let mesh_s = t0.elapsed().as_secs_f64();

@@ -1,7 +1,7 @@
 //! The `segfem bench` command: one function per `--case`, printing one row per size or
 //! refinement (the cases themselves are in [`super::bench`]).
 
-use segfem::model::QuadKind;
+use segfem::model::ElementKind;
 use std::process::ExitCode;
 
 use crate::stdout_failed;
@@ -22,12 +22,17 @@ pub(crate) fn bench(dofs: Vec<f64>, element: Vec<String>) -> ExitCode {
         "tip uy [m]"
     );
     for e in &element {
-        let kind = match e.as_str() {
-            "Q4" => QuadKind::Q4,
-            "Q8" => QuadKind::Q8,
-            "Q9" => QuadKind::Q9,
-            o => {
-                eprintln!("error: --element: unknown element '{o}' (Q4, Q8, Q9)");
+        let kind = match ElementKind::from_name(e) {
+            Some(k) if k.grid_layout().is_some() => k,
+            Some(_) => {
+                eprintln!("error: --element: the bench meshes quadrilaterals, not '{e}'");
+                return ExitCode::from(2);
+            }
+            None => {
+                eprintln!(
+                    "error: --element: unknown element '{e}' ({})",
+                    ElementKind::names()
+                );
                 return ExitCode::from(2);
             }
         };

@@ -12,7 +12,7 @@
 
 use crate::fem::shape::{cartesian_derivatives, jacobian, MAX_NODES};
 use crate::materials::steel::{update_uniaxial, SteelParams, SteelState};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// A bar point (plain model data, defined in [`crate::model`]).
 pub use crate::model::element_data::BarPoint;
@@ -30,13 +30,17 @@ pub fn strain_along(dir: [f64; 2], eps: [f64; 3]) -> f64 {
 
 /// The row vector g = T(φ) B of a bar point (length 2n, interleaved dofs): ε_b = g · a_e.
 /// Entries: g_{2i} = cosφ (t·∇N_i), g_{2i+1} = sinφ (t·∇N_i) [1/m].
-pub fn bar_strain_vector(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> Vec<f64> {
+pub fn bar_strain_vector(kind: ElementKind, coords: &[[f64; 2]], p: &BarPoint) -> Vec<f64> {
     bar_strain_row(kind, coords, p)[..2 * kind.n_nodes()].to_vec()
 }
 
 /// As [`bar_strain_vector`] without allocating (the assembly loop calls it for every bar
 /// point): the first 2n entries are g, the rest zero.
-pub fn bar_strain_row(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> [f64; 2 * MAX_NODES] {
+pub fn bar_strain_row(
+    kind: ElementKind,
+    coords: &[[f64; 2]],
+    p: &BarPoint,
+) -> [f64; 2 * MAX_NODES] {
     let n = kind.n_nodes();
     assert_eq!(coords.len(), n, "coords must have {n} entries for {kind:?}");
     let s = kind.eval(p.xi, p.eta);
@@ -59,7 +63,7 @@ pub fn bar_strain_row(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint) -> [f64
 /// Force f = g σ A w and tangent K = g E_t A w gᵀ + σ A w (d dᵀ ⊗ I₂) (the second term is
 /// the bar's geometric stiffness). Reduces to [`bar_strain_vector`] for u = 0.
 pub fn bar_green_strain(
-    kind: QuadKind,
+    kind: ElementKind,
     coords: &[[f64; 2]],
     p: &BarPoint,
     u_e: &[f64],
@@ -88,7 +92,7 @@ pub fn bar_green_strain(
 
 /// Bar strain ε_b = T(φ) B a_e [-] at point `p` from the host's nodal displacements `u_e` [m]
 /// (interleaved, 2·n_nodes entries).
-pub fn bar_strain(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint, u_e: &[f64]) -> f64 {
+pub fn bar_strain(kind: ElementKind, coords: &[[f64; 2]], p: &BarPoint, u_e: &[f64]) -> f64 {
     let g = bar_strain_vector(kind, coords, p);
     assert_eq!(u_e.len(), g.len(), "u_e must have {} entries", g.len());
     g.iter().zip(u_e).map(|(a, b)| a * b).sum()
@@ -100,7 +104,7 @@ pub fn bar_strain(kind: QuadKind, coords: &[[f64; 2]], p: &BarPoint, u_e: &[f64]
 /// `area` A_b [m²], `stress` σ_b [Pa], `tangent` E_t = dσ_b/dε_b [Pa].
 #[allow(clippy::too_many_arguments)]
 pub fn add_bar_point(
-    kind: QuadKind,
+    kind: ElementKind,
     coords: &[[f64; 2]],
     p: &BarPoint,
     area: f64,
@@ -184,7 +188,7 @@ pub struct BarPointResult {
 #[allow(clippy::too_many_arguments)]
 pub fn bar_point_response(
     kinematics: BarKinematics,
-    kind: QuadKind,
+    kind: ElementKind,
     coords: &[[f64; 2]],
     p: &BarPoint,
     steel: &SteelParams,
@@ -329,7 +333,7 @@ mod tests {
     fn patch_test_unit_square_q4() {
         let c = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         let hosts = [HostElement {
-            kind: QuadKind::Q4,
+            kind: ElementKind::Q4,
             coords: &c,
         }];
         let pieces = embed(&BarPath::Polyline(vec![[0.0, 0.5], [1.0, 0.5]]), &hosts, 2).unwrap();
@@ -339,9 +343,9 @@ mod tests {
         let mut f = vec![0.0; 8];
         let mut k = vec![0.0; 64];
         for p in &pieces[0].points {
-            let eb = bar_strain(QuadKind::Q4, &c, p, &u);
+            let eb = bar_strain(ElementKind::Q4, &c, p, &u);
             assert!((eb - eps0).abs() < 1e-15);
-            add_bar_point(QuadKind::Q4, &c, p, a, e * eb, e, &mut f, &mut k);
+            add_bar_point(ElementKind::Q4, &c, p, a, e * eb, e, &mut f, &mut k);
         }
         let half = e * a * eps0 / 2.0;
         let expect = [-half, 0.0, half, 0.0, half, 0.0, -half, 0.0];
@@ -366,20 +370,29 @@ mod tests {
             let mut c = coords_of(&nodes, &elems).remove(0);
             c[2][0] += 0.15;
             c[2][1] += 0.1;
-            if kind != QuadKind::Q4 {
-                c[5] = [0.5 * (c[1][0] + c[2][0]) + 0.03, 0.5 * (c[1][1] + c[2][1])];
-                c[6] = [0.5 * (c[2][0] + c[3][0]), 0.5 * (c[2][1] + c[3][1]) - 0.02];
+            // Quadratic kinds: the mid-side nodes of edges 1 and 2 off their edges' middles.
+            if kind.info().order == 2 {
+                let (e1, e2) = (kind.edge_nodes(1), kind.edge_nodes(2));
+                let mid = |e: &[usize]| {
+                    [
+                        0.5 * (c[e[0]][0] + c[e[1]][0]),
+                        0.5 * (c[e[0]][1] + c[e[1]][1]),
+                    ]
+                };
+                let (m1, m2) = (mid(e1), mid(e2));
+                c[e1[2]] = [m1[0] + 0.03, m1[1]];
+                c[e2[2]] = [m2[0], m2[1] - 0.02];
             }
-            if kind == QuadKind::Q9 {
+            if kind == ElementKind::Q9 {
                 c[8] = [0.62, 0.48];
             }
             let hosts = [HostElement { kind, coords: &c }];
-            let pieces = embed(
-                &BarPath::Quadratic([[0.1, 0.2], [0.6, 0.5], [1.1, 0.6]]),
-                &hosts,
-                3,
-            )
-            .unwrap();
+            // A curved path inside the host (a triangle: the cell's lower-right half).
+            let path = match kind.info().domain {
+                crate::fem::kinds::Domain::Square => [[0.1, 0.2], [0.6, 0.5], [1.1, 0.6]],
+                crate::fem::kinds::Domain::Triangle => [[0.3, 0.05], [0.8, 0.25], [1.2, 0.5]],
+            };
+            let pieces = embed(&BarPath::Quadratic(path), &hosts, 3).unwrap();
             let m = 2 * kind.n_nodes();
             let force = |u: &[f64]| -> (Vec<f64>, Vec<f64>) {
                 let mut f = vec![0.0; m];
@@ -438,7 +451,7 @@ mod tests {
     /// Force and tangent of one TL bar point with an elastic law σ = σ0 + E E_b.
     fn tl_bar_response(c: &[[f64; 2]], p: &BarPoint, u: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let (es, s0, area) = (200e9, 1e9, 1e-3);
-        let (e, g, d) = bar_green_strain(QuadKind::Q8, c, p, u);
+        let (e, g, d) = bar_green_strain(ElementKind::Q8, c, p, u);
         let sig = s0 + es * e;
         let nd = u.len();
         let (mut f, mut k) = (vec![0.0; nd], vec![0.0; nd * nd]);
@@ -497,11 +510,11 @@ mod tests {
             .iter()
             .flat_map(|x| [co * x[0] - si * x[1] - x[0], si * x[0] + co * x[1] - x[1]])
             .collect();
-        let (e, _, _) = bar_green_strain(QuadKind::Q8, &c, &p, &u);
+        let (e, _, _) = bar_green_strain(ElementKind::Q8, &c, &p, &u);
         assert!(e.abs() < 1e-15, "{e}");
-        assert!((bar_strain(QuadKind::Q8, &c, &p, &u) - (co - 1.0)).abs() < 1e-12);
-        let (_, g, _) = bar_green_strain(QuadKind::Q8, &c, &p, &[0.0; 16]);
-        let g0 = bar_strain_vector(QuadKind::Q8, &c, &p);
+        assert!((bar_strain(ElementKind::Q8, &c, &p, &u) - (co - 1.0)).abs() < 1e-12);
+        let (_, g, _) = bar_green_strain(ElementKind::Q8, &c, &p, &[0.0; 16]);
+        let g0 = bar_strain_vector(ElementKind::Q8, &c, &p);
         for (a, b) in g0.iter().zip(&g) {
             assert!((a - b).abs() < 1e-15 * g0.iter().fold(0.0f64, |m, v| m.max(v.abs())));
         }

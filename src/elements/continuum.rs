@@ -1,29 +1,24 @@
-//! Isoparametric plane-stress continuum elements (Q4, Q8, Q9): internal force and tangent
+//! Isoparametric plane-stress continuum elements (every kind of [`crate::fem::kinds`]): internal force and tangent
 //! stiffness from the trial displacements, consistent body and edge loads.
 
-use crate::fem::quadrature::{gauss, gauss_square, Point2};
+use crate::fem::quadrature::{gauss, Point2};
 use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 use serde::{Deserialize, Serialize};
 
 /// Integration rule (plain model data, defined in [`crate::model`]).
 pub use crate::model::element_data::Integration;
 
 /// The Gauss points of an element kind under a rule.
-pub fn rule(kind: QuadKind, integration: Integration) -> Vec<Point2> {
+pub fn rule(kind: ElementKind, integration: Integration) -> Vec<Point2> {
     rule_points(kind, integration).to_vec()
 }
 
 /// The Gauss points of an element kind under a rule, from tables built once (the element
-/// loop must not allocate).
-pub fn rule_points(kind: QuadKind, integration: Integration) -> &'static [Point2] {
-    static RULES: std::sync::OnceLock<[Vec<Point2>; 2]> = std::sync::OnceLock::new();
-    let r = RULES.get_or_init(|| [gauss_square(2), gauss_square(3)]);
-    match (kind, integration) {
-        (QuadKind::Q4, _) | (_, Integration::Reduced) => &r[0],
-        _ => &r[1],
-    }
+/// loop must not allocate); the kind's descriptor owns them ([`crate::fem::kinds`]).
+pub fn rule_points(kind: ElementKind, integration: Integration) -> &'static [Point2] {
+    kind.rule(integration)
 }
 
 /// How a continuum element turns nodal displacements into strains and forces: the one switch
@@ -34,7 +29,7 @@ pub enum Formulation {
     /// Small strains: an isoparametric element of `kind` integrated by `integration`.
     SmallStrain {
         /// Element kind.
-        kind: QuadKind,
+        kind: ElementKind,
         /// Integration rule (full or reduced).
         integration: Integration,
     },
@@ -45,7 +40,7 @@ pub enum Formulation {
     /// undeformed element ([`super::total_lagrangian`]).
     TotalLagrangian {
         /// Element kind.
-        kind: QuadKind,
+        kind: ElementKind,
         /// Integration rule.
         integration: Integration,
     },
@@ -54,11 +49,11 @@ pub enum Formulation {
 impl Formulation {
     /// The formulation of an element of `kind` under `integration`; `large_displacements`
     /// for a geometrically nonlinear model (the input refuses incompatible modes with it).
-    pub fn new(kind: QuadKind, integration: Integration, large_displacements: bool) -> Self {
+    pub fn new(kind: ElementKind, integration: Integration, large_displacements: bool) -> Self {
         if large_displacements {
             Formulation::TotalLagrangian { kind, integration }
         } else if integration == Integration::Incompatible {
-            debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
+            debug_assert!(kind.info().incompatible_modes, "checked at input");
             Formulation::IncompatibleModes
         } else {
             Formulation::SmallStrain { kind, integration }
@@ -68,7 +63,7 @@ impl Formulation {
 
 /// The signature of [`response_at`] and the total Lagrangian response.
 type ResponseFn = fn(
-    QuadKind,
+    ElementKind,
     &GaussGeometry,
     f64,
     &Material,
@@ -181,7 +176,7 @@ pub struct GaussOutput {
 /// Strain–displacement matrix rows at one point: (∂N/∂x, ∂N/∂y) per node, and the
 /// integration factor w·det J [m²].
 fn point_derivatives(
-    kind: QuadKind,
+    kind: ElementKind,
     coords: &[[f64; 2]],
     p: &Point2,
 ) -> ([[f64; 2]; MAX_NODES], f64) {
@@ -192,37 +187,36 @@ fn point_derivatives(
 
 /// Smallest det J over the Gauss points and the corners (negative or zero means inverted or
 /// degenerate). Corners are included because a Q4 can fold without any Gauss point seeing it.
-pub fn min_jacobian(kind: QuadKind, coords: &[[f64; 2]], integration: Integration) -> f64 {
+pub fn min_jacobian(kind: ElementKind, coords: &[[f64; 2]], integration: Integration) -> f64 {
     let mut pts: Vec<(f64, f64)> = rule(kind, integration).iter().map(|p| (p.0, p.1)).collect();
-    pts.extend([(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]);
+    pts.extend(kind.info().domain.vertices().iter().map(|v| (v[0], v[1])));
     pts.iter()
         .map(|(x, e)| jacobian(&kind.eval(*x, *e), coords).1)
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Points per side of the grid [`fold`] samples det J on (ξ, η = −1, −0.75, …, 1).
+/// Points per side of the grid [`fold`] samples det J on (ξ, η = −1, −0.75, …, 1 on the
+/// square; 0, 0.125, …, 1 on the triangle).
 const FOLD_GRID: usize = 9;
 
-/// Where a Q8 or Q9 element folds inside although det J is positive at its corners and
+/// Where a quadratic element folds inside although det J is positive at its corners and
 /// integration points (a mid-side node moved far from the middle of its edge): the smallest
-/// det J on a 9 × 9 grid over the element and the grid's edges, and its (ξ, η), if it is
-/// not positive. A quadratic element's det J is a polynomial of degree up to 4 in ξ and η
-/// that can dip below zero between the Gauss points; the grid's spacing of 1/8 of the element
-/// finds any fold reaching about a sixteenth of the element across. A Q4's det J is linear
-/// in each of ξ, η (smallest at a corner, which [`min_jacobian`] checks): None.
-pub fn fold(kind: QuadKind, coords: &[[f64; 2]]) -> Option<(f64, f64, f64)> {
-    if kind == QuadKind::Q4 {
+/// det J on a grid of 9 points a side over the element and the grid's edges, and its (ξ, η),
+/// if it is not positive. A quadratic element's det J is a polynomial of degree up to 4 in ξ
+/// and η that can dip below zero between the Gauss points; the grid's spacing of 1/8 of the
+/// element finds any fold reaching about a sixteenth of the element across. A linear kind's
+/// det J (Q4: linear in each of ξ, η) is smallest at a corner, which [`min_jacobian`]
+/// checks: None.
+pub fn fold(kind: ElementKind, coords: &[[f64; 2]]) -> Option<(f64, f64, f64)> {
+    let info = kind.info();
+    if info.order == 1 {
         return None;
     }
-    let at = |i: usize| -1.0 + 2.0 * i as f64 / (FOLD_GRID - 1) as f64;
     let mut low = (f64::INFINITY, 0.0, 0.0);
-    for i in 0..FOLD_GRID {
-        for j in 0..FOLD_GRID {
-            let (x, e) = (at(i), at(j));
-            let d = jacobian(&kind.eval(x, e), coords).1;
-            if d.is_nan() || d < low.0 {
-                low = (d, x, e);
-            }
+    for [x, e] in info.domain.grid(FOLD_GRID) {
+        let d = jacobian(&kind.eval(x, e), coords).1;
+        if d.is_nan() || d < low.0 {
+            low = (d, x, e);
         }
     }
     (low.0.is_nan() || low.0 <= 0.0).then_some(low)
@@ -237,8 +231,10 @@ pub fn fold_message(f: (f64, f64, f64)) -> String {
 }
 
 /// Element area [m²].
-pub fn area(kind: QuadKind, coords: &[[f64; 2]]) -> f64 {
-    gauss_square(3)
+pub fn area(kind: ElementKind, coords: &[[f64; 2]]) -> f64 {
+    kind.info()
+        .domain
+        .exact_rule()
         .iter()
         .map(|p| jacobian(&kind.eval(p.0, p.1), coords).1 * p.2)
         .sum()
@@ -249,7 +245,7 @@ pub fn area(kind: QuadKind, coords: &[[f64; 2]]) -> f64 {
 /// displacements (ux, uy per node) [m]; `thickness` [m].
 #[allow(clippy::too_many_arguments)]
 pub fn response(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
     coords: &[[f64; 2]],
     thickness: f64,
@@ -281,7 +277,7 @@ pub fn response(
 /// material points of time-dependent materials need (creep, shrinkage).
 #[allow(clippy::too_many_arguments)]
 pub fn response_with_time(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
     coords: &[[f64; 2]],
     thickness: f64,
@@ -295,7 +291,7 @@ pub fn response_with_time(
     time: &TimeContext,
 ) -> Result<(), UpdateError> {
     if integration == Integration::Incompatible {
-        debug_assert_eq!(kind, QuadKind::Q4, "checked at input");
+        debug_assert!(kind.info().incompatible_modes, "checked at input");
         return super::incompatible::response_at(
             coords,
             thickness,
@@ -378,7 +374,7 @@ impl GaussGeometry {
 /// The Gauss-point geometry of an element of `kind` with nodes at `coords` under the rule
 /// `integration` (computed for all points before any material update).
 pub fn gauss_geometry(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
     coords: &[[f64; 2]],
 ) -> GaussGeometry {
@@ -404,7 +400,7 @@ pub fn gauss_geometry(
 /// of the tangent are formed (the others are zero; [`NodeBlocks::ALL`]: all).
 #[allow(clippy::too_many_arguments)]
 pub fn response_at(
-    kind: QuadKind,
+    kind: ElementKind,
     geometry: &GaussGeometry,
     thickness: f64,
     mat: &Material,
@@ -530,10 +526,10 @@ pub(crate) fn mechanical(eps: [f64; 3], imposed: &[f64], g: usize) -> [f64; 3] {
 }
 
 /// Consistent nodal forces [N] of a body force b [N/m³] (e.g. ρ g) over the element.
-pub fn body_force(kind: QuadKind, coords: &[[f64; 2]], thickness: f64, b: [f64; 2]) -> Vec<f64> {
+pub fn body_force(kind: ElementKind, coords: &[[f64; 2]], thickness: f64, b: [f64; 2]) -> Vec<f64> {
     let n = kind.n_nodes();
     let mut f = vec![0.0; 2 * n];
-    for p in gauss_square(3) {
+    for p in kind.info().domain.exact_rule() {
         let s = kind.eval(p.0, p.1);
         let (_, det, _) = jacobian(&s, coords);
         let w = det * p.2 * thickness;
@@ -579,7 +575,7 @@ pub fn edge_force_partial(edge_coords: &[[f64; 2]], q: [f64; 2], r0: f64, r1: f6
 /// Gauss-point values extrapolated to the element's nodes: the tensor-product Lagrange
 /// interpolant through the Gauss points (2×2 or 3×3) evaluated at each node.
 pub fn extrapolate_to_nodes(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
     gp_values: &[[f64; 3]],
 ) -> Vec<[f64; 3]> {
@@ -598,45 +594,25 @@ pub fn extrapolate_to_nodes(
 }
 
 /// Weights of [`extrapolate_to_nodes`]: value at node a = Σ_g w\[a\]\[g\] · value at Gauss
-/// point g. Computed once per element kind and rule (the output loop must not redo it for
-/// every element).
+/// point g, from the kind's descriptor. Computed once per element kind and rule (the output
+/// loop must not redo it for every element).
 pub fn extrapolation_weights(
-    kind: QuadKind,
+    kind: ElementKind,
     integration: Integration,
 ) -> &'static [[f64; 9]; MAX_NODES] {
     static TABLES: std::sync::OnceLock<Vec<[[f64; 9]; MAX_NODES]>> = std::sync::OnceLock::new();
-    const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];
     let tables = TABLES.get_or_init(|| {
         let mut t = Vec::new();
-        for kind in KINDS {
+        for kind in crate::fem::kinds::ALL {
             for integration in [Integration::Full, Integration::Reduced] {
-                let order = if rule_points(kind, integration).len() == 4 {
-                    2
-                } else {
-                    3
-                };
-                let r = gauss(order);
-                let lag = |x: f64, i: usize| -> f64 {
-                    let mut v = 1.0;
-                    for (j, pj) in r.points.iter().enumerate() {
-                        if j != i {
-                            v *= (x - pj) / (r.points[i] - pj);
-                        }
-                    }
-                    v
-                };
-                let mut w = [[0.0; 9]; MAX_NODES];
-                for a in 0..kind.n_nodes() {
-                    let [xi, eta] = crate::fem::shape::NODE_XI[a];
-                    for g in 0..order * order {
-                        w[a][g] = lag(xi, g % order) * lag(eta, g / order);
-                    }
-                }
-                t.push(w);
+                t.push((kind.info().extrapolation)(rule_points(kind, integration)));
             }
         }
         t
     });
-    let k = KINDS.iter().position(|k| *k == kind).unwrap_or(0);
+    let k = crate::fem::kinds::ALL
+        .iter()
+        .position(|k| *k == kind)
+        .expect("every kind is in ALL");
     &tables[2 * k + usize::from(integration == Integration::Reduced)]
 }

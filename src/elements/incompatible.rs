@@ -17,7 +17,7 @@
 use super::continuum::{gauss_geometry, rule_points, GaussGeometry, GaussOutput, Integration};
 use crate::fem::shape::{jacobian, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// Local Newton iterations allowed for α.
 const MAX_LOCAL: usize = 30;
@@ -34,8 +34,8 @@ type LocalSystem = ([f64; 4], [[f64; 4]; 4], f64);
 /// Incompatible-mode strain rows at one Gauss point: for each mode k, (∂N_k/∂x, ∂N_k/∂y)
 /// with Taylor's centre Jacobian and det J₀/det J scaling [1/m].
 fn mode_derivatives(coords: &[[f64; 2]], xi: f64, eta: f64) -> [[f64; 2]; 2] {
-    let (_, det0, inv0) = jacobian(&QuadKind::Q4.eval(0.0, 0.0), coords);
-    let (_, det, _) = jacobian(&QuadKind::Q4.eval(xi, eta), coords);
+    let (_, det0, inv0) = jacobian(&ElementKind::Q4.eval(0.0, 0.0), coords);
+    let (_, det, _) = jacobian(&ElementKind::Q4.eval(xi, eta), coords);
     let s = det0 / det;
     // Natural derivatives of 1 − ξ² and 1 − η².
     let nat = [[-2.0 * xi, 0.0], [0.0, -2.0 * eta]];
@@ -130,12 +130,12 @@ pub fn response_at(
     time: &TimeContext,
     imposed: &[f64],
 ) -> Result<(), UpdateError> {
-    let pts = rule_points(QuadKind::Q4, Integration::Full);
+    let pts = rule_points(ElementKind::Q4, Integration::Full);
     let GaussGeometry {
         n_pts,
         points: geo,
         h,
-    } = gauss_geometry(QuadKind::Q4, Integration::Full, coords);
+    } = gauss_geometry(ElementKind::Q4, Integration::Full, coords);
     let mut gm = [[[0.0; 2]; 2]; 4];
     for g in 0..n_pts {
         gm[g] = mode_derivatives(coords, pts[g].0, pts[g].1);

@@ -16,7 +16,7 @@
 
 use super::continuum::{GaussOutput, NodeBlocks};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
 /// `h[i][j] = ∂u_i/∂X_j` [-].
@@ -50,7 +50,7 @@ pub fn displacement_gradient(dn: &[[f64; 2]], u: &[f64], n: usize) -> [[f64; 2];
 /// formed (the others are zero; see [`NodeBlocks`]).
 #[allow(clippy::too_many_arguments)]
 pub fn response_tl(
-    kind: QuadKind,
+    kind: ElementKind,
     geometry: &super::continuum::GaussGeometry,
     thickness: f64,
     mat: &Material,
@@ -176,16 +176,21 @@ pub fn response_tl(
 mod tests {
     use super::*;
     use crate::elements::continuum::{gauss_geometry, response_at, rule_points, Integration};
-    use crate::fem::shape::NODE_XI;
 
-    const KINDS: [QuadKind; 3] = [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9];
+    const KINDS: [ElementKind; 4] = crate::fem::kinds::ALL;
 
     /// A distorted element: the natural node positions mapped through a skewed, stretched map
-    /// with a quadratic term (curved edges for Q8/Q9) [m].
-    fn coords(kind: QuadKind) -> Vec<[f64; 2]> {
+    /// with a quadratic term (curved edges for the quadratic kinds) [m].
+    fn coords(kind: ElementKind) -> Vec<[f64; 2]> {
         (0..kind.n_nodes())
             .map(|a| {
-                let [x, y] = NODE_XI[a];
+                // A triangle's (ξ, η) ∈ [0, 1] stretched to the quadrilaterals' [−1, 1].
+                let [x, y] = match kind.info().domain {
+                    crate::fem::kinds::Domain::Square => kind.info().node_xi[a],
+                    crate::fem::kinds::Domain::Triangle => {
+                        kind.info().node_xi[a].map(|v| 2.0 * v - 1.0)
+                    }
+                };
                 [
                     0.6 * x + 0.1 * y + 0.03 * y * y + 1.0,
                     0.25 * y - 0.05 * x + 0.02 * x * x - 0.4,
@@ -210,7 +215,7 @@ mod tests {
         }
     }
 
-    fn tl(kind: QuadKind, u: &[f64], tangent: bool) -> (Vec<f64>, Vec<f64>, Vec<GaussOutput>) {
+    fn tl(kind: ElementKind, u: &[f64], tangent: bool) -> (Vec<f64>, Vec<f64>, Vec<GaussOutput>) {
         let nd = 2 * kind.n_nodes();
         let c = coords(kind);
         let mat = elastic();

@@ -2,6 +2,7 @@
 
 pub mod assembly;
 pub mod dofs;
+pub mod kinds;
 pub mod numbering;
 pub mod quadrature;
 pub mod shape;

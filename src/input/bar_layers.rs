@@ -12,7 +12,6 @@
 use super::error::{Ctx, InputError};
 use super::schema::BarLayerIn;
 use crate::elements::bar::BarPoint;
-use crate::fem::quadrature::gauss_square;
 use crate::fem::shape::{jacobian, map_point};
 use crate::materials::steel::SteelParams;
 use crate::model::{Bar, BarGaussPoint, Model};
@@ -133,10 +132,11 @@ fn layer(
         }
         let coords = model.element_coords(el);
         // Same centroid rule as `regions[].boxes`: the corner nodes' mean.
-        let k = coords.len().min(4) as f64;
+        let nc = el.kind.n_corners();
+        let k = coords.len().min(nc) as f64;
         let c = coords
             .iter()
-            .take(4)
+            .take(nc)
             .fold([0.0, 0.0], |a, x| [a[0] + x[0] / k, a[1] + x[1] / k]);
         let inside = |[[x0, y0], [x1, y1]]: &[[f64; 2]; 2]| {
             (*x0..=*x1).contains(&c[0]) && (*y0..=*y1).contains(&c[1])
@@ -145,7 +145,7 @@ fn layer(
             continue;
         }
         let p0 = bar.points.len();
-        for (xi, eta, w) in gauss_square(el.kind.full_gauss_order()) {
+        for &(xi, eta, w) in el.kind.rule(crate::model::Integration::Full) {
             let sv = el.kind.eval(xi, eta);
             let (_, det_j, _) = jacobian(&sv, &coords);
             bar.points.push(BarGaussPoint {

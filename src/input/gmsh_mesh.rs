@@ -9,7 +9,7 @@ use crate::elements::continuum::{fold, fold_message, min_jacobian, Integration};
 use crate::mesh::gmsh::{parse_msh, GmshElementKind, GmshMesh};
 use crate::mesh::segmental::{Joint, JointFace};
 use crate::model::Element;
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -53,7 +53,7 @@ pub fn build_gmsh(mesh: &MeshIn, ctx: &Ctx, region_names: &[&str]) -> R<GmshBuil
         ctx,
         "mesh.integration",
         mesh.integration.as_deref(),
-        crate::model::QuadKind::Q4,
+        crate::model::ElementKind::Q4,
     )?;
     for k in [
         "length",
@@ -140,13 +140,7 @@ fn map(
                 })
             })
             .collect::<R<_>>()?;
-        let kind = match el.kind {
-            GmshElementKind::Quad4 => Some(QuadKind::Q4),
-            GmshElementKind::Quad8 => Some(QuadKind::Q8),
-            GmshElementKind::Quad9 => Some(QuadKind::Q9),
-            _ => None,
-        };
-        if let Some(kind) = kind {
+        if let Some(kind) = el.kind.element_kind() {
             let names: Vec<&str> = el
                 .physical
                 .iter()
@@ -160,11 +154,20 @@ fn map(
                 .position(|r| r == name)
                 .expect("checked above");
             let coords: Vec<[f64; 2]> = ids.iter().map(|&i| nodes[i]).collect();
-            if let Some(m) = degenerate(&coords, &el.nodes, size) {
+            if let Some(m) = degenerate(&coords, kind.n_corners(), &el.nodes, size) {
                 return Err(ctx.err("mesh.file", format!("{file}: element {}: {m}", el.tag)));
             }
-            if integ == Integration::Incompatible && kind != crate::model::QuadKind::Q4 {
+            if integ == Integration::Incompatible && !kind.info().incompatible_modes {
                 return Err(ctx.err("mesh.integration", format!("{file}: element {} is a {kind:?}: 'incompatible' (bending modes) is for Q4 elements only", el.tag)));
+            }
+            if integ == Integration::Reduced && kind.info().reduced_rule.is_none() {
+                return Err(ctx.err(
+                    "mesh.integration",
+                    format!(
+                        "{file}: element {} is a {kind:?}, which has no reduced rule: use 'full'",
+                        el.tag
+                    ),
+                ));
             }
             let detj = min_jacobian(kind, &coords, integ);
             if detj.is_nan() || detj <= 0.0 {
@@ -205,7 +208,10 @@ fn map(
     if elements.is_empty() {
         return Err(ctx.err(
             "mesh.file",
-            format!("{file}: no quadrilateral elements (Q4, Q8 or Q9) found"),
+            format!(
+                "{file}: no continuum elements ({}) found",
+                ElementKind::names()
+            ),
         ));
     }
     for v in groups.nodes.values_mut() {
@@ -266,9 +272,8 @@ fn joints(
                 .iter()
                 .enumerate()
                 .filter_map(|(ei, el)| {
-                    (0..4).find_map(|k| {
-                        let e: Vec<usize> =
-                            el.kind.edge_nodes(k).iter().map(|&l| el.nodes[l]).collect();
+                    el.kind.edges().iter().find_map(|edge| {
+                        let e: Vec<usize> = edge.iter().map(|&l| el.nodes[l]).collect();
                         let fits = e.len() == a.len() && e.iter().all(|n| a.contains(n));
                         fits.then_some((ei, e))
                     })

@@ -121,20 +121,16 @@ pub fn check_size(
 }
 
 /// Number of nodes of a structured grid of `nx` × `ny` quadrilaterals of `kind` (f64: the
-/// count is checked before anything is allocated).
-pub fn grid_nodes(kind: crate::model::QuadKind, nx: f64, ny: f64) -> f64 {
-    use crate::model::QuadKind;
-    match kind {
-        QuadKind::Q4 => (nx + 1.0) * (ny + 1.0),
-        QuadKind::Q9 => (2.0 * nx + 1.0) * (2.0 * ny + 1.0),
-        QuadKind::Q8 => (2.0 * nx + 1.0) * (2.0 * ny + 1.0) - nx * ny,
-    }
+/// count is checked before anything is allocated; the kind's descriptor gives its grid
+/// layout). 0 for a kind the generators cannot make (refused before this is asked).
+pub fn grid_nodes(kind: crate::model::ElementKind, nx: f64, ny: f64) -> f64 {
+    kind.grid_nodes(nx, ny).unwrap_or(0.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::QuadKind;
+    use crate::model::ElementKind;
 
     fn ctx() -> Ctx {
         Ctx {
@@ -145,9 +141,9 @@ mod tests {
     /// Node counts of small grids counted by hand: 2 × 1 Q4 → 6, Q8 → 13, Q9 → 15.
     #[test]
     fn grid_node_counts() {
-        assert_eq!(grid_nodes(QuadKind::Q4, 2.0, 1.0), 6.0);
-        assert_eq!(grid_nodes(QuadKind::Q8, 2.0, 1.0), 13.0);
-        assert_eq!(grid_nodes(QuadKind::Q9, 2.0, 1.0), 15.0);
+        assert_eq!(grid_nodes(ElementKind::Q4, 2.0, 1.0), 6.0);
+        assert_eq!(grid_nodes(ElementKind::Q8, 2.0, 1.0), 13.0);
+        assert_eq!(grid_nodes(ElementKind::Q9, 2.0, 1.0), 15.0);
     }
 
     /// Above the dof limit always an error; below it, an error only when the estimate
@@ -186,32 +182,34 @@ pub fn extent(nodes: &[[f64; 2]]) -> f64 {
 
 /// Why an element is degenerate, if it is: a corner edge shorter than 1e-9 of the model size
 /// `size` [m], or a corner polygon of area below 1e-12 size² (both far below any meshing
-/// intent, far above round-off). `ids` are the element's node numbers as the user knows them.
-pub fn degenerate(coords: &[[f64; 2]], ids: &[u64], size: f64) -> Option<String> {
+/// intent, far above round-off). The first `nc` nodes are the corners (the kind's
+/// descriptor); `ids` are the element's node numbers as the user knows them.
+pub fn degenerate(coords: &[[f64; 2]], nc: usize, ids: &[u64], size: f64) -> Option<String> {
     let tol = 1e-9 * size;
-    for k in 0..4 {
-        let (a, b) = (coords[k], coords[(k + 1) % 4]);
+    for k in 0..nc {
+        let (a, b) = (coords[k], coords[(k + 1) % nc]);
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         if len.is_nan() || len <= tol {
             return Some(format!(
                 "the edge from node {} to node {} has (nearly) zero length: {len:.3e} m in a model {size:.3e} m across",
                 ids[k],
-                ids[(k + 1) % 4]
+                ids[(k + 1) % nc]
             ));
         }
     }
     // Shoelace area of the corner polygon.
-    let area: f64 = (0..4)
+    let area: f64 = (0..nc)
         .map(|k| {
-            let (a, b) = (coords[k], coords[(k + 1) % 4]);
+            let (a, b) = (coords[k], coords[(k + 1) % nc]);
             a[0] * b[1] - b[0] * a[1]
         })
         .sum::<f64>()
         * 0.5;
     if area.is_nan() || area.abs() <= 1e-12 * size * size {
+        let corners: Vec<String> = ids[..nc].iter().map(|i| i.to_string()).collect();
         return Some(format!(
-            "zero area ({area:.3e} m²): its corners (nodes {}, {}, {}, {}) are collinear",
-            ids[0], ids[1], ids[2], ids[3]
+            "zero area ({area:.3e} m²): its corners (nodes {}) are collinear",
+            corners.join(", ")
         ));
     }
     None
@@ -227,15 +225,15 @@ mod geometry_tests {
     fn degenerate_elements() {
         let ids = [1, 2, 3, 4];
         let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert_eq!(degenerate(&sq, &ids, 10.0), None);
+        assert_eq!(degenerate(&sq, 4, &ids, 10.0), None);
         let pinched = [[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-        let m = degenerate(&pinched, &ids, 10.0).unwrap();
+        let m = degenerate(&pinched, 4, &ids, 10.0).unwrap();
         assert!(m.contains("node 2 to node 3"), "{m}");
         let flat = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]];
-        let m = degenerate(&flat, &ids, 10.0).unwrap();
+        let m = degenerate(&flat, 4, &ids, 10.0).unwrap();
         assert!(m.contains("zero area"), "{m}");
         let nan = [[f64::NAN, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert!(degenerate(&nan, &ids, 10.0).is_some());
+        assert!(degenerate(&nan, 4, &ids, 10.0).is_some());
     }
 }
 

@@ -23,7 +23,10 @@ fn in_corners(corners: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
 pub fn inside_mesh(model: &Model, p: [f64; 2]) -> bool {
     let tol = 1e-6 * model_size(model);
     model.elements.iter().any(|e| {
-        let c: Vec<[f64; 2]> = e.nodes[..4].iter().map(|&n| model.nodes[n]).collect();
+        let c: Vec<[f64; 2]> = e.nodes[..e.kind.n_corners()]
+            .iter()
+            .map(|&n| model.nodes[n])
+            .collect();
         in_corners(&c, p, tol)
     })
 }
@@ -111,8 +114,7 @@ fn edges_on_segment_of(
     let param = |p: [f64; 2]| ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len; // [m] along a→b
     let off_line = |p: [f64; 2]| ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex).abs() / len;
     for e in model.elements.iter().filter(|e| keep(e)) {
-        for k in 0..4 {
-            let local = e.kind.edge_nodes(k);
+        for local in e.kind.edges() {
             let nodes: Vec<usize> = local.iter().map(|&l| e.nodes[l]).collect();
             if !nodes.iter().all(|&n| off_line(model.nodes[n]) <= tol) {
                 continue;

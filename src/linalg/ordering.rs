@@ -557,7 +557,7 @@ mod tests {
     /// coordinates, continuum element node lists and all couplings.
     #[allow(clippy::type_complexity)]
     fn jointed_mesh(
-        kind: crate::model::QuadKind,
+        kind: crate::model::ElementKind,
         nx: usize,
         ny: usize,
         extra: usize,
@@ -609,8 +609,8 @@ mod tests {
     #[test]
     fn element_dissection_is_a_permutation() {
         use crate::fem::assembly::Assembler;
-        use crate::model::QuadKind;
-        for kind in [QuadKind::Q8, QuadKind::Q9] {
+        use crate::model::ElementKind;
+        for kind in [ElementKind::Q8, ElementKind::Q9] {
             let (xy, elements, couplings) = jointed_mesh(kind, 12, 9, 7);
             let cons: Vec<(usize, f64)> = (0..xy.len())
                 .filter(|&a| xy[a][0] == 0.0)
@@ -648,7 +648,7 @@ mod tests {
     #[test]
     fn element_separators_separate() {
         use crate::fem::assembly::Assembler;
-        use crate::model::QuadKind;
+        use crate::model::ElementKind;
         fn check(
             d: &mut Dissection,
             el: &mut Elements,
@@ -678,7 +678,7 @@ mod tests {
             check(d, el, up_e, up_n, levels);
         }
         for (extra, nx) in [(0, 10), (9, 10), (5, 3)] {
-            let (xy, elements, couplings) = jointed_mesh(QuadKind::Q8, nx, 6, extra);
+            let (xy, elements, couplings) = jointed_mesh(ElementKind::Q8, nx, 6, extra);
             let dofs = DofMap::new(xy.len(), &[]);
             let asm = Assembler::new(xy.len(), &couplings, &dofs);
             let mut nodes: Vec<u32> = (0..xy.len() as u32).collect();
@@ -701,7 +701,7 @@ mod tests {
         }
         // One block alone (10 × 6 elements): the top separator is the element edge line
         // x = 0.5 m, 13 nodes eliminated last.
-        let (xy, elements, _) = jointed_mesh(QuadKind::Q8, 10, 6, 0);
+        let (xy, elements, _) = jointed_mesh(ElementKind::Q8, 10, 6, 0);
         let elements = &elements[..60];
         let dofs = DofMap::new(xy.len(), &[]);
         let asm = Assembler::new(xy.len(), elements, &dofs);
@@ -727,14 +727,14 @@ mod tests {
         use crate::fem::assembly::Assembler;
         use crate::linalg::solver::SparseCholesky;
         use crate::mesh::banded::{generate, Band};
-        use crate::model::QuadKind;
+        use crate::model::ElementKind;
         let n = 40;
         let band = [Band {
             depth: 1.0,
             rows: n,
             region: 0,
         }];
-        let g = generate([0.0, 0.0], 1.0, n, &band, QuadKind::Q8);
+        let g = generate([0.0, 0.0], 1.0, n, &band, ElementKind::Q8);
         let elements: Vec<Vec<usize>> = g.elements.iter().map(|e| e.0.clone()).collect();
         let cons: Vec<(usize, f64)> = (0..g.nodes.len())
             .filter(|&a| g.nodes[a][0] == 0.0)

@@ -2,7 +2,7 @@
 //! its own depth, thickness (through its region) and number of element rows — the
 //! plane-stress idealisation of I, T and box sections.
 
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// One horizontal band, listed from the bottom up.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,15 +25,20 @@ pub struct GeneratedMesh {
 }
 
 /// Generate a structured mesh of `nx` columns over [x0, x0 + length] and the bands stacked
-/// upward from y0. Quadratic kinds get mid-side nodes (Q9 also centre nodes).
+/// upward from y0. Quadratic kinds get mid-side nodes (Q9 also centre nodes), each node
+/// placed on the grid where its natural coordinates put it (the kind's descriptor). A kind
+/// without a grid layout (triangles, refused at input) is generated as Q4.
 pub fn generate(
     origin: [f64; 2],
     length: f64,
     nx: usize,
     bands: &[Band],
-    kind: QuadKind,
+    kind: ElementKind,
 ) -> GeneratedMesh {
-    let order = if kind == QuadKind::Q4 { 1 } else { 2 };
+    let (kind, (order, centre)) = match kind.grid_layout() {
+        Some(l) => (kind, l),
+        None => (ElementKind::Q4, (1, false)),
+    };
     // Grid lines in y (sub-grid for quadratic elements).
     let mut ys = vec![origin[1]];
     let mut row_region = Vec::new();
@@ -52,7 +57,7 @@ pub fn generate(
     let mut nodes = Vec::new();
     for (j, y) in ys.iter().enumerate() {
         for i in 0..ncols {
-            if kind == QuadKind::Q8 && i % 2 == 1 && j % 2 == 1 {
+            if order == 2 && !centre && i % 2 == 1 && j % 2 == 1 {
                 continue;
             }
             id[j * ncols + i] = nodes.len();
@@ -64,25 +69,12 @@ pub fn generate(
     for (r, &region) in row_region.iter().enumerate() {
         for c in 0..nx {
             let (i, j) = (c * order, r * order);
-            let el = match kind {
-                QuadKind::Q4 => vec![g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)],
-                _ => {
-                    let mut v = vec![
-                        g(i, j),
-                        g(i + 2, j),
-                        g(i + 2, j + 2),
-                        g(i, j + 2),
-                        g(i + 1, j),
-                        g(i + 2, j + 1),
-                        g(i + 1, j + 2),
-                        g(i, j + 1),
-                    ];
-                    if kind == QuadKind::Q9 {
-                        v.push(g(i + 1, j + 1));
-                    }
-                    v
-                }
-            };
+            let el = (0..kind.n_nodes())
+                .map(|a| {
+                    let (di, dj) = kind.grid_offset(a, order);
+                    g(i + di, j + dj)
+                })
+                .collect();
             elements.push((el, region));
         }
     }
@@ -128,9 +120,9 @@ mod tests {
             },
         ];
         for (kind, n_nodes) in [
-            (QuadKind::Q4, 4 * 4),
-            (QuadKind::Q8, 7 * 7 - 9),
-            (QuadKind::Q9, 7 * 7),
+            (ElementKind::Q4, 4 * 4),
+            (ElementKind::Q8, 7 * 7 - 9),
+            (ElementKind::Q9, 7 * 7),
         ] {
             let m = generate([0.0, 0.0], 3.0, 3, &bands, kind);
             assert_eq!(m.nodes.len(), n_nodes, "{kind:?}");

@@ -2,17 +2,19 @@
 //!
 //! Sections read: `$MeshFormat`, `$PhysicalNames`, `$Entities` (4.1: maps entity tags to
 //! physical tags), `$Nodes`, `$Elements`; any other section is skipped. Element types accepted:
-//! 15 (point), 1 (2-node line), 8 (3-node line), 3 (4-node quad), 16 (8-node quad), 10 (9-node
-//! quad); any other type is an error naming the type. Node lists are returned in VTK order
-//! (quads: corners counter-clockwise as in the file, mid-edges 0–1, 1–2, 2–3, 3–0, centre; lines:
-//! start, end, middle), which for these types coincides with Gmsh's order. Coordinates are in the
+//! 15 (point), 1 (2-node line), 8 (3-node line) and the continuum kinds' types (their
+//! descriptors, `crate::fem::kinds`: 3 4-node quad, 16 8-node quad, 10 9-node quad, 9 6-node
+//! triangle); any other type is an error naming the type. Node lists are returned in VTK order
+//! (quads: corners counter-clockwise as in the file, mid-edges 0–1, 1–2, 2–3, 3–0, centre; T6:
+//! corners, mid-edges 0–1, 1–2, 2–0; lines: start, end, middle), which for these types
+//! coincides with Gmsh's order. Coordinates are in the
 //! file's units (metres by project convention); z is ignored.
 //!
 //! Errors name the file, the line (ASCII) or byte offset (binary) and what is wrong; malformed
 //! input never panics, and no allocation is sized by a count larger than the input itself.
 //! See `docs/gmsh.md`.
 
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::Path;
@@ -26,12 +28,9 @@ pub enum GmshElementKind {
     Line2,
     /// Type 8: 3-node line (start, end, middle).
     Line3,
-    /// Type 3: 4-node quadrangle.
-    Quad4,
-    /// Type 16: 8-node (serendipity) quadrangle.
-    Quad8,
-    /// Type 10: 9-node (Lagrange) quadrangle.
-    Quad9,
+    /// A continuum element kind of the solver, by its descriptor's Gmsh type id
+    /// ([`crate::fem::kinds`]: 3 Q4, 16 Q8, 10 Q9).
+    Surface(ElementKind),
 }
 
 impl GmshElementKind {
@@ -41,22 +40,17 @@ impl GmshElementKind {
             15 => Self::Point,
             1 => Self::Line2,
             8 => Self::Line3,
-            3 => Self::Quad4,
-            16 => Self::Quad8,
-            10 => Self::Quad9,
-            _ => return None,
+            t => Self::Surface(ElementKind::from_gmsh(t)?),
         })
     }
 
     /// Gmsh element type number.
-    pub fn gmsh_type(self) -> i32 {
+    pub fn gmsh_type(self) -> i64 {
         match self {
             Self::Point => 15,
             Self::Line2 => 1,
             Self::Line3 => 8,
-            Self::Quad4 => 3,
-            Self::Quad8 => 16,
-            Self::Quad9 => 10,
+            Self::Surface(k) => k.info().gmsh_type,
         }
     }
 
@@ -66,9 +60,7 @@ impl GmshElementKind {
             Self::Point => 1,
             Self::Line2 => 2,
             Self::Line3 => 3,
-            Self::Quad4 => 4,
-            Self::Quad8 => 8,
-            Self::Quad9 => 9,
+            Self::Surface(k) => k.n_nodes(),
         }
     }
 
@@ -77,17 +69,15 @@ impl GmshElementKind {
         match self {
             Self::Point => 0,
             Self::Line2 | Self::Line3 => 1,
-            _ => 2,
+            Self::Surface(_) => 2,
         }
     }
 
-    /// The matching quadrilateral kind of the solver, for 2-D elements.
-    pub fn quad_kind(self) -> Option<QuadKind> {
+    /// The continuum element kind of the solver, for 2-D elements.
+    pub fn element_kind(self) -> Option<ElementKind> {
         match self {
-            Self::Quad4 => Some(QuadKind::Q4),
-            Self::Quad8 => Some(QuadKind::Q8),
-            Self::Quad9 => Some(QuadKind::Q9),
-            _ => None,
+            Self::Surface(k) => Some(k),
+            Self::Point | Self::Line2 | Self::Line3 => None,
         }
     }
 
@@ -221,7 +211,7 @@ pub enum GmshError {
         message: String,
     },
     /// An element type the solver does not support.
-    #[error("{file}, {location}: element type {type_id} ({name}) is not supported; use quadrangles (types 3, 16, 10), lines (1, 8) and points (15) — e.g. Mesh.RecombineAll = 1")]
+    #[error("{file}, {location}: element type {type_id} ({name}) is not supported; use quadrangles (types 3, 16, 10), 6-node triangles (9), lines (1, 8) and points (15) — e.g. Mesh.RecombineAll = 1, or Mesh.ElementOrder = 2 for 6-node triangles")]
     UnsupportedElement {
         /// File name.
         file: String,
@@ -1184,7 +1174,18 @@ $EndElements
         assert_eq!(a.elements.len(), 7);
         let kinds: Vec<_> = a.elements.iter().map(|e| e.kind).collect();
         use GmshElementKind::*;
-        assert_eq!(kinds, [Quad9, Quad9, Quad8, Quad4, Line3, Line2, Point]);
+        assert_eq!(
+            kinds,
+            [
+                Surface(ElementKind::Q9),
+                Surface(ElementKind::Q9),
+                Surface(ElementKind::Q8),
+                Surface(ElementKind::Q4),
+                Line3,
+                Line2,
+                Point
+            ]
+        );
         assert_eq!(a.elements[0].physical, [10]);
         assert_eq!(a.elements[2].physical, [11]);
         assert_eq!(a.elements[4].physical, [20]);
@@ -1196,7 +1197,7 @@ $EndElements
     }
 
     /// Gmsh node order = VTK order for Q8/Q9/3-node lines: mid-edge node k lies at the
-    /// midpoint of edge k of `QuadKind::edge_nodes`, the centre at the centroid, the element is
+    /// midpoint of edge k of `ElementKind::edges`, the centre at the centroid, the element is
     /// counter-clockwise (positive Jacobian), and a 3-node line's middle node is the midpoint.
     #[test]
     fn node_order_is_vtk() {
@@ -1205,9 +1206,8 @@ $EndElements
         let x = |t: u64| m.nodes[idx[&t]].1;
         for el in &m.elements {
             let xs: Vec<[f64; 2]> = el.nodes.iter().map(|&t| x(t)).collect();
-            if let Some(q) = el.kind.quad_kind() {
-                for e in 0..4 {
-                    let en = q.edge_nodes(e);
+            if let Some(q) = el.kind.element_kind() {
+                for en in q.edges() {
                     if en.len() == 3 {
                         for d in 0..2 {
                             let mid = 0.5 * (xs[en[0]][d] + xs[en[1]][d]);
@@ -1215,7 +1215,7 @@ $EndElements
                         }
                     }
                 }
-                if q == QuadKind::Q9 {
+                if q == ElementKind::Q9 {
                     for d in 0..2 {
                         let c = 0.25 * (xs[0][d] + xs[1][d] + xs[2][d] + xs[3][d]);
                         assert!((xs[8][d] - c).abs() < 1e-15);

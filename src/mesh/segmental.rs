@@ -3,7 +3,7 @@
 //! element-edge pairs between them.
 
 use super::banded::{generate, Band};
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 
 /// One joint face pair: the nodes of the left segment's edge and the right segment's edge at
 /// the same height, both ordered bottom to top as (start, end, [mid]).
@@ -43,15 +43,20 @@ pub struct SegmentalMesh {
 }
 
 /// Generate segments of the given lengths [m] placed end to end from `x0`, each with
-/// `nx[i]` element columns, sharing the band layout (bottom up).
+/// `nx[i]` element columns, sharing the band layout (bottom up). A kind without a grid
+/// layout (triangles, refused at input) is generated as Q4, as [`generate`] does.
 pub fn generate_segments(
     x0: f64,
     y0: f64,
     lengths: &[f64],
     nx: &[usize],
     bands: &[Band],
-    kind: QuadKind,
+    kind: ElementKind,
 ) -> SegmentalMesh {
+    let kind = match kind.grid_layout() {
+        Some(_) => kind,
+        None => ElementKind::Q4,
+    };
     let mut out = SegmentalMesh::default();
     let mut x = x0;
     let rows: usize = bands.iter().map(|b| b.rows).sum();
@@ -69,17 +74,12 @@ pub fn generate_segments(
         // edge 3 the left edge (nodes 3→0, top to bottom, so reversed here to go upward).
         let edge = |r: usize, c: usize, right: bool| -> (Vec<usize>, usize) {
             let (el, region, _) = &out.elements[first + r * n + c];
-            let v = if right {
-                let mut v = vec![el[1], el[2]];
-                if kind != QuadKind::Q4 {
-                    v.push(el[5]);
-                }
-                v
+            let v: Vec<usize> = if right {
+                kind.edge_nodes(1).iter().map(|&l| el[l]).collect()
             } else {
-                let mut v = vec![el[0], el[3]];
-                if kind != QuadKind::Q4 {
-                    v.push(el[7]);
-                }
+                let e = kind.edge_nodes(3);
+                let mut v = vec![el[e[1]], el[e[0]]];
+                v.extend(e[2..].iter().map(|&l| el[l]));
                 v
             };
             (v, *region)
@@ -231,7 +231,7 @@ mod tests {
                 region: 1,
             },
         ];
-        for kind in [QuadKind::Q4, QuadKind::Q8, QuadKind::Q9] {
+        for kind in [ElementKind::Q4, ElementKind::Q8, ElementKind::Q9] {
             let m = generate_segments(0.0, 0.0, &[1.0, 1.0, 1.5], &[2, 2, 3], &bands, kind);
             assert_eq!(m.joints.len(), 2);
             assert!((m.joints[1].x - 2.0).abs() < 1e-12);

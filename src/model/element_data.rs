@@ -5,15 +5,20 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The quadrilateral element kinds.
+/// The continuum element kinds. Each kind's properties (nodes, edges, reference domain,
+/// shape functions, quadrature, extrapolation, VTK and Gmsh ids, name) are one descriptor in
+/// `crate::fem::kinds` (`ElementKind::info`); a new kind is a variant here, its descriptor
+/// file there and its line in `crate::fem::kinds::ALL`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum QuadKind {
+pub enum ElementKind {
     /// 4-node bilinear quadrilateral.
     Q4,
     /// 8-node serendipity quadrilateral.
     Q8,
     /// 9-node Lagrange quadrilateral.
     Q9,
+    /// 6-node quadratic triangle.
+    T6,
 }
 
 /// Integration rule of a continuum element.

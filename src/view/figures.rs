@@ -832,10 +832,25 @@ pub fn colour(v: f64, lo: f64, hi: f64) -> RGBColor {
 }
 
 /// Shape functions of a cell at natural coordinates (ξ, η) ∈ [−1, 1]², VTK node order;
-/// `None` for cells that are not Q4/Q8/Q9.
+/// `None` for cells that are not Q4/Q8/Q9/T6. A 6-node triangle (VTK 22) is reached through
+/// the collapsed square: area coordinates L₂ = (1 + ξ)(1 − η)/4, L₃ = (1 + η)/2 (the side
+/// η = 1 of the square is its third corner).
 fn shape(ty: u8, xi: f64, eta: f64) -> Option<Vec<f64>> {
     let c = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
     match ty {
+        22 => {
+            let l2 = 0.25 * (1.0 + xi) * (1.0 - eta);
+            let l3 = 0.5 * (1.0 + eta);
+            let l1 = 1.0 - l2 - l3;
+            Some(vec![
+                l1 * (2.0 * l1 - 1.0),
+                l2 * (2.0 * l2 - 1.0),
+                l3 * (2.0 * l3 - 1.0),
+                4.0 * l1 * l2,
+                4.0 * l2 * l3,
+                4.0 * l3 * l1,
+            ])
+        }
         9 => Some(
             c.iter()
                 .map(|&(a, b)| 0.25 * (1.0 + a * xi) * (1.0 + b * eta))
@@ -1400,6 +1415,29 @@ impl Figure for StageFigure {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The T6 cell's shape functions through the collapsed square are the quadratic
+    /// triangle's: 1 at their own node's image and 0 at the others (Kronecker), summing to 1.
+    #[test]
+    fn t6_cell_shape_interpolates_its_nodes() {
+        let images = [
+            (-1.0, -1.0),
+            (1.0, -1.0),
+            (0.3, 1.0),
+            (0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+        ];
+        for (j, &(x, e)) in images.iter().enumerate() {
+            let n = shape(22, x, e).unwrap();
+            for (i, v) in n.iter().enumerate() {
+                let d = if i == j { 1.0 } else { 0.0 };
+                assert!((v - d).abs() < 1e-15, "N{i} at node {j}: {v}");
+            }
+        }
+        let sum: f64 = shape(22, 0.2, -0.4).unwrap().iter().sum();
+        assert!((sum - 1.0).abs() < 1e-15);
+    }
 
     /// Tick labels never repeat, over spans from 1e-7 to 1e9 and offsets that put the
     /// ticks far from zero (the case that printed "0.001" twice before).

@@ -72,8 +72,8 @@ pub fn plate_line(model: &Model, node: usize, axis: [f64; 2]) -> Option<[f64; 2]
         if !e.nodes.contains(&node) {
             continue;
         }
-        for k in 0..4 {
-            let nodes: Vec<usize> = e.kind.edge_nodes(k).iter().map(|&l| e.nodes[l]).collect();
+        for edge in e.kind.edges() {
+            let nodes: Vec<usize> = edge.iter().map(|&l| e.nodes[l]).collect();
             if !nodes.contains(&node) {
                 continue;
             }
@@ -269,8 +269,9 @@ pub const LOCAL_ZONE_DEPTH: f64 = 1.0;
 /// keeps the region's construction stage and thermal coefficient.
 pub(super) fn apply_local_zones(model: &mut Model, zones: &[LocalZone], used: &[bool]) {
     let centroid = |model: &Model, e: &crate::model::Element| {
-        let k = e.nodes.len().min(4) as f64;
-        e.nodes.iter().take(4).fold([0.0, 0.0], |c, &n| {
+        let nc = e.kind.n_corners();
+        let k = e.nodes.len().min(nc) as f64;
+        e.nodes.iter().take(nc).fold([0.0, 0.0], |c, &n| {
             [c[0] + model.nodes[n][0] / k, c[1] + model.nodes[n][1] / k]
         })
     };
@@ -375,8 +376,9 @@ pub fn support_zone(model: &Model, node: usize, held: [f64; 2], bearing: f64) ->
         .iter()
         .filter(|e| e.nodes.contains(&node))
         .map(|e| {
-            let k = e.nodes.len().min(4) as f64;
-            let m = e.nodes.iter().take(4).fold([0.0, 0.0], |a, &n| {
+            let nc = e.kind.n_corners();
+            let k = e.nodes.len().min(nc) as f64;
+            let m = e.nodes.iter().take(nc).fold([0.0, 0.0], |a, &n| {
                 [a[0] + model.nodes[n][0] / k, a[1] + model.nodes[n][1] / k]
             });
             (m[0] - c[0]) * normal[0] + (m[1] - c[1]) * normal[1]

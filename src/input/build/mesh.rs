@@ -9,7 +9,7 @@ use crate::input::schema::MeshIn;
 use crate::input::{gmsh_mesh, limits, locate};
 use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
-use crate::model::QuadKind;
+use crate::model::ElementKind;
 use crate::model::{Element, Model, Region};
 
 /// A generated or read mesh: nodes [m], elements, the joints between segments and the gmsh
@@ -89,16 +89,37 @@ pub(super) fn used_nodes(ctx: &Ctx, model: &Model, warnings: &mut Vec<String>) -
     used
 }
 
-pub(super) fn quad_kind(ctx: &Ctx, key: &str, s: &str) -> R<QuadKind> {
-    match s {
-        "Q4" | "q4" => Ok(QuadKind::Q4),
-        "Q8" | "q8" => Ok(QuadKind::Q8),
-        "Q9" | "q9" => Ok(QuadKind::Q9),
-        _ => Err(ctx.err(
+/// The element kind named `s` (the one name parser, [`ElementKind::from_name`]).
+pub(super) fn element_kind(ctx: &Ctx, key: &str, s: &str) -> R<ElementKind> {
+    ElementKind::from_name(s).ok_or_else(|| {
+        ctx.err(
             key,
-            format!("unknown element type '{s}' (expected Q4, Q8 or Q9)"),
-        )),
+            format!(
+                "unknown element type '{s}' (expected {})",
+                ElementKind::names()
+            ),
+        )
+    })
+}
+
+/// The element kind named `s` for a generated (structured) mesh: a quadrilateral.
+fn grid_kind(ctx: &Ctx, key: &str, s: &str) -> R<ElementKind> {
+    let kind = element_kind(ctx, key, s)?;
+    if kind.grid_layout().is_none() {
+        let quads: Vec<&str> = crate::fem::kinds::ALL
+            .iter()
+            .filter(|k| k.grid_layout().is_some())
+            .map(|k| k.info().name)
+            .collect();
+        return Err(ctx.err(
+            key,
+            format!(
+                "the mesh generators make quadrilaterals ({}), not {s}: {s} elements come from an explicit mesh (mesh.blocks) or a Gmsh file",
+                quads.join(", ")
+            ),
+        ));
     }
+    Ok(kind)
 }
 
 /// The `integration` of elements of `kind`: `incompatible` (incompatible bending modes) is
@@ -107,12 +128,16 @@ pub(in crate::input) fn integration(
     ctx: &Ctx,
     key: &str,
     s: Option<&str>,
-    kind: QuadKind,
+    kind: ElementKind,
 ) -> R<Integration> {
     match s {
         None | Some("full") => Ok(Integration::Full),
-        Some("reduced") => Ok(Integration::Reduced),
-        Some("incompatible") if kind == QuadKind::Q4 => Ok(Integration::Incompatible),
+        Some("reduced") if kind.info().reduced_rule.is_some() => Ok(Integration::Reduced),
+        Some("reduced") => Err(ctx.err(
+            key,
+            format!("{kind:?} elements have no reduced rule: use 'full'"),
+        )),
+        Some("incompatible") if kind.info().incompatible_modes => Ok(Integration::Incompatible),
         Some("incompatible") => Err(ctx.err(
             key,
             format!("'incompatible' (bending modes) is for Q4 elements only, not {kind:?}: Q8 and Q9 bend well with full or reduced integration"),
@@ -160,7 +185,7 @@ fn banded_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
     if nx == 0 {
         return Err(ctx.err("mesh.nx", "must be at least 1"));
     }
-    let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q4"))?;
+    let kind = grid_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q4"))?;
     let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
     if mesh.bands.is_empty() {
         return Err(ctx.err(
@@ -182,7 +207,7 @@ fn banded_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
         limits::available_memory(),
     )?;
     let g = banded::generate(origin, length, nx, &bands, kind);
-    check_generated(ctx, &g.nodes, &g.elements)?;
+    check_generated(ctx, kind, &g.nodes, &g.elements)?;
     let elements = g
         .elements
         .into_iter()
@@ -258,7 +283,7 @@ fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
             region_names(),
             &blk.region,
         )?;
-        let kind = quad_kind(ctx, &format!("mesh.blocks[{b}].element"), &blk.element)?;
+        let kind = element_kind(ctx, &format!("mesh.blocks[{b}].element"), &blk.element)?;
         let integ = integration(
             ctx,
             &format!("mesh.blocks[{b}].integration"),
@@ -292,7 +317,7 @@ fn explicit_mesh<'a, I: Iterator<Item = &'a str> + Clone>(
                 nodes.push(n);
             }
             let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.nodes[n]).collect();
-            if let Some(m) = limits::degenerate(&coords, &ids_of(conn), size) {
+            if let Some(m) = limits::degenerate(&coords, kind.n_corners(), &ids_of(conn), size) {
                 return Err(ctx.err(&key, m));
             }
             let detj = min_jacobian(kind, &coords, integ);
@@ -358,7 +383,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
             "a segmental mesh takes nx_per_segment, not nx, nodes or blocks",
         ));
     }
-    let kind = quad_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
+    let kind = grid_kind(ctx, "mesh.element", mesh.element.as_deref().unwrap_or("Q8"))?;
     let integ = integration(ctx, "mesh.integration", mesh.integration.as_deref(), kind)?;
     let bands = bands_of(mesh, ctx, region_names)?;
     let origin = origin_of(mesh, ctx)?;
@@ -385,7 +410,7 @@ pub(super) fn build_segmental<'a, I: Iterator<Item = &'a str> + Clone>(
         .into_iter()
         .map(|(nodes, region, _segment)| (nodes, region))
         .collect::<Vec<_>>();
-    check_generated(ctx, &g.nodes, &elements)?;
+    check_generated(ctx, kind, &g.nodes, &elements)?;
     let elements = elements
         .into_iter()
         .map(|(nodes, region)| Element {
@@ -504,6 +529,7 @@ fn shape_segmental(
 /// zero-length edges.
 pub(super) fn check_generated(
     ctx: &Ctx,
+    kind: ElementKind,
     nodes: &[[f64; 2]],
     elements: &[(Vec<usize>, usize)],
 ) -> R<()> {
@@ -526,7 +552,7 @@ pub(super) fn check_generated(
     for (i, (conn, _)) in elements.iter().enumerate() {
         let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();
         let ids: Vec<u64> = conn.iter().map(|&n| n as u64 + 1).collect();
-        if let Some(m) = limits::degenerate(&c, &ids, size) {
+        if let Some(m) = limits::degenerate(&c, kind.n_corners(), &ids, size) {
             return Err(ctx.err(
                 "mesh",
                 format!(

@@ -76,8 +76,9 @@ pub(super) fn region_boxes(
             }
             let mut hit = 0;
             for e in elements.iter_mut() {
-                let k = e.nodes.len().min(4) as f64;
-                let (cx, cy) = e.nodes.iter().take(4).fold((0.0, 0.0), |(a, b), &n| {
+                let nc = e.kind.n_corners();
+                let k = e.nodes.len().min(nc) as f64;
+                let (cx, cy) = e.nodes.iter().take(nc).fold((0.0, 0.0), |(a, b), &n| {
                     (a + nodes[n][0] / k, b + nodes[n][1] / k)
                 });
                 if (*x0..=*x1).contains(&cx) && (*y0..=*y1).contains(&cy) {
