@@ -91,38 +91,54 @@ fn oa1_peaks_bracket_the_test_and_the_failure_is_brittle() {
     );
 }
 
-/// B1 (D5 stirrups at 190 mm) fails in shear-compression at P_u = 434 kN. The default
-/// model (fixed cracks, seed β, IMPL-EX as the RC example), coarse mesh (10 rows): the peak
-/// within 10 % of P_u (the issue's criterion for beams with stirrups), the run's verdict a
-/// limit point ("loss of equilibrium") reached with the concrete crushed, as in the test.
-/// The 20-row mesh (within 0.4 % of this one, docs/validation.md) is left to `segfem bench
+/// B1 (D5 stirrups at 190 mm, shear-compression, P_u = 434 kN at 22.0 mm) with the default
+/// model (fixed cracks, seed β, IMPL-EX as the RC example), coarse mesh (10 rows), at
+/// converged plate increments (issue 42 item 5; about 30 s of CPU): pushed to 20 mm at 0.05
+/// and 0.025 mm, the two peaks within 2 % of each other (measured 423.9 / 424.2 kN, 0.1 %;
+/// the 0.2 mm bench figure, 431.5 kN, is 1.8 % above: docs/validation.md, "Converged plate
+/// increments"), the converged peak within 10 % of P_u (the acceptance band for beams with
+/// stirrups; measured test/predicted 1.02), and the run's verdict naming the concrete
+/// crushed, as in the test. The 20-row mesh (416.0 kN, −1.9 %) is left to `segfem bench
 /// --case beams`: minutes of CPU.
 #[test]
-fn b1_default_model_reaches_the_measured_peak_by_crushing() {
+#[cfg_attr(
+    debug_assertions,
+    ignore = "release test: 1,200 increments of a shear beam"
+)]
+fn b1_default_model_converged_in_the_increment_reaches_the_measured_peak_by_crushing() {
     let b1 = &beam("B1");
     let p_u = b1.test.0;
     let keys = option("fixed, seed β");
-    let r = run_beam(b1, keys, 10, -0.02, PLATE_INCREMENT).unwrap();
-    let u = r.ultimate.as_ref().expect("a verdict");
-    eprintln!(
-        "B1: {:.1} kN at {:.1} mm, {} {:?}; test {:.0} kN",
-        r.p_peak / 1e3,
-        r.deflection * 1e3,
-        u.mode,
-        u.events,
-        p_u / 1e3
+    let coarse = run_beam(b1, keys, 10, -0.02, 0.05e-3).unwrap();
+    let fine = run_beam(b1, keys, 10, -0.02, 0.025e-3).unwrap();
+    for r in [&coarse, &fine] {
+        let u = r.ultimate.as_ref().expect("a verdict");
+        eprintln!(
+            "B1: {:.1} kN at {:.1} mm, {} {:?}; test {:.0} kN",
+            r.p_peak / 1e3,
+            r.deflection * 1e3,
+            u.mode,
+            u.events,
+            p_u / 1e3
+        );
+        assert!(
+            u.mode == "concrete crushing" || u.events.iter().any(|e| e.0 == "concrete crushing"),
+            "{} {:?}",
+            u.mode,
+            u.events
+        );
+    }
+    assert!(
+        (coarse.p_peak - fine.p_peak).abs() < 0.02 * fine.p_peak,
+        "peak {:.1} kN (0.05 mm) vs {:.1} kN (0.025 mm)",
+        coarse.p_peak / 1e3,
+        fine.p_peak / 1e3
     );
     assert!(
-        (r.p_peak / p_u - 1.0).abs() < 0.10,
+        (fine.p_peak / p_u - 1.0).abs() < 0.10,
         "peak {:.1} kN vs {:.0} kN",
-        r.p_peak / 1e3,
+        fine.p_peak / 1e3,
         p_u / 1e3
-    );
-    assert_eq!(u.mode, "loss of equilibrium");
-    assert!(
-        u.events.iter().any(|e| e.0 == "concrete crushing"),
-        "{:?}",
-        u.events
     );
 }
 
