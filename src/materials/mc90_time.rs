@@ -434,6 +434,35 @@ mod tests {
         assert!(rel(p.eci(), 35495.72e6) < 1e-5);
     }
 
+    /// MC90 2.1.6.4 temperature and cement adjustments against hand values of the code
+    /// formulas (computed apart from this crate; 1e-9 relative: exact arithmetic, round-off
+    /// only), on the check case (RH 70 %, h = 200 mm, φ_RH = 1.5176308):
+    /// - φ_RH,T = φ_T + (φ_RH − 1) φ_T^1.2, φ_T = exp[0.015 (T − 20)]: at 40 °C 2.0917942;
+    /// - t0 = t0,T [9/(2 + (t0,T/t1)^1.2) + 1]^α: t0 = 7 d gives 12.109318 d for RS
+    ///   (α = 1), 4.0464706 d for SL (α = −1), 7 d for N (α = 0);
+    /// - the high-stress factor exp[1.5 (|σ|/f_cm − 0.4)]: 1.1618342 at 0.5, 1.3498588 at
+    ///   −0.6 (its magnitude), 1 at 0.3.
+    #[test]
+    fn temperature_cement_and_high_stress_adjustments_follow_mc90() {
+        let mut p = check_params(7.0);
+        assert!(rel(p.phi_rh(), 1.5176307778) < 1e-9);
+        p.temperature = Some(40.0);
+        assert!(rel(p.phi_rh(), 2.0917942273) < 1e-9, "{}", p.phi_rh());
+        for (cement, t0) in [
+            (CementClass::RS, 12.109318271754),
+            (CementClass::SL, 4.046470569222),
+            (CementClass::N, 7.0),
+        ] {
+            let mut p = CreepShrinkageParams::new(45.0e6, 0.70, 0.200, cement, 7.0);
+            p.adjust_age_for_cement = true;
+            let got = p.effective_loading_age(7.0);
+            assert!(rel(got, t0) < 1e-9, "{cement:?}: {got}");
+        }
+        assert!(rel(high_stress_creep_factor(0.5), 1.1618342427) < 1e-9);
+        assert!(rel(high_stress_creep_factor(-0.6), 1.3498588076) < 1e-9);
+        assert_eq!(high_stress_creep_factor(0.3), 1.0);
+    }
+
     #[test]
     fn check_11_creep_table() {
         let p = check_params(7.0);
