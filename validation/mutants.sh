@@ -4,10 +4,12 @@
 # Each module is mutated alone (`cargo mutants -f FILE`) and every mutant is run against the
 # fast tests that cover that module: its unit tests in the library and one or two integration
 # test binaries, never the whole suite. Builds are incremental in the repository's own
-# release target (`--in-place`: cargo-mutants restores the file after each mutant and on
-# Ctrl-C; if it is killed hard, `git checkout -- src/` restores the sources).
-# Not for CI: a whole module takes hours on a 2-core machine (about 1–2 minutes of build and
-# test per mutant; src/prestress/friction.rs alone has 352 mutants).
+# dev target (`--in-place`, the dev profile: opt-level 1, dependencies at 3, incremental, so a
+# mutant recompiles a few codegen units instead of the release crate; cargo-mutants restores
+# the file after each mutant and on Ctrl-C; if it is killed hard, `git checkout -- src/`
+# restores the sources). Run it in a worktree of its own, not in a checkout you edit.
+# Not for CI: a whole module takes hours on a 2-core machine (src/prestress/friction.rs
+# alone has 352 mutants, src/materials/concrete/ 2,813); SHARD samples a module.
 #
 # Usage:
 #   validation/mutants.sh                       # every module below, one after the other
@@ -15,8 +17,11 @@
 #   SHARD=0/16 validation/mutants.sh friction   # one 16th of the mutants (round robin)
 #   validation/mutants.sh --list                # the modules, files and tests
 #
-# Results: target/mutants/<module>/mutants.out/{caught,missed,timeout,unviable}.txt and
-# outcomes.json; the last lines of each run give the counts. Record the figures, with the date,
+# Two tiers: every mutant against all the library's unit tests (3 s), then only the mutants
+# those missed against the module's integration test binaries as well.
+# Results: target/mutants/<module>/mutants.out/ (tier 1) and
+# target/mutants/<module>-integration/mutants.out/ (tier 2): {caught,missed,timeout,
+# unviable}.txt and outcomes.json; the last lines of each run give the counts. Record the figures, with the date,
 # in docs/validation.md ("Mutation testing").
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,7 +35,7 @@ MODULES=(
     "friction|src/prestress/friction.rs|prestress bonded_losses|test(/^prestress::/) | binary(prestress) | binary(bonded_losses)"
     "interface|src/elements/interface.rs|joints|test(/^elements::interface::/) | binary(joints)"
     "tendon|src/elements/tendon.rs|tendons|test(/^elements::tendon::/) | binary(tendons)"
-    "thermal|src/elements/thermal.rs|thermal|test(/^elements::thermal::/) | binary(thermal)"
+    "thermal|src/model/thermal.rs|thermal|test(/^model::thermal::/) | binary(thermal)"
 )
 
 if [[ "${1:-}" == "--list" ]]; then
@@ -51,23 +56,48 @@ for m in "${MODULES[@]}"; do
     if ((${#wanted[@]})) && [[ ! " ${wanted[*]} " == *" $name "* ]]; then
         continue
     fi
-    args=(--in-place --profile release --test-tool nextest --no-shuffle
-        --timeout 300 --output "target/mutants/$name" --cargo-arg=--lib)
-    for t in $tests; do
-        args+=("--cargo-arg=--test=$t")
-    done
+    common=(--in-place --profile mutants --test-tool nextest --no-shuffle --timeout 300)
     for f in $files; do
-        args+=(-f "$f")
+        common+=(-f "$f")
     done
+    # Tier 1: every mutant against the library's unit tests (all of them: 3 s), one crate
+    # build per mutant.
+    args=("${common[@]}" --output "target/mutants/$name" --cargo-arg=--lib)
     if [[ -n "${SHARD:-}" ]]; then
         args+=(--shard "$SHARD" --sharding round-robin)
     fi
     mkdir -p "target/mutants/$name"
-    echo "== $name ($(date -u +%F)): cargo mutants ${args[*]} -- -E '$filter'"
-    # Missed mutants make cargo-mutants exit non-zero: carry on with the next module.
-    cargo mutants "${args[@]}" -- -E "$filter" || true
+    echo "== $name ($(date -u +%F)) tier 1: cargo mutants ${args[*]}"
+    # Missed mutants make cargo-mutants exit non-zero: carry on.
+    cargo mutants "${args[@]}" || true
     out="target/mutants/$name/mutants.out"
-    for k in caught missed timeout unviable; do
-        printf '%s %s: %s\n' "$name" "$k" "$(wc -l <"$out/$k.txt" 2>/dev/null || echo 0)"
-    done
+    # Tier 2: the mutants the unit tests missed, against the module's integration tests too.
+    missed="$out/missed.txt"
+    out2="target/mutants/$name-integration/mutants.out"
+    rm -rf "$out2"
+    if [[ -s "$missed" ]]; then
+        re=$(python3 -c 'import re,sys; print("^(" + "|".join(re.escape(l.rstrip("\n")) for l in open(sys.argv[1]) if l.strip()) + ")$")' "$missed")
+        args=("${common[@]}" --output "target/mutants/$name-integration" --cargo-arg=--lib --re "$re")
+        for t in $tests; do
+            args+=("--cargo-arg=--test=$t")
+        done
+        echo "== $name tier 2 ($(wc -l <"$missed") missed by the unit tests): integration tests $tests"
+        mkdir -p "target/mutants/$name-integration"
+        cargo mutants "${args[@]}" -- -E "$filter" || true
+    fi
+    count() { if [[ -f "$1" ]]; then wc -l <"$1"; else echo 0; fi; }
+    c1=$(count "$out/caught.txt")
+    c2=$(count "$out2/caught.txt")
+    printf '%s caught: %s (unit tests) + %s (integration tests)\n' "$name" "$c1" "$c2"
+    if [[ ! -s "$missed" ]]; then
+        m=0
+    elif [[ -f "$out2/outcomes.json" ]]; then
+        m=$(count "$out2/missed.txt")
+    else
+        m="$(count "$missed") (tier 2 did not run)"
+    fi
+    printf '%s missed: %s\n' "$name" "$m"
+    printf '%s timeout: %s\n' "$name" "$(( $(count "$out/timeout.txt") + $(count "$out2/timeout.txt") ))"
+    printf '%s unviable: %s\n' "$name" "$(count "$out/unviable.txt")"
+    [[ -s "$out2/missed.txt" ]] && { echo "$name still missed:"; cat "$out2/missed.txt"; }
 done
