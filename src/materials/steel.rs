@@ -213,6 +213,29 @@ mod tests {
             .collect()
     }
 
+    /// Kinematic hardening past its cap in one step (E_s = 200 GPa, f_y = 500 MPa,
+    /// H = 2 GPa, f_u = 600 MPa: the back stress reaches f_u − f_y = 100 MPa at ε_p =
+    /// 0.05): from zero to ε = 0.1 at once the stress is f_u, the tangent 0, the plastic
+    /// strain ε − f_u/E_s = 0.097 and the back stress 100 MPa; from there, unloading by
+    /// 0.001 is elastic (σ = 400 MPa). Hand values, 1e-9 relative (closed form).
+    #[test]
+    fn kinematic_hardening_past_the_cap_in_one_step() {
+        let p = SteelParams {
+            es: ES,
+            fy: FY,
+            hardening: 2e9,
+            fu: 600e6,
+            rule: HardeningRule::Kinematic,
+        };
+        let r = drive(&p, &[0.1, 0.099]);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+        assert!(close(r[0].0, 600e6), "{}", r[0].0);
+        assert_eq!(r[0].1, 0.0);
+        assert!(close(r[0].2.plastic_strain, 0.097), "{:?}", r[0].2);
+        assert!(close(r[0].2.back_stress, 100e6), "{:?}", r[0].2);
+        assert!(close(r[1].0, 400e6) && close(r[1].1, ES), "{:?}", r[1]);
+    }
+
     /// Elastic–perfectly plastic rebar: yield at f_y, plateau, elastic unloading with E_s,
     /// reverse yield at −f_y. Hand values; tolerance 1e-9 rel (closed form, round-off only).
     #[test]
