@@ -232,11 +232,15 @@ impl Assembler {
     }
 }
 
+/// Assembled entries (element matrix index, value position) and the end or start of each
+/// element's entries in them.
+type Packed = (Vec<(u32, u32)>, Vec<usize>);
+
 /// The assembled entries of every element's map ([`Assembler::packed`]) and their starts,
 /// built chunk-parallel (the linear runs build the map once and assemble once or twice).
-fn pack(scatter: &[u32], scatter_ptr: &[usize]) -> (Vec<(u32, u32)>, Vec<usize>) {
+fn pack(scatter: &[u32], scatter_ptr: &[usize]) -> Packed {
     let n_el = scatter_ptr.len() - 1;
-    let parts: Vec<(Vec<(u32, u32)>, Vec<usize>)> = (0..n_el.div_ceil(ELEM_CHUNK))
+    let parts: Vec<Packed> = (0..n_el.div_ceil(ELEM_CHUNK))
         .into_par_iter()
         .map(|c| {
             let (e0, e1) = (c * ELEM_CHUNK, ((c + 1) * ELEM_CHUNK).min(n_el));
