@@ -381,7 +381,13 @@ impl ConcreteParams {
     /// points of a uniformly sheared body into plasticity and others not (a spurious
     /// bifurcation: the points then take different stresses and crack early).
     pub fn compression_dominated(&self, s: &[f64; 3]) -> bool {
-        principal_max(s).0 < self.crack_ratio * self.ftm && s[0] + s[1] < -1e-9 * self.ftm
+        self.compression_dominated_s1(principal_max_value(s), s)
+    }
+
+    /// [`Self::compression_dominated`] with σ1 [Pa] of `s` already known
+    /// ([`principal_max_value`]).
+    fn compression_dominated_s1(&self, s1: f64, s: &[f64; 3]) -> bool {
+        s1 < self.crack_ratio * self.ftm && s[0] + s[1] < -1e-9 * self.ftm
     }
 
     /// Shear retention β [-] and dβ/dε [-] of a fixed crack whose largest normal strain is
@@ -617,9 +623,20 @@ pub fn d_matrix(e: f64, nu: f64) -> [[f64; 3]; 3] {
 
 /// Largest principal stress σ1 [Pa] and the angle of its direction from x [rad].
 pub fn principal_max(s: &[f64; 3]) -> (f64, f64) {
+    (principal_max_value(s), principal_angle(s))
+}
+
+/// Largest principal stress σ1 [Pa] alone (the value of [`principal_max`], without the
+/// arctangent of its direction).
+pub fn principal_max_value(s: &[f64; 3]) -> f64 {
     let c = 0.5 * (s[0] + s[1]);
     let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
-    (c + r, 0.5 * (2.0 * s[2]).atan2(s[0] - s[1]))
+    c + r
+}
+
+/// Angle [rad] of the direction of σ1 from x (that of [`principal_max`]).
+fn principal_angle(s: &[f64; 3]) -> f64 {
+    0.5 * (2.0 * s[2]).atan2(s[0] - s[1])
 }
 
 fn matvec(d: &[[f64; 3]; 3], v: &[f64; 3]) -> [f64; 3] {
@@ -725,13 +742,14 @@ pub fn update_full_into(
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let s_tr = matvec(&d, &ee);
-    let (s1, phi) = principal_max(&s_tr);
+    // σ1 once; its direction only where a crack forms (the same bits as before).
+    let s1 = principal_max_value(&s_tr);
     // Plastic (compression) branch: if the trial stress is compression-dominated, or if the
     // trial would yield and the returned stress is compression-dominated. Routing on the
     // returned stress as well avoids sending a plastically flowing point to the elastic
     // branch only because its elastic trial shows lateral tension (uniaxial compression
     // with dilatancy does exactly that).
-    let trial_cd = p.compression_dominated(&s_tr);
+    let trial_cd = p.compression_dominated_s1(s1, &s_tr);
     // A virgin state stores ε̄ = 0; the hardening variable starts at initial yield ε̄0.
     let law = compression::HardeningLaw::new(p);
     let ebar0 = law.initial_yield_strain();
@@ -742,7 +760,15 @@ pub fn update_full_into(
         ottosen::equivalent_stress(&p.ottosen, &s_tr) / p.q_norm()
             > law.at(ebar_n).sigma_c * (1.0 + 1e-13)
     };
-    if trial_cd || committed.hold_plastic || yields() {
+    // The returned-stress route is only open to points that have flowed already: a
+    // virgin point whose trial is tension-dominated stays elastic (else the Ottosen
+    // loading surface, which reaches into tension at ~0.3 f_tm, would pull a cracking
+    // point back into plasticity and make the response jump between iterations). Such a
+    // point's return mapping would be thrown away whatever it gives, so it is not run,
+    // nor its yield check (the same routes and bits as running and rejecting it).
+    let flowed = committed.ebar > ebar0 + 1e-12;
+    let held = committed.hold_plastic;
+    if trial_cd || held || (flowed && yields()) {
         let res = compression::update_rate_with_law(
             p,
             &law,
@@ -752,12 +778,6 @@ pub fn update_full_into(
             ebar_n,
             strain,
         );
-        // The returned-stress route is only open to points that have flowed already: a
-        // virgin point whose trial is tension-dominated stays elastic (else the Ottosen
-        // loading surface, which reaches into tension at ~0.3 f_tm, would pull a cracking
-        // point back into plasticity and make the response jump between iterations).
-        let flowed = committed.ebar > ebar0 + 1e-12;
-        let held = committed.hold_plastic;
         let accept = match &res {
             Ok(u) => {
                 held || trial_cd || (flowed && u.plastic && p.compression_dominated(&u.stress))
@@ -786,6 +806,7 @@ pub fn update_full_into(
     }
     // Tension-dominated: elastic until the Ottosen failure surface, then crack.
     if s1 >= p.crack_ratio * p.ftm && ottosen::equivalent_stress(&p.ottosen, &s_tr) >= p.fcm {
+        let phi = principal_angle(&s_tr);
         assign(out, committed);
         let st = &mut *out;
         st.n_cracks = 1;
