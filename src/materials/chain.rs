@@ -968,6 +968,43 @@ mod tests {
         }
     }
 
+    /// Creep in shear: a shear stress τ applied at t0 = 28 d and held gives γ(t) =
+    /// 2(1 + ν) τ J(t, t0) (plane stress, constant ν: the chain's shear compliance is the
+    /// uniaxial one over G/E), no normal strain, within 1 % from 1 d on (the fit's error, as
+    /// check 14); a shear creep strain of the wrong sign or size misses it by far more.
+    #[test]
+    fn creep_in_shear_follows_the_uniaxial_compliance() {
+        let p = params();
+        let chain = MaxwellChain::fit(&p, 5).unwrap();
+        let (nu, t0, tau) = (0.2, 28.0, 1.0e6);
+        let dinv = plane_stress_d1_inv(nu);
+        let mut state = ChainState::new(chain.n_units());
+        let (mut eps, mut t, mut target) = ([0.0; 3], t0, [0.0, 0.0, tau]);
+        for tn in std::iter::once(t0).chain(log_ages(t0, 1e-2, 1e4, 10)) {
+            let pred = chain_predictor(&chain, nu, &state, t, tn);
+            let de_el = mat_vec(&dinv, &target);
+            let de: [f64; 3] =
+                std::array::from_fn(|c| pred.d_creep_strain[c] + de_el[c] / pred.e_incr);
+            let step = chain_step(&chain, nu, &state, t, tn, &de, 0.0);
+            for c in 0..3 {
+                eps[c] += de[c];
+            }
+            state = step.new_state;
+            target = [0.0; 3];
+            if tn - t0 >= 1.0 - 1e-9 {
+                let expect = 2.0 * (1.0 + nu) * tau * compliance(&p, tn, t0);
+                assert!(
+                    rel(eps[2], expect) < 0.01,
+                    "t - t0 = {}: γ {} vs {expect}",
+                    tn - t0,
+                    eps[2]
+                );
+                assert!(eps[0].abs() < 1e-12 && eps[1].abs() < 1e-12, "{eps:?}");
+            }
+            t = tn;
+        }
+    }
+
     /// Brief: halving Δt changes the 1e4-day strain by < 1 % (the exponential algorithm is
     /// exact for non-ageing units; the remaining dependence comes from the ageing moduli).
     #[test]
