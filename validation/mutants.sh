@@ -71,6 +71,12 @@ for m in "${MODULES[@]}"; do
     # Missed mutants make cargo-mutants exit non-zero: carry on.
     cargo mutants "${args[@]}" || true
     out="target/mutants/$name/mutants.out"
+    if ! grep -q '"Mutant"' "$out/outcomes.json" 2>/dev/null; then
+        # The unmutated tree did not build or pass (e.g. a stale incremental cache after a
+        # killed run: remove target/mutants/incremental and retry).
+        echo "$name: no mutant tested; see $out/log/ and $out/debug.log" >&2
+        continue
+    fi
     # Tier 2: the mutants the unit tests missed, against the module's integration tests too.
     missed="$out/missed.txt"
     out2="target/mutants/$name-integration/mutants.out"
