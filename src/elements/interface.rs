@@ -857,8 +857,15 @@ mod tests {
         let limit_g = mu * sigma / KT;
         let (fa, fb) = faces(3);
         for keyed in [false, true] {
-            let mut p = InterfaceParams::dry(KN, KT, mu);
-            p.keyed = keyed;
+            // The keyed joint through its constructor (friction set for the comparison).
+            let p = if keyed {
+                InterfaceParams {
+                    friction: mu,
+                    ..InterfaceParams::keyed(KN, KT)
+                }
+            } else {
+                InterfaceParams::dry(KN, KT, mu)
+            };
             let el = InterfaceElement::new(&fa, &fb, &p).unwrap();
             let st = el.initial_states(&p);
             for (g, expect_slide) in [(0.9 * limit_g, false), (1.5 * limit_g, true)] {
@@ -877,6 +884,26 @@ mod tests {
                 }
                 assert_eq!(r.symmetric, !expect_slide || keyed);
             }
+        }
+    }
+
+    /// Arc length along a curved 3-node face (ends (−1, 0), (1, 0), midside (0, h), so
+    /// x = r, y = h (1 − r²)) against the closed form ∫ √(1 + a² x²) dx, a = 2h:
+    /// F(x) = x/2 √(1 + a² x²) + asinh(a x)/(2a), from −1 to r. h = 0.1: the integrand is
+    /// smooth and the 4-point rule is within 1e-7 of it (asserted 1e-6 relative).
+    #[test]
+    fn arc_length_of_a_curved_face_follows_the_closed_form() {
+        let h = 0.1;
+        let a = 2.0 * h;
+        let f = |x: f64| 0.5 * x * (1.0 + a * a * x * x).sqrt() + (a * x).asinh() / (2.0 * a);
+        let coords = [[-1.0, 0.0], [1.0, 0.0], [0.0, h]];
+        for r in [-0.5, 0.0, 0.3, 1.0] {
+            let exact = f(r) - f(-1.0);
+            let got = arc_length(&coords, r);
+            assert!(
+                (got - exact).abs() < 1e-6 * exact,
+                "r = {r}: {got} vs {exact}"
+            );
         }
     }
 
