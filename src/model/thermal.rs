@@ -175,6 +175,129 @@ pub fn aashto_profile(h: f64, zone: u8, factor: f64) -> Option<Vec<[f64; 2]>> {
 mod tests {
     use super::*;
 
+    /// EN 1991-1-5 Figure 6.2c (concrete decks, 100 mm surfacing) at depths between its
+    /// rows, interpolated by hand from the code's table (heating h ≤ 0.2: T1, T2, T3 = 8.5,
+    /// 3.5, 0.5; 0.4: 12.0, 3.0, 1.5; cooling h ≤ 0.2: −2.0, −0.5, −0.5, −1.5; 0.4: −4.5, −1.4, −1.0, −3.5; 0.6: −6.5, −1.8,
+    /// −1.5, −5.0; 0.8: −7.6, −1.7, −1.5, −6.0; 1.0: −8.0, −1.5, −1.5, −6.3; ≥ 1.5: −8.4,
+    /// −0.5, −1.0, −6.5) with the figure's depths h1, h2, h3 (h = 0.2: h3 limited by
+    /// h − h1 − h2). Exact arithmetic: 1e-12.
+    #[test]
+    fn en1991_profiles_between_table_rows() {
+        let cases: [(f64, bool, Vec<[f64; 2]>); 7] = [
+            (
+                0.2,
+                false,
+                vec![
+                    [0.0, -2.0],
+                    [0.04, -0.5],
+                    [0.09, 0.0],
+                    [0.11, 0.0],
+                    [0.16, -0.5],
+                    [0.2, -1.5],
+                ],
+            ),
+            (
+                0.2,
+                true,
+                vec![
+                    [0.0, 8.5],
+                    [0.06, 3.5],
+                    [0.16, 0.0],
+                    [0.16, 0.0],
+                    [0.2, 0.5],
+                ],
+            ),
+            (
+                0.3,
+                true,
+                vec![
+                    [0.0, 10.25],
+                    [0.09, 3.25],
+                    [0.19, 0.0],
+                    [0.21, 0.0],
+                    [0.3, 1.0],
+                ],
+            ),
+            (
+                0.5,
+                false,
+                vec![
+                    [0.0, -5.5],
+                    [0.1, -1.6],
+                    [0.225, 0.0],
+                    [0.275, 0.0],
+                    [0.4, -1.25],
+                    [0.5, -4.25],
+                ],
+            ),
+            (
+                0.9,
+                false,
+                vec![
+                    [0.0, -7.8],
+                    [0.18, -1.6],
+                    [0.38, 0.0],
+                    [0.52, 0.0],
+                    [0.72, -1.5],
+                    [0.9, -6.15],
+                ],
+            ),
+            (
+                1.25,
+                false,
+                vec![
+                    [0.0, -8.2],
+                    [0.25, -1.0],
+                    [0.45, 0.0],
+                    [0.8, 0.0],
+                    [1.0, -1.25],
+                    [1.25, -6.4],
+                ],
+            ),
+            (
+                2.0,
+                false,
+                vec![
+                    [0.0, -8.4],
+                    [0.25, -0.5],
+                    [0.45, 0.0],
+                    [1.55, 0.0],
+                    [1.75, -1.0],
+                    [2.0, -6.5],
+                ],
+            ),
+        ];
+        for (h, heating, expect) in cases {
+            let got = en1991_profile(h, heating);
+            assert_eq!(
+                got.len(),
+                expect.len(),
+                "h = {h}, heating {heating}: {got:?}"
+            );
+            for (g, e) in got.iter().zip(&expect) {
+                assert!(
+                    (g[0] - e[0]).abs() < 1e-12 && (g[1] - e[1]).abs() < 1e-12,
+                    "h = {h}, heating {heating}: {got:?}"
+                );
+            }
+        }
+    }
+
+    /// The mean temperature along an inclined external-tendon span: the trapezoidal rule is
+    /// exact for the linear field, so a span from y = 0.6 to 1.0 m in a section 0 … 1 m with
+    /// ΔT_M = 10 K (ΔT = 10 (y − 0.5)) averages ΔT(0.8) = 3 K (1e-12).
+    #[test]
+    fn span_temperature_is_the_mean_along_an_inclined_span() {
+        let t = ThermalAction {
+            linear: 10.0,
+            top: 1.0,
+            bottom: 0.0,
+            ..ThermalAction::default()
+        };
+        let m = t.span_temperature([0.0, 0.6], [10.0, 1.0]);
+        assert!((m - 3.0).abs() < 1e-12, "{m}");
+    }
+
     /// The profile is piecewise linear and zero outside its points.
     #[test]
     fn profile_interpolates_and_vanishes_outside() {
