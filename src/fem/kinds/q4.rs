@@ -13,7 +13,8 @@ pub static Q4: ElementKindInfo = ElementKindInfo {
     n_corners: 4,
     order: 1,
     edges: &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
-    node_xi: &[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
+    // The Q9's corner nodes.
+    node_xi: NODE_XI.split_at(4).0,
     domain: Domain::Square,
     eval,
     full_rule: rule,
