@@ -434,6 +434,27 @@ impl<'a> Table<'a> {
         self.num(key).ok_or_else(|| self.err(key, missing))
     }
 
+    /// A steel's modulus and strength [Pa] at `key_e` and `key_f` (rebar: E and fy;
+    /// prestressing steel: Ep and fptk): both required and > 0, the strength far below the
+    /// modulus (a value in MPa or GPa is refused, with a warning on an unusual magnitude).
+    pub fn steel_modulus_and_strength(
+        &self,
+        warnings: &mut Vec<String>,
+        key_e: &str,
+        key_f: &str,
+    ) -> R<(f64, f64)> {
+        use crate::input::build::fields::positive;
+        use crate::input::units;
+        let e = positive(self.ctx, &self.key(key_e), self.need(key_e, "missing")?)?;
+        let f = positive(self.ctx, &self.key(key_f), self.need(key_f, "missing")?)?;
+        units::modulus(warnings, self.ctx, &self.key(key_e), e);
+        units::strength(warnings, self.ctx, &self.key(key_f), f);
+        if f >= e {
+            return Err(self.err(key_f, format!("must be far below {key_e} (units are Pa)")));
+        }
+        Ok((e, f))
+    }
+
     /// A whole number at `key`.
     pub fn count(&self, key: &str) -> Option<usize> {
         match self.values.get(key) {

@@ -2,10 +2,8 @@
 //! 0.9 f_ptk then plastic, or hardening to f_ptk at ε_uk.
 
 use super::{Key, Law, Schema, Table, THERMAL_EXPANSION};
-use crate::input::build::fields::positive;
 use crate::input::build::loads::ALPHA_STEEL;
 use crate::input::build::R;
-use crate::input::units;
 use crate::materials::steel::SteelParams;
 
 /// The schema of `kind = "prestressing_steel"`.
@@ -34,14 +32,7 @@ pub(super) const SCHEMA: Schema = Schema {
 
 /// The uniaxial law of embedded bars.
 fn build(t: &Table, warnings: &mut Vec<String>) -> R<Law> {
-    let ctx = t.ctx();
-    let ep = positive(ctx, &t.key("Ep"), t.need("Ep", "missing")?)?;
-    let fptk = positive(ctx, &t.key("fptk"), t.need("fptk", "missing")?)?;
-    units::modulus(warnings, ctx, &t.key("Ep"), ep);
-    units::strength(warnings, ctx, &t.key("fptk"), fptk);
-    if fptk >= ep {
-        return Err(t.err("fptk", "must be far below Ep (units are Pa)"));
-    }
+    let (ep, fptk) = t.steel_modulus_and_strength(warnings, "Ep", "fptk")?;
     Ok(Law::Bar(match t.num("eps_uk") {
         None => SteelParams::prestressing(ep, fptk),
         Some(e) if e.is_finite() && e > 0.9 * fptk / ep => {

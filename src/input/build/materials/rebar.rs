@@ -2,10 +2,8 @@
 //! kinematic hardening.
 
 use super::{Key, Law, Schema, Table, THERMAL_EXPANSION};
-use crate::input::build::fields::positive;
 use crate::input::build::loads::ALPHA_STEEL;
 use crate::input::build::R;
-use crate::input::units;
 use crate::materials::steel::SteelParams;
 
 /// The schema of `kind = "rebar"`.
@@ -34,14 +32,7 @@ pub(super) const SCHEMA: Schema = Schema {
 
 /// The uniaxial law of embedded bars.
 fn build(t: &Table, warnings: &mut Vec<String>) -> R<Law> {
-    let ctx = t.ctx();
-    let e = positive(ctx, &t.key("E"), t.need("E", "missing")?)?;
-    let fy = positive(ctx, &t.key("fy"), t.need("fy", "missing")?)?;
-    units::modulus(warnings, ctx, &t.key("E"), e);
-    units::strength(warnings, ctx, &t.key("fy"), fy);
-    if fy >= e {
-        return Err(t.err("fy", "must be far below E (units are Pa)"));
-    }
+    let (e, fy) = t.steel_modulus_and_strength(warnings, "E", "fy")?;
     Ok(Law::Bar(match t.num("Et") {
         None => SteelParams::rebar(e, fy),
         Some(et) if et.is_finite() && (0.0..e).contains(&et) => {
