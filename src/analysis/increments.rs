@@ -8,7 +8,7 @@
 //! force pieces ([`ArcSizing`], [`external_forces_along`]).
 
 use super::context::PathContext;
-use super::driver::{implex_retry, AnalysisError, Observer, Timings};
+use super::driver::{implex_retry, AnalysisError, Observer};
 use super::failure::NewtonFailure;
 use super::state::SystemState;
 
@@ -290,18 +290,18 @@ impl Controller {
         true
     }
 
-    /// A converged attempt ending at `target` after `iterations`, with displacements `u`
-    /// [m] from the committed `committed_u` [m]: what becomes of it, and the size and level
-    /// that follow. `implex_over` is asked (once, and only for an attempt that would
-    /// otherwise be kept) whether its IMPL-EX error calls for a retry.
+    /// A converged attempt (ending at [`Controller::target`]) after `iterations`, with
+    /// displacements `u` [m] from the committed `committed_u` [m]: what becomes of it, and
+    /// the size and level that follow. `implex_over` is asked (once, and only for an
+    /// attempt that would otherwise be kept) whether its IMPL-EX error calls for a retry.
     pub fn converged(
         &mut self,
-        target: f64,
         iterations: usize,
         u: &[f64],
         committed_u: &[f64],
         implex_over: impl FnOnce(&mut Controller) -> bool,
     ) -> Verdict {
+        let target = self.target();
         if self.tolerance.is_some() && self.pair.is_probe() {
             // The whole pair as one increment: kept to compare with its halves.
             self.pair = Pair::First(Box::new(PairStart {
@@ -399,17 +399,104 @@ pub(super) enum Verdict {
     },
 }
 
+/// The sizing rules of a step kind, driven by [`run`]: where the step ends, how a failed
+/// attempt is cut, and what becomes of a converged one (pairs of increments with their error
+/// control, the IMPL-EX retry, growth). [`Controller`] sizes load, displacement and time
+/// steps by a fraction of the step; [`ArcSizing`] sizes arc-length steps by an arc length.
+pub(super) trait Sizing {
+    /// True once the step's end is reached.
+    fn finished(&self) -> bool;
+
+    /// Whether a failed attempt may still be cut (otherwise the step fails).
+    fn can_cut(&self) -> bool;
+
+    /// Throw a failed attempt away: false if no cut is left, else the next attempt's size.
+    fn cut(&mut self) -> bool;
+
+    /// The attempt is solved again from its start at the same size (a one-way support
+    /// switched in it).
+    fn again(&mut self);
+
+    /// A converged attempt after `iterations`, with displacements `u` [m] from the
+    /// committed `committed_u` [m]: what becomes of it. `implex_over` is asked (once, and
+    /// only for an attempt that would otherwise be kept) whether its IMPL-EX error calls
+    /// for a retry at half the size.
+    fn converged(
+        &mut self,
+        iterations: usize,
+        u: &[f64],
+        committed_u: &[f64],
+        implex_over: impl FnOnce(&mut Self) -> bool,
+    ) -> Verdict;
+
+    /// The IMPL-EX control's sizes of the current attempt: (its size, the smallest size's
+    /// reference), in the sizing's own unit.
+    fn implex_sizes(&self) -> (f64, f64);
+
+    /// The IMPL-EX error of the last attempt of this increment, if it was retried for it.
+    fn implex_last(&mut self) -> &mut Option<f64>;
+
+    /// The phase of the current pair of increments.
+    fn pair_mut(&mut self) -> &mut Pair;
+
+    /// Step-doubling tolerance (None: single increments).
+    fn tolerance(&self) -> Option<f64>;
+}
+
+impl Sizing for Controller {
+    fn finished(&self) -> bool {
+        Controller::finished(self)
+    }
+
+    fn can_cut(&self) -> bool {
+        self.cuts < self.max_cuts
+    }
+
+    fn cut(&mut self) -> bool {
+        Controller::cut(self)
+    }
+
+    fn again(&mut self) {
+        self.retry = true;
+    }
+
+    fn converged(
+        &mut self,
+        iterations: usize,
+        u: &[f64],
+        committed_u: &[f64],
+        implex_over: impl FnOnce(&mut Self) -> bool,
+    ) -> Verdict {
+        Controller::converged(self, iterations, u, committed_u, implex_over)
+    }
+
+    fn implex_sizes(&self) -> (f64, f64) {
+        (self.target() - self.level, self.nominal)
+    }
+
+    fn implex_last(&mut self) -> &mut Option<f64> {
+        &mut self.implex_last
+    }
+
+    fn pair_mut(&mut self) -> &mut Pair {
+        &mut self.pair
+    }
+
+    fn tolerance(&self) -> Option<f64> {
+        self.tolerance
+    }
+}
+
 /// What a step kind supplies to [`run`]: how an attempt is solved and what a converged
-/// increment does.
-pub(super) trait Stepper {
-    /// Solve the increment from `ctl.level` to `target` (level of the step [-]), starting
-    /// from `ctx.u`. Returns the internal forces [N] and the Newton iterations.
+/// increment does. The sizing `S` is the step kind's ([`Controller`] or [`ArcSizing`]).
+pub(super) trait Stepper<S> {
+    /// Solve the next increment (its size from `ctl`), starting from `ctx.u`. Returns the
+    /// internal forces [N] and the Newton iterations.
     fn attempt(
         &mut self,
         ctx: &mut PathContext,
         obs: &mut dyn Observer,
-        ctl: &Controller,
-        target: f64,
+        ctl: &mut S,
     ) -> Result<(Vec<f64>, usize), NewtonFailure>;
 
     /// The external forces of the last attempt (all dofs) [N].
@@ -423,59 +510,60 @@ pub(super) trait Stepper {
     /// Throw the trial state of an attempt away (back to the committed state).
     fn discard(&mut self, ctx: &mut PathContext);
 
-    /// The step kind's own record of the state committed now (restored with a rejected
-    /// pair, [`Stepper::restore_mark`]).
-    fn mark(&self) -> f64 {
+    /// Keep the step kind's own record of the state committed now (restored with a
+    /// rejected pair, [`Stepper::restore_mark`]); returns what the pair keeps of it.
+    fn mark(&mut self) -> f64 {
         0.0
     }
 
     /// Restore the record [`Stepper::mark`] gave at a rejected pair's start.
-    fn restore_mark(&mut self, _mark: f64) {}
+    fn restore_mark(&mut self, _ctx: &mut PathContext, _mark: f64) {}
 
     /// Commit the first half of a pair (not reported: it is reported with the second).
     fn commit_half(&mut self, ctx: &mut PathContext);
 
-    /// Commit and report a kept increment (`ctl` already at its end) with internal forces
-    /// `f_int` [N] after `iterations`.
+    /// Commit and report a kept increment (`ctl` already past it) with internal forces
+    /// `f_int` [N] after `iterations`. Returns true if the step ends with it (a step whose
+    /// end is found on the way, as an arc-length step's).
     fn accept(
         &mut self,
         ctx: &mut PathContext,
         obs: &mut dyn Observer,
-        ctl: &Controller,
+        ctl: &mut S,
         f_int: Vec<f64>,
         iterations: usize,
-    ) -> Result<(), AnalysisError>;
+    ) -> Result<bool, AnalysisError>;
 
-    /// An attempt ending at `target` failed with `failure`: throw its trial state away and,
-    /// when `give_up` (no cut left), return the step's error. A step kind may also return
-    /// an error without `give_up` (a singular linear system is a mechanism, not a cut).
+    /// The attempt failed with `failure`: throw its trial state away and, when `give_up`
+    /// (no cut left), return the step's error. A step kind may also return an error
+    /// without `give_up` (a singular linear system is a mechanism, not a cut).
     fn failed(
         &mut self,
         ctx: &mut PathContext,
-        ctl: &Controller,
-        target: f64,
+        ctl: &S,
         failure: NewtonFailure,
         give_up: bool,
     ) -> Option<AnalysisError>;
 }
 
-/// Run a step: attempts from level 0 to 1 sized by `ctl`, each solved by `stepper`.
-pub(super) fn run(
-    ctl: &mut Controller,
-    stepper: &mut dyn Stepper,
+/// Run a step: attempts sized by `ctl` until it is finished or the stepper ends the step,
+/// each solved by `stepper`; failed attempts cut, one-way support switches solved again,
+/// pairs probed, kept or rejected, IMPL-EX errors retried.
+pub(super) fn run<S: Sizing>(
+    ctl: &mut S,
+    stepper: &mut dyn Stepper<S>,
     ctx: &mut PathContext,
     obs: &mut dyn Observer,
 ) -> Result<(), AnalysisError> {
     // Rounds of one-way support switches in the current increment.
     let mut rounds = 0;
     while !ctl.finished() {
-        let target = ctl.target();
-        let (f_int, iterations) = match stepper.attempt(ctx, obs, ctl, target) {
+        let (f_int, iterations) = match stepper.attempt(ctx, obs, ctl) {
             Ok(solved) => solved,
             Err(failure) => {
                 rounds = 0;
-                let give_up = ctl.cuts >= ctl.max_cuts;
-                if let Some(e) = stepper.failed(ctx, ctl, target, failure, give_up) {
+                let give_up = !ctl.can_cut();
+                if let Some(e) = stepper.failed(ctx, ctl, failure, give_up) {
                     return Err(e);
                 }
                 ctl.cut();
@@ -488,18 +576,15 @@ pub(super) fn run(
             ctx.timings.iterations += iterations;
             stepper.discard(ctx);
             ctx.one_way_resume(&trial);
-            ctl.retry = true;
+            ctl.again();
             continue;
         }
         let implex = stepper.implex_controlled();
-        let verdict = ctl.converged(target, iterations, ctx.u, &ctx.sys.u, |c| {
-            implex
-                && implex_retry(
-                    ctx.sys,
-                    ctx.timings,
-                    (target - c.level, c.nominal),
-                    &mut c.implex_last,
-                )
+        let verdict = ctl.converged(iterations, ctx.u, &ctx.sys.u, |c| {
+            implex && {
+                let sizes = c.implex_sizes();
+                implex_retry(ctx.sys, ctx.timings, sizes, c.implex_last())
+            }
         });
         match verdict {
             Verdict::Probed => {
@@ -507,9 +592,10 @@ pub(super) fn run(
                 // halves are rejected.
                 ctx.timings.iterations += iterations;
                 stepper.discard(ctx);
-                if let Pair::First(start) = &mut ctl.pair {
+                let mark = stepper.mark();
+                if let Pair::First(start) = ctl.pair_mut() {
                     start.saved = Some(ctx.sys.snapshot());
-                    start.mark = stepper.mark();
+                    start.mark = mark;
                 }
             }
             Verdict::FirstHalf => {
@@ -519,7 +605,7 @@ pub(super) fn run(
             Verdict::Rejected(start) => {
                 ctx.timings.iterations += iterations;
                 ctx.timings.increments_rejected += 1;
-                stepper.restore_mark(start.mark);
+                stepper.restore_mark(ctx, start.mark);
                 let saved = start.saved.expect("saved after the probe");
                 ctx.sys.restore(saved).map_err(AnalysisError::Mechanism)?;
                 stepper.discard(ctx);
@@ -531,11 +617,13 @@ pub(super) fn run(
             Verdict::Accepted { pair_error } => {
                 if let Some(e) = pair_error {
                     ctx.timings.increment_max_error = ctx.timings.increment_max_error.max(e);
-                    if ctl.tolerance.is_some_and(|tol| e > tol) {
+                    if ctl.tolerance().is_some_and(|tol| e > tol) {
                         ctx.timings.increments_over_tolerance += 1;
                     }
                 }
-                stepper.accept(ctx, obs, ctl, f_int, iterations)?;
+                if stepper.accept(ctx, obs, ctl, f_int, iterations)? {
+                    break;
+                }
             }
         }
     }
@@ -548,7 +636,9 @@ pub(super) fn run(
 /// (`[solver] increment_tolerance`) Δl is the length of a pair of arcs: solved once whole
 /// (the probe) and then as two arcs of Δl/2, kept if the rms difference of the
 /// displacements is within the tolerance of the rms change over the pair
-/// ([`ArcSizing::converged`]), and sized by that error as well as by the iterations.
+/// ([`ArcSizing::converged`]), and sized by that error as well as by the iterations. The
+/// step ends after `max_increments` kept increments, or earlier where its stepper finds
+/// its end (a target load factor or displacement reached).
 #[derive(Debug, Default)]
 pub(super) struct ArcSizing {
     /// Arc length of the next increment (None before the first sets it).
@@ -557,10 +647,14 @@ pub(super) struct ArcSizing {
     pub dl0: f64,
     /// Cuts since the last converged increment.
     pub cuts: usize,
+    /// Cuts allowed before the step fails.
+    max_cuts: usize,
     /// The arc length that failed first (the cuts' reference).
     failed_dl: Option<f64>,
     /// Arc length of the last converged increment.
     pub prev_dl: Option<f64>,
+    /// The arc length the current attempt was made with.
+    tried: Option<f64>,
     /// IMPL-EX error of the last attempt of this increment, if it was cut for it.
     pub implex_last: Option<f64>,
     /// Step-doubling tolerance (None: single arcs).
@@ -572,13 +666,20 @@ pub(super) struct ArcSizing {
     last_rejected: Option<f64>,
     /// Growth factor the last kept pair's error allows (applied with the iterations' one).
     pair_growth: Option<f64>,
+    /// Kept (reported) increments of this step.
+    pub increment: usize,
+    /// Kept increments after which the step ends.
+    max_increments: usize,
 }
 
 impl ArcSizing {
-    /// Arc-length sizing with the step-doubling tolerance `tolerance` (None: single arcs).
-    pub fn with_tolerance(tolerance: Option<f64>) -> Self {
+    /// Arc-length sizing of a step of at most `max_increments` increments with `max_cuts`
+    /// cuts allowed and the step-doubling tolerance `tolerance` (None: single arcs).
+    pub fn new(max_increments: usize, max_cuts: usize, tolerance: Option<f64>) -> Self {
         ArcSizing {
             tolerance,
+            max_cuts,
+            max_increments,
             ..ArcSizing::default()
         }
     }
@@ -592,18 +693,13 @@ impl ArcSizing {
         }
     }
 
-    /// Set the pair's (or single arc's) length from the first attempt's, `tried`.
-    pub fn set_first(&mut self, tried: Option<f64>) {
+    /// The attempt was made with the arc length `tried` (converged or not): it sets the
+    /// pair's (or single arc's) length if none is set yet.
+    pub fn attempted(&mut self, tried: Option<f64>) {
+        self.tried = tried;
         if self.dl.is_none() {
             self.dl = tried;
         }
-    }
-
-    /// Whether the IMPL-EX error of a converged attempt is to be checked: a single arc or
-    /// the second half of a pair (a probe is thrown away anyway and a first half is
-    /// checked with the second, as in [`Controller::converged`]).
-    pub fn checks_implex(&self) -> bool {
-        self.tolerance.is_none() || matches!(self.pair, Pair::Second(_))
     }
 
     /// History extrapolation factor (IMPL-EX cracking): ratio of the arc lengths.
@@ -614,25 +710,114 @@ impl ArcSizing {
         }
     }
 
-    /// A converged arc of a pair (with a tolerance; outside pairs always
-    /// `Accepted { pair_error: None }`): `u` the displacements it reached [m], `committed_u`
-    /// the committed ones [m] and `lambda` the committed load factor [-].
-    /// - the probe: kept to compare with the halves ([`Verdict::Probed`], the caller throws
-    ///   its state away and sets [`PairStart::saved`]);
+    /// A converged attempt is kept; `tried` is the arc length it was attempted with.
+    fn accept(&mut self, tried: Option<f64>) {
+        self.prev_dl = tried.or(self.dl);
+        if self.dl0 == 0.0 {
+            self.dl0 = self.dl.expect("set by the first increment");
+        }
+        self.cuts = 0;
+    }
+
+    /// A kept increment (a single arc, or the second half of a pair) that `implex_over`
+    /// does not send back: accepted with the pair's relative error `pair_error`; else the
+    /// arc is halved (not counted against the cuts) and a pair starts again from the point
+    /// reached (its first half stays committed).
+    fn implex_or_accept(
+        &mut self,
+        implex_over: impl FnOnce(&mut Self) -> bool,
+        pair_error: Option<f64>,
+    ) -> Verdict {
+        if implex_over(self) {
+            if self.dl0 == 0.0 {
+                self.dl0 = self.dl.expect("set by the first increment");
+            }
+            self.dl = self.dl.map(|l| 0.5 * l);
+            self.pair = Pair::Probe;
+            return Verdict::ImplexRetry;
+        }
+        self.accept(self.tried);
+        self.increment += 1;
+        Verdict::Accepted { pair_error }
+    }
+
+    /// Step-size adaptation after a kept increment of `iterations`:
+    /// Δl ← Δl √(desired/N), bounded to [½, 2] per increment and to `max_growth` × the
+    /// first arc length; after a kept pair, by the smaller of that and the factor its error
+    /// allows ([`PairStart::growth`]).
+    pub fn grow(&mut self, desired: usize, iterations: usize, max_growth: f64) {
+        let ratio = (desired as f64 / iterations.max(1) as f64)
+            .sqrt()
+            .clamp(0.5, 2.0);
+        let ratio = self.pair_growth.take().map_or(ratio, |g| ratio.min(g));
+        let dl0 = self.dl0;
+        self.dl = self.dl.map(|l| (l * ratio).min(max_growth * dl0));
+    }
+}
+
+impl Sizing for ArcSizing {
+    fn finished(&self) -> bool {
+        self.increment >= self.max_increments
+    }
+
+    fn can_cut(&self) -> bool {
+        self.cuts < self.max_cuts && self.dl.is_some()
+    }
+
+    /// After a failed attempt: false if the step fails (no cut left, or no arc length yet),
+    /// else the next arc length. A material jump (a crack forming, the stress dropping at
+    /// fixed strain) leaves a gap in the path that a shorter arc cannot cross when the last
+    /// point sits just before it; a longer one steps over it: ½, 2, ¼, 4, … of the failed
+    /// length.
+    fn cut(&mut self) -> bool {
+        if !self.can_cut() {
+            return false;
+        }
+        // A failed arc of a pair: a new pair from the point reached.
+        self.pair = Pair::Probe;
+        if self.cuts == 0 {
+            self.failed_dl = self.dl;
+        }
+        self.cuts += 1;
+        let k = self.cuts.div_ceil(2) as i32;
+        let factor = if self.cuts % 2 == 1 {
+            0.5_f64.powi(k)
+        } else {
+            2.0_f64.powi(k)
+        };
+        self.dl = self.failed_dl.map(|l| factor * l);
+        true
+    }
+
+    fn again(&mut self) {}
+
+    /// A converged arc:
+    /// - without a tolerance: kept, unless its IMPL-EX error sends it back;
+    /// - the probe of a pair: kept to compare with the halves ([`Verdict::Probed`], [`run`]
+    ///   throws its state away and sets [`PairStart::saved`]);
     /// - the first half: committed, not reported ([`Verdict::FirstHalf`]);
     /// - the second half: kept if rms|u_probe − u| ≤ tol · rms|u − u_a| (step doubling, as
     ///   [`Controller::converged`]), or if the pair is already the shortest (1/1024 of the
     ///   first) or its error did not fall below [`MIN_REDUCTION`] of the last rejected
     ///   one's; else rejected with the pair length × 0.9 (tol · change/err)^½ (at least ¼).
-    pub fn converged(&mut self, u: &[f64], committed_u: &[f64], lambda: f64) -> Verdict {
+    ///   A kept second half is still sent back for its IMPL-EX error.
+    fn converged(
+        &mut self,
+        _iterations: usize,
+        u: &[f64],
+        committed_u: &[f64],
+        implex_over: impl FnOnce(&mut Self) -> bool,
+    ) -> Verdict {
         let Some(tol) = self.tolerance else {
-            return Verdict::Accepted { pair_error: None };
+            return self.implex_or_accept(implex_over, None);
         };
         match std::mem::take(&mut self.pair) {
             Pair::Probe => {
                 self.pair = Pair::First(Box::new(PairStart {
-                    level: lambda,
-                    end: lambda,
+                    // Levels are a load or displacement step's; an arc's pair keeps its
+                    // start through the stepper's mark.
+                    level: 0.0,
+                    end: 0.0,
                     probe: u.to_vec(),
                     start_u: committed_u.to_vec(),
                     saved: None,
@@ -662,6 +847,14 @@ impl ArcSizing {
                     self.pair_growth = None;
                     return Verdict::Rejected(s);
                 }
+                // Put back for the IMPL-EX check, which starts a new pair if it sends the
+                // half back.
+                self.pair = Pair::Second(s);
+                let verdict = self.implex_or_accept(implex_over, Some(error));
+                if matches!(verdict, Verdict::ImplexRetry) {
+                    return verdict;
+                }
+                self.pair = Pair::Probe;
                 if error <= tol {
                     self.last_rejected = None;
                     self.pair_growth = Some(growth);
@@ -674,78 +867,26 @@ impl ArcSizing {
                     // at 8× finer arcs crawled to its increment limit, 3,707 increments).
                     self.pair_growth = Some(growth.max(1.0));
                 }
-                Verdict::Accepted {
-                    pair_error: Some(error),
-                }
+                verdict
             }
         }
     }
 
-    /// After a converged attempt: true if it is to be retried for its IMPL-EX error (the
-    /// arc halved, not counted against the cuts).
-    pub fn implex_retry(&mut self, sys: &super::system::System, timings: &mut Timings) -> bool {
-        if !self.checks_implex() {
-            return false;
-        }
+    fn implex_sizes(&self) -> (f64, f64) {
         let dl = self.dl.unwrap_or(0.0);
-        let nominal = if self.dl0 == 0.0 { dl } else { self.dl0 };
-        if !implex_retry(sys, timings, (dl, nominal), &mut self.implex_last) {
-            return false;
-        }
-        if self.dl0 == 0.0 {
-            self.dl0 = self.dl.expect("set by the first increment");
-        }
-        self.dl = self.dl.map(|l| 0.5 * l);
-        // A pair retried: from the level reached (its first half stays committed).
-        self.pair = Pair::Probe;
-        true
+        (dl, if self.dl0 == 0.0 { dl } else { self.dl0 })
     }
 
-    /// A converged increment is kept; `tried` is the arc length it was attempted with.
-    pub fn accept(&mut self, tried: Option<f64>) {
-        self.prev_dl = tried.or(self.dl);
-        if self.dl0 == 0.0 {
-            self.dl0 = self.dl.expect("set by the first increment");
-        }
-        self.cuts = 0;
+    fn implex_last(&mut self) -> &mut Option<f64> {
+        &mut self.implex_last
     }
 
-    /// Step-size adaptation after a kept increment of `iterations`:
-    /// Δl ← Δl √(desired/N), bounded to [½, 2] per increment and to `max_growth` × the
-    /// first arc length; after a kept pair, by the smaller of that and the factor its error
-    /// allows ([`PairStart::growth`]).
-    pub fn grow(&mut self, desired: usize, iterations: usize, max_growth: f64) {
-        let ratio = (desired as f64 / iterations.max(1) as f64)
-            .sqrt()
-            .clamp(0.5, 2.0);
-        let ratio = self.pair_growth.take().map_or(ratio, |g| ratio.min(g));
-        let dl0 = self.dl0;
-        self.dl = self.dl.map(|l| (l * ratio).min(max_growth * dl0));
+    fn pair_mut(&mut self) -> &mut Pair {
+        &mut self.pair
     }
 
-    /// After a failed attempt: false if the step fails (no cut left, or no arc length yet),
-    /// else the next arc length. A material jump (a crack forming, the stress dropping at
-    /// fixed strain) leaves a gap in the path that a shorter arc cannot cross when the last
-    /// point sits just before it; a longer one steps over it: ½, 2, ¼, 4, … of the failed
-    /// length.
-    pub fn cut(&mut self, max_cuts: usize) -> bool {
-        if self.cuts >= max_cuts || self.dl.is_none() {
-            return false;
-        }
-        // A failed arc of a pair: a new pair from the point reached.
-        self.pair = Pair::Probe;
-        if self.cuts == 0 {
-            self.failed_dl = self.dl;
-        }
-        self.cuts += 1;
-        let k = self.cuts.div_ceil(2) as i32;
-        let factor = if self.cuts % 2 == 1 {
-            0.5_f64.powi(k)
-        } else {
-            2.0_f64.powi(k)
-        };
-        self.dl = self.failed_dl.map(|l| factor * l);
-        true
+    fn tolerance(&self) -> Option<f64> {
+        self.tolerance
     }
 }
 
@@ -777,7 +918,7 @@ mod tests {
                 ctl.cut();
                 continue;
             };
-            match ctl.converged(target, iterations, &u, &committed, |_| false) {
+            match ctl.converged(iterations, &u, &committed, |_| false) {
                 Verdict::Probed => saved.push(committed.clone()),
                 Verdict::FirstHalf => {
                     sizes.push(target - level);
@@ -914,9 +1055,9 @@ mod tests {
         let (mut kept, mut errors, mut rejected, mut reported) = (Vec::new(), Vec::new(), 0, 0);
         while reported < reports {
             let arc = sizing.attempt_length().unwrap_or(first);
-            sizing.set_first(Some(arc));
+            sizing.attempted(Some(arc));
             let u = attempt(&committed, arc);
-            match sizing.converged(&u, &committed, 0.0) {
+            match Sizing::converged(sizing, 1, &u, &committed, |_| false) {
                 Verdict::Probed => saved = committed.clone(),
                 Verdict::FirstHalf => {
                     kept.push(arc);
@@ -929,7 +1070,6 @@ mod tests {
                 }
                 Verdict::ImplexRetry => unreachable!("no IMPL-EX control here"),
                 Verdict::Accepted { pair_error } => {
-                    sizing.accept(Some(arc));
                     // One iteration where four are desired: the iterations allow ×2.
                     sizing.grow(4, 1, 1e9);
                     kept.push(arc);
@@ -947,7 +1087,7 @@ mod tests {
         // u moves along a straight line: whole and halves end at the same point, the pair
         // error is 0, every pair is kept and the next is twice as long (the iterations
         // allow ×2 too): pairs of 1, 2, 4 → arcs 0.5, 0.5, 1, 1, 2, 2.
-        let mut sizing = ArcSizing::with_tolerance(Some(0.05));
+        let mut sizing = ArcSizing::new(usize::MAX, 8, Some(0.05));
         let line = |u: &[f64], l: f64| vec![u[0] + 0.6 * l, u[1] + 0.8 * l];
         let (u, kept, errors, rejected) = drive_arcs(&mut sizing, vec![0.0, 0.0], 1.0, 3, line);
         assert_eq!(rejected, 0);
@@ -969,7 +1109,7 @@ mod tests {
         // l ≈ 4 tol = 0.08 and every kept pair's error is within the tolerance (the
         // shortest pair, 1/1024 of the first, is not reached).
         let tol = 0.02;
-        let mut sizing = ArcSizing::with_tolerance(Some(tol));
+        let mut sizing = ArcSizing::new(usize::MAX, 8, Some(tol));
         let euler = |u: &[f64], l: f64| {
             let r = (u[0] * u[0] + u[1] * u[1]).sqrt();
             vec![u[0] - l * u[1] / r, u[1] + l * u[0] / r]

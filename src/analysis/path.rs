@@ -7,8 +7,7 @@ use super::context::PathContext;
 use super::driver::{check_stop, note_limit_point, AnalysisError, Observer, Snapshot};
 use super::failure::{report, FailedAt, NewtonFailure};
 use super::increments::{
-    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, Pair, PairNorm,
-    Verdict,
+    self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm, Sizing,
 };
 use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
 use super::system::{Assembled, System};
@@ -257,14 +256,14 @@ struct DisplacementStepper {
     v0: f64,
 }
 
-impl increments::Stepper for DisplacementStepper {
+impl increments::Stepper<Controller> for DisplacementStepper {
     fn attempt(
         &mut self,
         ctx: &mut PathContext,
         _obs: &mut dyn Observer,
-        sizing: &Controller,
-        target: f64,
+        sizing: &mut Controller,
     ) -> Result<(Vec<f64>, usize), NewtonFailure> {
+        let target = sizing.target();
         let shift = (self.value - self.v0) * target;
         // History extrapolation (IMPL-EX cracking) relative to the last increment of this step.
         ctx.sys.time.extrapolation = sizing.extrapolation(target);
@@ -294,10 +293,10 @@ impl increments::Stepper for DisplacementStepper {
         &mut self,
         ctx: &mut PathContext,
         obs: &mut dyn Observer,
-        sizing: &Controller,
+        sizing: &mut Controller,
         f_int: Vec<f64>,
         iterations: usize,
-    ) -> Result<(), AnalysisError> {
+    ) -> Result<bool, AnalysisError> {
         let u = ctx.u.clone();
         ctx.sys.commit(&u);
         let force: f64 = self.ctl.iter().map(|k| f_int[k.c] - self.f_ext[k.c]).sum();
@@ -311,14 +310,14 @@ impl increments::Stepper for DisplacementStepper {
             iterations,
             None,
             Some(force),
-        )
+        )?;
+        Ok(false)
     }
 
     fn failed(
         &mut self,
         ctx: &mut PathContext,
         sizing: &Controller,
-        target: f64,
         failure: NewtonFailure,
         give_up: bool,
     ) -> Option<AnalysisError> {
@@ -328,7 +327,7 @@ impl increments::Stepper for DisplacementStepper {
                 ctx,
                 self.si,
                 sizing.increment + 1,
-                target,
+                sizing.target(),
                 sizing.cuts,
                 &failure,
             )
@@ -646,7 +645,8 @@ struct ArcIncrement {
     iterations: usize,
 }
 
-// long: the arc-length loop keeps its own arc, pair and one-way state (its end is found on the way, so it is no `increments::Stepper`); sizing is `ArcSizing`, the arc itself `arc_increment`
+/// Run one arc-length step: arcs sized by [`ArcSizing`] and driven by the increment
+/// controller ([`increments::run`]), each solved by [`arc_increment`].
 fn arc_length_step(
     ctx: &mut PathContext,
     si: usize,
@@ -657,163 +657,201 @@ fn arc_length_step(
     let n_dofs = ctx.sys.model.n_dofs();
     let f_base = external_forces(n_dofs, ctx.cases, &held);
     let q_full = external_forces(n_dofs, ctx.cases, &a.reference);
-    let max_cuts = ctx.sys.model.controls.max_cuts;
-    let mut lambda = 0.0;
     // Nonlinear materials: pairs of arcs with `[solver] increment_tolerance`.
     let tolerance = (!ctx.sys.linear)
         .then_some(ctx.sys.model.controls.increment_tolerance)
         .flatten();
-    let mut sizing = ArcSizing::with_tolerance(tolerance);
-    let mut du_prev: Option<Vec<f64>> = None;
-    // The load factor and direction at the start of the current pair (restored when its
-    // halves are rejected) and at the last reported increment (where a target factor is
-    // crossed from).
-    let mut pair_start: (f64, Option<Vec<f64>>) = (0.0, None);
-    let mut reported_lambda = 0.0;
-    let mut increment = 0;
-    // Rounds of one-way support switches in the current increment.
-    let mut rounds = 0;
+    let mut sizing = ArcSizing::new(a.max_increments, ctx.sys.model.controls.max_cuts, tolerance);
     let start_disp = a
         .target_displacement
         .map(|(n, d, _)| ctx.sys.u[2 * n + d.index()]);
-    let factors_at = |lam: f64| -> Vec<f64> {
-        held.iter()
-            .zip(&a.reference)
-            .map(|(h, r)| h + lam * r)
-            .collect()
+    let mut stepper = ArcStepper {
+        si,
+        a,
+        held,
+        f_base,
+        q_full,
+        lambda: 0.0,
+        reported_lambda: 0.0,
+        du_prev: None,
+        pair_start_du: None,
+        start_disp,
+        last: None,
+        f_try: Vec::new(),
     };
-    while increment < a.max_increments {
+    increments::run(&mut sizing, &mut stepper, ctx, obs)
+}
+
+/// What an arc-length step supplies to the increment controller: the arc solved from the
+/// committed load factor, and the end found on the way (a target factor or displacement).
+struct ArcStepper<'a> {
+    /// Step index.
+    si: usize,
+    /// The step's control.
+    a: &'a ArcLengthControl,
+    /// The load-case factors held at the step's start [-].
+    held: Vec<f64>,
+    /// External forces held over the step [N].
+    f_base: Vec<f64>,
+    /// The reference load at factor 1 (all dofs) [N].
+    q_full: Vec<f64>,
+    /// Committed load factor of the step [-].
+    lambda: f64,
+    /// Load factor at the last reported increment (where a target factor is crossed
+    /// from) [-].
+    reported_lambda: f64,
+    /// The last committed increment's displacement change (free equations) [m].
+    du_prev: Option<Vec<f64>>,
+    /// `du_prev` at the start of the current pair (restored when its halves are rejected).
+    pair_start_du: Option<Vec<f64>>,
+    /// The start value of the target displacement's dof [m].
+    start_disp: Option<f64>,
+    /// The last converged arc: load factor change [-] and displacement change [m].
+    last: Option<(f64, Vec<f64>)>,
+    /// External forces at the last converged arc's end (all dofs) [N].
+    f_try: Vec<f64>,
+}
+
+impl ArcStepper<'_> {
+    /// The load-case factors at the step's load factor `lambda` [-].
+    fn factors_at(&self, lambda: f64) -> Vec<f64> {
+        self.held
+            .iter()
+            .zip(&self.a.reference)
+            .map(|(h, r)| h + lambda * r)
+            .collect()
+    }
+}
+
+impl increments::Stepper<ArcSizing> for ArcStepper<'_> {
+    fn attempt(
+        &mut self,
+        ctx: &mut PathContext,
+        _obs: &mut dyn Observer,
+        sizing: &mut ArcSizing,
+    ) -> Result<(Vec<f64>, usize), NewtonFailure> {
         // History extrapolation (IMPL-EX cracking): ratio of arc lengths.
         ctx.sys.time.extrapolation = sizing.extrapolation();
         let mut dl_try = sizing.attempt_length();
         // On the equations free now (one-way supports hold and let go of theirs).
-        let q_free = ctx.sys.to_free(&q_full);
-        let loads = (f_base.as_slice(), q_full.as_slice(), q_free.as_slice());
-        let solved = arc_increment(ctx, loads, lambda, &mut dl_try, a, &du_prev);
+        let q_free = ctx.sys.to_free(&self.q_full);
+        let loads = (
+            self.f_base.as_slice(),
+            self.q_full.as_slice(),
+            q_free.as_slice(),
+        );
+        let solved = arc_increment(ctx, loads, self.lambda, &mut dl_try, self.a, &self.du_prev);
         // The first attempt sets the arc length, converged or not (a failed first arc is
         // cut from it).
-        sizing.set_first(dl_try);
-        match solved {
-            Ok(inc) if sizing.implex_retry(ctx.sys, ctx.timings) => {
-                // The IMPL-EX error is above the tolerance: the arc retried at half its
-                // length (not counted against the cuts).
-                ctx.timings.iterations += inc.iterations;
-                ctx.back_to_committed();
-            }
-            Ok(inc) => {
-                // A one-way support lifted off or touched down: the same arc again, from
-                // its start, with the new statuses.
-                let f_try = external_forces_along(&f_base, &q_full, lambda + inc.d_lambda);
-                if let Some(trial) = ctx.one_way_check(&inc.f_int, &f_try, &mut rounds) {
-                    ctx.timings.iterations += inc.iterations;
-                    ctx.back_to_committed();
-                    ctx.one_way_resume(&trial);
-                    continue;
-                }
-                let verdict = sizing.converged(ctx.u, &ctx.sys.u, lambda);
-                match verdict {
-                    Verdict::Probed => {
-                        // Thrown away; the committed state kept in case the halves are
-                        // rejected.
-                        ctx.timings.iterations += inc.iterations;
-                        ctx.back_to_committed();
-                        if let Pair::First(start) = &mut sizing.pair {
-                            start.saved = Some(ctx.sys.snapshot());
-                        }
-                        pair_start = (lambda, du_prev.clone());
-                        continue;
-                    }
-                    Verdict::FirstHalf => {
-                        // Committed, reported with the second half.
-                        ctx.timings.iterations += inc.iterations;
-                        let u = ctx.u.clone();
-                        ctx.sys.commit(&u);
-                        lambda += inc.d_lambda;
-                        *ctx.factors = factors_at(lambda);
-                        du_prev = Some(inc.du);
-                        continue;
-                    }
-                    Verdict::Rejected(start) => {
-                        // Back to the pair's start with a shorter pair.
-                        ctx.timings.iterations += inc.iterations;
-                        ctx.timings.increments_rejected += 1;
-                        let saved = start.saved.expect("saved after the probe");
-                        ctx.sys.restore(saved).map_err(AnalysisError::Mechanism)?;
-                        ctx.back_to_committed();
-                        (lambda, du_prev) = (pair_start.0, pair_start.1.take());
-                        *ctx.factors = factors_at(lambda);
-                        continue;
-                    }
-                    Verdict::ImplexRetry => unreachable!("checked before the verdict"),
-                    Verdict::Accepted { pair_error } => {
-                        if let Some(e) = pair_error {
-                            ctx.timings.increment_max_error =
-                                ctx.timings.increment_max_error.max(e);
-                            if tolerance.is_some_and(|tol| e > tol) {
-                                ctx.timings.increments_over_tolerance += 1;
-                            }
-                        }
-                    }
-                }
-                sizing.accept(dl_try);
-                let mut lam_new = lambda + inc.d_lambda;
-                let mut f_int = inc.f_int;
-                let mut iterations = inc.iterations;
-                // Land on the target factor by a load-controlled correction if this increment
-                // crossed it on the way up (the arc-length point is kept if that fails).
-                let mut reached = false;
-                if let Some(t) = a.target_factor {
-                    if reported_lambda < t && lam_new >= t {
-                        reached = true;
-                        if let Some((fi, it)) = land_on_factor(ctx, &f_base, &q_full, t)? {
-                            f_int = fi;
-                            iterations += it;
-                            lam_new = t;
-                        }
-                    }
-                }
-                let u = ctx.u.clone();
-                ctx.sys.commit(&u);
-                lambda = lam_new;
-                reported_lambda = lambda;
-                increment += 1;
-                *ctx.factors = factors_at(lambda);
-                if let (Some((n, d, v)), Some(u0)) = (a.target_displacement, start_disp) {
-                    let x = ctx.sys.u[2 * n + d.index()];
-                    if (x - v) * (v - u0).signum() >= 0.0 {
-                        reached = true;
-                    }
-                }
-                let end = reached || increment >= a.max_increments;
-                let f_ext = external_forces_along(&f_base, &q_full, lambda);
-                ctx.report(
-                    obs,
-                    si,
-                    increment,
-                    end,
-                    &f_int,
-                    &f_ext,
-                    iterations,
-                    Some(lambda),
-                    None,
-                )?;
-                sizing.grow(a.desired_iterations, inc.iterations, a.max_growth);
-                du_prev = Some(inc.du);
-                if end {
-                    break;
-                }
-            }
-            Err(f) => {
-                rounds = 0;
-                ctx.back_to_committed();
-                let cuts = sizing.cuts;
-                if !sizing.cut(max_cuts) {
-                    return Err(not_converged(ctx, si, increment + 1, lambda, cuts, &f));
+        sizing.attempted(dl_try);
+        let inc = solved?;
+        self.f_try = external_forces_along(&self.f_base, &self.q_full, self.lambda + inc.d_lambda);
+        self.last = Some((inc.d_lambda, inc.du));
+        Ok((inc.f_int, inc.iterations))
+    }
+
+    fn external(&self) -> &[f64] {
+        &self.f_try
+    }
+
+    fn discard(&mut self, ctx: &mut PathContext) {
+        ctx.back_to_committed();
+    }
+
+    fn mark(&mut self) -> f64 {
+        self.pair_start_du = self.du_prev.clone();
+        self.lambda
+    }
+
+    fn restore_mark(&mut self, ctx: &mut PathContext, mark: f64) {
+        self.lambda = mark;
+        self.du_prev = self.pair_start_du.take();
+        *ctx.factors = self.factors_at(mark);
+    }
+
+    fn commit_half(&mut self, ctx: &mut PathContext) {
+        let u = ctx.u.clone();
+        ctx.sys.commit(&u);
+        let (d_lambda, du) = self.last.take().expect("a converged arc");
+        self.lambda += d_lambda;
+        *ctx.factors = self.factors_at(self.lambda);
+        self.du_prev = Some(du);
+    }
+
+    fn accept(
+        &mut self,
+        ctx: &mut PathContext,
+        obs: &mut dyn Observer,
+        sizing: &mut ArcSizing,
+        f_int: Vec<f64>,
+        iterations: usize,
+    ) -> Result<bool, AnalysisError> {
+        let (d_lambda, du) = self.last.take().expect("a converged arc");
+        let a = self.a;
+        let mut lam_new = self.lambda + d_lambda;
+        let mut f_int = f_int;
+        let mut reported_iterations = iterations;
+        // Land on the target factor by a load-controlled correction if this increment
+        // crossed it on the way up (the arc-length point is kept if that fails).
+        let mut reached = false;
+        if let Some(t) = a.target_factor {
+            if self.reported_lambda < t && lam_new >= t {
+                reached = true;
+                if let Some((fi, it)) = land_on_factor(ctx, &self.f_base, &self.q_full, t)? {
+                    f_int = fi;
+                    reported_iterations += it;
+                    lam_new = t;
                 }
             }
         }
+        let u = ctx.u.clone();
+        ctx.sys.commit(&u);
+        self.lambda = lam_new;
+        self.reported_lambda = lam_new;
+        *ctx.factors = self.factors_at(lam_new);
+        if let (Some((n, d, v)), Some(u0)) = (a.target_displacement, self.start_disp) {
+            let x = ctx.sys.u[2 * n + d.index()];
+            if (x - v) * (v - u0).signum() >= 0.0 {
+                reached = true;
+            }
+        }
+        let end = reached || sizing.finished();
+        let f_ext = external_forces_along(&self.f_base, &self.q_full, lam_new);
+        ctx.report(
+            obs,
+            self.si,
+            sizing.increment,
+            end,
+            &f_int,
+            &f_ext,
+            reported_iterations,
+            Some(lam_new),
+            None,
+        )?;
+        sizing.grow(a.desired_iterations, iterations, a.max_growth);
+        self.du_prev = Some(du);
+        Ok(end)
     }
-    Ok(())
+
+    fn failed(
+        &mut self,
+        ctx: &mut PathContext,
+        sizing: &ArcSizing,
+        failure: NewtonFailure,
+        give_up: bool,
+    ) -> Option<AnalysisError> {
+        ctx.back_to_committed();
+        give_up.then(|| {
+            not_converged(
+                ctx,
+                self.si,
+                sizing.increment + 1,
+                self.lambda,
+                sizing.cuts,
+                &failure,
+            )
+        })
+    }
 }
 
 /// Load-controlled correction from the arc-length point in `ctx.u` onto the load factor

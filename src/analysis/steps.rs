@@ -328,14 +328,14 @@ struct LoadStepper<'a> {
     f_ext: Vec<f64>,
 }
 
-impl increments::Stepper for LoadStepper<'_> {
+impl increments::Stepper<Controller> for LoadStepper<'_> {
     fn attempt(
         &mut self,
         ctx: &mut super::context::PathContext,
         obs: &mut dyn Observer,
-        ctl: &Controller,
-        target: f64,
+        ctl: &mut Controller,
     ) -> Result<(Vec<f64>, usize), NewtonFailure> {
+        let target = ctl.target();
         let step = self.step;
         self.lam = self
             .start
@@ -418,11 +418,11 @@ impl increments::Stepper for LoadStepper<'_> {
         discard_trial(ctx);
     }
 
-    fn mark(&self) -> f64 {
+    fn mark(&mut self) -> f64 {
         self.reached_clock
     }
 
-    fn restore_mark(&mut self, mark: f64) {
+    fn restore_mark(&mut self, _ctx: &mut super::context::PathContext, mark: f64) {
         self.reached_clock = mark;
     }
 
@@ -435,10 +435,10 @@ impl increments::Stepper for LoadStepper<'_> {
         &mut self,
         ctx: &mut super::context::PathContext,
         obs: &mut dyn Observer,
-        ctl: &Controller,
+        ctl: &mut Controller,
         f_int: Vec<f64>,
         iterations: usize,
-    ) -> Result<(), AnalysisError> {
+    ) -> Result<bool, AnalysisError> {
         let si = self.si;
         ctx.sys.commit(ctx.u);
         *ctx.factors = std::mem::take(&mut self.lam);
@@ -473,14 +473,14 @@ impl increments::Stepper for LoadStepper<'_> {
             control_force: None,
         })?;
         ctx.timings.output_s += t.elapsed().as_secs_f64();
-        check_stop(obs, si, ctl.increment, end_of_step)
+        check_stop(obs, si, ctl.increment, end_of_step)?;
+        Ok(false)
     }
 
     fn failed(
         &mut self,
         ctx: &mut super::context::PathContext,
         ctl: &Controller,
-        target: f64,
         failure: NewtonFailure,
         give_up: bool,
     ) -> Option<AnalysisError> {
@@ -497,7 +497,7 @@ impl increments::Stepper for LoadStepper<'_> {
                 FailedAt {
                     step: self.si,
                     increment: ctl.increment + 1,
-                    level: target,
+                    level: ctl.target(),
                     cuts: ctl.cuts,
                     factors: ctx.factors,
                     negative_pivots: ctx.solver.negative_pivots,
