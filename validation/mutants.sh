@@ -34,7 +34,7 @@ MODULES=(
     "steel|src/materials/steel.rs|properties|test(/^materials::steel::/) | binary(properties)"
     "friction|src/prestress/friction.rs|prestress bonded_losses|test(/^prestress::/) | binary(prestress) | binary(bonded_losses)"
     "interface|src/elements/interface.rs|joints|test(/^elements::interface::/) | binary(joints)"
-    "tendon|src/elements/tendon.rs|tendons|test(/^elements::tendon::/) | binary(tendons)"
+    "tendon|src/elements/tendon.rs|tendons properties|test(/^elements::tendon::/) | binary(tendons) | binary(properties)"
     "thermal|src/model/thermal.rs|thermal|test(/^model::thermal::/) | binary(thermal)"
 )
 

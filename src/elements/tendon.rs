@@ -1078,6 +1078,116 @@ mod tests {
         }
     }
 
+    /// A V-shaped tendon with spans of unequal length (2.04 m and 4.02 m) pulled at one
+    /// anchor so that its deviator slips: the condensed tangent D (I − C_a (G D C_a)⁻¹ G D)
+    /// against central differences of the forces. Equal spans (the capstan test's V) make
+    /// D a multiple of I, where a tangent built with D⁻¹ in place of D would agree (found by
+    /// mutation testing). Tolerance 1e-6 of the largest entry, as the draped test.
+    #[test]
+    fn tangent_at_a_slipping_deviator_between_unequal_spans_matches_finite_differences() {
+        let pts = vec![[0.0, 0.0], [2.0, -0.4], [6.0, 0.0]];
+        let t = ExternalTendon::new(
+            &pts,
+            AP,
+            EP,
+            S0,
+            TendonLaw::Elastic,
+            DeviatorMode::Friction { mu: 0.25 },
+        )
+        .unwrap();
+        let mut u = zeros(3);
+        u[2][0] = 3e-3;
+        let c = t.initial_state();
+        let r = t.response(&u, &c);
+        assert!(r.state.slipping[0] != 0, "{:?}", r.state);
+        let e = fd_check(&t, &u, &c, 1e-7);
+        assert!(e < 1e-6, "{e}");
+    }
+
+    /// Frictionless tendon with different thermal strains per span and no displacement:
+    /// one force A_p E_p (ε0 − ᾱΔT) with the length-weighted mean ᾱΔT = Σ ε_T,i L_i / Σ L_i
+    /// written out here (spans 2.4, 4.0 and 1.6 m; ε0 = σ0/E_p). Tolerance 1e-12 rel
+    /// (round-off).
+    #[test]
+    fn frictionless_tendon_takes_the_length_weighted_mean_thermal_strain() {
+        let pts = vec![[0.0, 0.0], [2.4, 0.0], [6.4, 0.0], [8.0, 0.0]];
+        let mut t = ExternalTendon::new(
+            &pts,
+            AP,
+            EP,
+            S0,
+            TendonLaw::Elastic,
+            DeviatorMode::Frictionless,
+        )
+        .unwrap();
+        t.set_thermal_strains(&[1e-4, 3e-4, -2e-4]);
+        let mean = (1e-4 * 2.4 + 3e-4 * 4.0 - 2e-4 * 1.6) / 8.0;
+        let expect = AP * EP * (S0 / EP - mean);
+        let r = t.response(&zeros(4), &t.initial_state());
+        for n in r.state.forces() {
+            assert!((n - expect).abs() < 1e-12 * expect, "{n} vs {expect}");
+        }
+    }
+
+    /// The accessors give back what the constructors were given, and a deviation angle per
+    /// deviator is required, each a number ≥ 0.
+    #[test]
+    fn accessors_and_deviation_angle_checks() {
+        let t = ExternalTendon::new(
+            &draped(),
+            AP,
+            EP,
+            S0,
+            TendonLaw::Elastic,
+            DeviatorMode::Held,
+        )
+        .unwrap();
+        assert_eq!(t.modulus(), EP);
+        assert_eq!(t.area(), AP);
+        assert_eq!(t.initial_stresses(), &[S0, S0, S0]);
+        let spans = vec![1000e6, 990e6, 980e6];
+        let t = t.with_span_initial_stresses(spans.clone()).unwrap();
+        assert_eq!(t.initial_stresses(), spans.as_slice());
+        for bad in [
+            vec![0.1],
+            vec![0.1, -0.1],
+            vec![f64::NAN, 0.1],
+            vec![-0.1, 0.1],
+        ] {
+            assert!(
+                t.clone().with_deviation_angles(bad.clone()).is_err(),
+                "{bad:?}"
+            );
+        }
+        let t = t.with_deviation_angles(vec![0.1, 0.2]).unwrap();
+        assert_eq!(t.deviation_angles(), &[0.1, 0.2]);
+    }
+
+    /// Through the element interface the tendon says whether its tangent is symmetric: a
+    /// frictionless tendon always, a friction deviator slipping with a capstan ratio
+    /// e^{μΔα} ≠ 1 not (the solver then takes the unsymmetric route).
+    #[test]
+    fn the_element_interface_reports_an_unsymmetric_tangent_only_when_a_deviator_slips() {
+        use crate::elements::{ElementResponse, Response};
+        let pts = vec![[0.0, 0.0], [2.0, -0.4], [6.0, 0.0]];
+        let mut u = [0.0; 6];
+        u[4] = 3e-3;
+        for (mode, symmetric) in [
+            (DeviatorMode::Frictionless, true),
+            (DeviatorMode::Friction { mu: 0.25 }, false),
+        ] {
+            let t = ExternalTendon::new(&pts, AP, EP, S0, TendonLaw::Elastic, mode).unwrap();
+            let (mut f, mut k, mut trial) = (vec![0.0; 6], vec![0.0; 36], None);
+            let into = Response {
+                f: &mut f,
+                k: Some(&mut k),
+            };
+            let got = ElementResponse::response(&t, &u, &t.initial_state(), &mut trial, into);
+            assert_eq!(got.unwrap(), symmetric, "{mode:?}");
+            assert!(trial.is_some());
+        }
+    }
+
     /// Plastic tendon: stress capped at 0.9 f_ptk (perfectly plastic) and the plastic strain
     /// is kept on unloading. Tolerance 1e-9 rel.
     #[test]
