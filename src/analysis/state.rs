@@ -267,8 +267,10 @@ pub(crate) mod layout {
         let span_time = SpanTime {
             sigma_initial: 1.0,
             eps0: 2.0,
-            relax_strain: 3.0,
-            relax_strain_trial: 4.0,
+            relax_strain: Staged {
+                committed: 3.0,
+                trial: 4.0,
+            },
             steel_strain: 5.0,
             hidden: vec![6.0],
             relax_drop: 7.0,
@@ -279,8 +281,10 @@ pub(crate) mod layout {
         let bar_time = BarPointTime {
             sigma_initial: 1.0,
             stress: 2.0,
-            relax_strain: 3.0,
-            relax_strain_trial: 4.0,
+            relax_strain: Staged {
+                committed: 3.0,
+                trial: 4.0,
+            },
             steel_strain: 5.0,
             chain: Some(chain.clone()),
             hidden: vec![6.0],
@@ -367,8 +371,7 @@ pub(crate) mod layout {
                         sign: -1.0,
                         seat: 7.0,
                         acting: true,
-                        touching: false,
-                        trial: false,
+                        touching: Staged::new(false),
                     }],
                 },
             }),
