@@ -65,7 +65,8 @@ impl System<'_> {
     }
 
     /// Book-keeping of a converged increment (before the trial bar outputs replace the
-    /// committed ones): the loss split and the relaxation chains.
+    /// committed ones): the loss split and the relaxation chains (the trial relaxation
+    /// strains are committed with the block, `BarBlock::commit`).
     pub(crate) fn commit_bonded_time(&mut self, dt: f64) {
         self.ensure_bar_records();
         for (rec, out) in self
@@ -89,7 +90,6 @@ impl System<'_> {
             }
             rec.steel_strain = steel;
             rec.stress = out.stress;
-            rec.relax_strain.commit();
             rec.relax_drop = 0.0;
         }
     }

@@ -99,17 +99,14 @@ impl System<'_> {
                 }
                 eps0.push(sp.eps0 - sp.relax_strain.trial);
             }
-            // The element computes with its copy; the family block keeps the one saved in
-            // checkpoints.
-            if let Some(el) = self.tendons[t].as_mut() {
-                el.set_initial_strains(&eps0);
-            }
+            // The strains in force: the element reads them from the block.
             self.families.tendons.initial_strains[t] = eps0;
         }
     }
 
     /// Book-keeping of a converged increment, called by [`System::commit`] before the trial
-    /// tendon states replace the committed ones: the loss split and the relaxation chains.
+    /// tendon states replace the committed ones: the loss split and the relaxation chains
+    /// (the trial relaxation strains are committed with the block, `TendonBlock::commit`).
     pub(crate) fn commit_time_dependent(&mut self) {
         let dt = self.time.dt();
         self.commit_bonded_time(dt);
@@ -134,7 +131,6 @@ impl System<'_> {
                     sp.hidden = c.step(&sp.hidden, dt, steel - sp.steel_strain).new_hidden;
                 }
                 sp.steel_strain = steel;
-                sp.relax_strain.commit();
                 sp.relax_drop = 0.0;
             }
         }
