@@ -57,7 +57,8 @@ impl StateBlock for Families {
     fn check_shape(&self, saved: &Self, model: &Model) -> Result<(), Mismatch> {
         self.continuum.check_shape(&saved.continuum, ())?;
         self.joints.check_shape(&saved.joints, ())?;
-        self.tendons.check_shape(&saved.tendons, model)?;
+        let nodes: Vec<usize> = model.tendons.iter().map(|t| t.nodes.len()).collect();
+        self.tendons.check_shape(&saved.tendons, &nodes)?;
         self.bars.check_shape(&saved.bars, ())
     }
 }
@@ -263,8 +264,8 @@ pub struct TendonBlock {
 }
 
 impl StateBlock for TendonBlock {
-    /// The model, whose tendons give the node counts.
-    type Shape<'a> = &'a Model;
+    /// The number of nodes of each tendon of the model.
+    type Shape<'a> = &'a [usize];
 
     /// Accept the trial span states and relaxation strains.
     fn commit(&mut self) {
@@ -282,15 +283,15 @@ impl StateBlock for TendonBlock {
 
     /// One entry per tendon of the model; a stressed tendon has one displacement per node,
     /// one initial strain, span state and time record per span.
-    fn check_shape(&self, saved: &Self, model: &Model) -> Result<(), Mismatch> {
-        let n = model.tendons.len();
+    fn check_shape(&self, saved: &Self, tendon_nodes: &[usize]) -> Result<(), Mismatch> {
+        let n = tendon_nodes.len();
         same_len("tendons", &saved.states, n)?;
         same_count("tendon displacements", saved.u0.len(), n)?;
         same_count("tendon strains", saved.initial_strains.len(), n)?;
         same_count("tendon records", saved.time.len(), n)?;
         for (t, state) in saved.states.committed.iter().enumerate() {
             let Some(state) = state else { continue };
-            let nodes = model.tendons[t].nodes.len();
+            let nodes = tendon_nodes[t];
             same_count("tendon nodes", saved.u0[t].len(), nodes)?;
             same_count("tendon spans", saved.initial_strains[t].len(), nodes - 1)?;
             same_count("tendon span states", state.spans.len(), nodes - 1)?;
@@ -382,4 +383,113 @@ pub struct BarOutput {
     pub stress: f64,
     /// Plastic strain [-].
     pub plastic_strain: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::state::layout::sample;
+
+    /// Every staged pair of every block, the relaxation strains included: (committed,
+    /// trial) values that tell whether a commit or revert reached them.
+    fn pairs(f: &Families) -> Vec<(String, String)> {
+        let d =
+            |c: &dyn std::fmt::Debug, t: &dyn std::fmt::Debug| (format!("{c:?}"), format!("{t:?}"));
+        let mut v = vec![
+            d(&f.continuum.points.committed, &f.continuum.points.trial),
+            d(&f.continuum.gauss.committed, &f.continuum.gauss.trial),
+            d(&f.joints.points.committed, &f.joints.points.trial),
+            d(&f.tendons.states.committed, &f.tendons.states.trial),
+            d(&f.bars.steel.committed, &f.bars.steel.trial),
+            d(&f.bars.out.committed, &f.bars.out.trial),
+        ];
+        for r in f.tendons.time.iter().flatten().flat_map(|r| &r.spans) {
+            v.push(d(&r.relax_strain.committed, &r.relax_strain.trial));
+        }
+        for r in f.bars.time.iter().flatten() {
+            v.push(d(&r.relax_strain.committed, &r.relax_strain.trial));
+        }
+        v
+    }
+
+    /// A state whose every trial copy differs from its committed one (the sample's
+    /// relaxation strains already do: committed 3, trial 4).
+    fn with_trials() -> Families {
+        let mut f = sample().families.into_owned();
+        f.continuum.points.trial[0] = PointState::Concrete(Box::default());
+        f.continuum.gauss.trial[0].stress[0] = 99.0;
+        f.joints.points.trial[0][0].slip = 99.0;
+        f.tendons.states.trial[0] = None;
+        f.bars.steel.trial[0].plastic_strain = 99.0;
+        f.bars.out.trial[0].stress = 99.0;
+        f.joints.held = vec![vec![true]];
+        f
+    }
+
+    /// Revert reaches every pair (trial = committed, as before) and releases the holds;
+    /// commit reaches every pair (committed = trial).
+    #[test]
+    fn commit_and_revert_reach_every_pair() {
+        let before = pairs(&with_trials());
+        assert!(before.iter().all(|(c, t)| c != t), "{before:?}");
+        let mut f = with_trials();
+        f.continuum.holds.frozen = true;
+        f.revert();
+        for ((c, t), (c0, _)) in pairs(&f).iter().zip(&before) {
+            assert_eq!((c, t), (c0, c0));
+        }
+        assert!(!f.continuum.holds.frozen && f.joints.held.is_empty());
+        let mut f = with_trials();
+        f.commit();
+        for ((c, t), (_, t0)) in pairs(&f).iter().zip(&before) {
+            assert_eq!((c, t), (t0, t0));
+        }
+        assert!(f.joints.held.is_empty());
+    }
+
+    /// A saved tendon block that does not fit the model's tendons is refused, naming what
+    /// differs; one that fits is accepted.
+    #[test]
+    fn tendon_sizes_are_checked() {
+        let now = sample().families.into_owned().tendons;
+        // The sample's one tendon: 2 nodes, 1 span.
+        assert!(now.check_shape(&now, &[2]).is_ok());
+        let e = now.check_shape(&now, &[2, 3]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 1 tendons, the model 2"),
+            "{e}"
+        );
+        let e = now.check_shape(&now, &[3]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 tendon nodes, the model 3"),
+            "{e}"
+        );
+        let mut saved = now.clone();
+        saved.initial_strains[0].push(0.0);
+        let e = now.check_shape(&saved, &[2]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 tendon spans, the model 1"),
+            "{e}"
+        );
+        let mut saved = now.clone();
+        saved.time[0].as_mut().unwrap().spans.clear();
+        let e = now.check_shape(&saved, &[2]).unwrap_err();
+        assert!(e.contains("0 tendon span records"), "{e}");
+    }
+
+    /// A continuum point whose kind of state differs from the model's is named.
+    #[test]
+    fn point_kinds_are_checked() {
+        let now = sample().families.into_owned().continuum;
+        let mut saved = now.clone();
+        saved.points.committed.swap(0, 1);
+        let e = now.check_shape(&saved, ()).unwrap_err();
+        assert!(e.starts_with("material point 1 has another kind"), "{e}");
+        saved.points.committed.pop();
+        let e = now.check_shape(&saved, ()).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 material points, the model 3"),
+            "{e}"
+        );
+    }
 }
