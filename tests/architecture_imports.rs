@@ -333,6 +333,38 @@ fn analysis_files_import_without_a_circle() {
     }
 }
 
+/// The output code (`src/results/`, `src/cli/`) reads the analysis state through the
+/// accessors of `analysis/committed.rs` (docs/architecture.md, "Analysis state"), not through
+/// the family blocks, their committed copies or the point offsets, whose layout is the
+/// analysis's own.
+#[test]
+fn results_read_the_state_through_accessors() {
+    let inner = [
+        ".families",
+        ".gp_offset",
+        ".bar_gps",
+        ".u_prev",
+        "system.u[",
+        "sys.u[",
+    ];
+    let mut bad = vec![];
+    for dir in ["src/results", "src/cli"] {
+        for f in rust_files(&manifest().join(dir)) {
+            let (code, _) = production_code(&std::fs::read_to_string(&f).unwrap());
+            for (i, line) in code.iter().enumerate() {
+                if let Some(w) = inner.iter().find(|w| line.contains(*w)) {
+                    bad.push(format!("{}:{}: `{w}`", f.display(), i + 1));
+                }
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "state read past the accessors of analysis/committed.rs:\n{}",
+        bad.join("\n")
+    );
+}
+
 /// A circle of the directed graph (as a path back to its start), if any.
 fn find_circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
     // Depth-first search; 1 = on the current path, 2 = done.

@@ -1,6 +1,7 @@
 //! Joint contact through the whole engine: two blocks pressed, pulled and sheared; the
 //! decompression moment of a segmental beam against beam theory; opening after it.
 
+use segfem::analysis::staged::StateBlock;
 use segfem::analysis::steps::{self, Observer, Snapshot};
 use segfem::results::joints::summarise;
 

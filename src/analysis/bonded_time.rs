@@ -48,7 +48,7 @@ impl System<'_> {
         self.ensure_bar_records();
         for rec in self.families.bars.time.iter_mut().flatten() {
             rec.relax_drop = 0.0;
-            rec.relax_strain_trial = rec.relax_strain;
+            rec.relax_strain.revert();
             let (Some(c), true) = (&rec.chain, dt > 0.0) else {
                 continue;
             };
@@ -60,12 +60,13 @@ impl System<'_> {
                 .sum();
             let mismatch = rec.stress - rec.hidden.iter().sum::<f64>();
             rec.relax_drop = drop;
-            rec.relax_strain_trial = rec.relax_strain + (drop + mismatch) / c.ep;
+            rec.relax_strain.trial = rec.relax_strain.committed + (drop + mismatch) / c.ep;
         }
     }
 
     /// Book-keeping of a converged increment (before the trial bar outputs replace the
-    /// committed ones): the loss split and the relaxation chains.
+    /// committed ones): the loss split and the relaxation chains (the trial relaxation
+    /// strains are committed with the block, `BarBlock::commit`).
     pub(crate) fn commit_bonded_time(&mut self, dt: f64) {
         self.ensure_bar_records();
         for (rec, out) in self
@@ -83,13 +84,12 @@ impl System<'_> {
             } else {
                 rec.loss_elastic += -d_sigma;
             }
-            let steel = out.strain + rec.relax_strain_trial;
+            let steel = out.strain + rec.relax_strain.trial;
             if let Some(c) = &rec.chain {
                 rec.hidden = c.step(&rec.hidden, dt, steel - rec.steel_strain).new_hidden;
             }
             rec.steel_strain = steel;
             rec.stress = out.stress;
-            rec.relax_strain = rec.relax_strain_trial;
             rec.relax_drop = 0.0;
         }
     }

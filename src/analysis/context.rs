@@ -66,14 +66,17 @@ impl PathContext<'_, '_> {
         self.timings.support_switches += 1;
         let mut next = st.one_way.clone();
         if self.sys.model.controls.verbose {
-            let off = which.iter().filter(|&&i| next.points[i].trial).count();
+            let off = which
+                .iter()
+                .filter(|&&i| next.points[i].touching.trial)
+                .count();
             eprintln!(
                 "    one-way supports: {off} points lift off, {} touch down: the increment again (round {rounds})",
                 which.len() - off
             );
         }
         next.switch(&which);
-        Some(next.points.iter().map(|p| p.trial).collect())
+        Some(next.points.iter().map(|p| p.touching.trial).collect())
     }
 
     /// Start the attempt again (after its trial state was thrown away) with the one-way
@@ -84,7 +87,7 @@ impl PathContext<'_, '_> {
             return;
         };
         for (p, &t) in st.one_way.points.iter_mut().zip(trial) {
-            p.trial = t;
+            p.touching.trial = t;
         }
         st.apply_contacts();
         st.one_way.seat(self.u);

@@ -109,7 +109,7 @@ fn lifted_supports(sys: &System) -> Option<String> {
     let mut per = vec![(0, 0); sys.model.supports.len()];
     for p in st.one_way.points.iter().filter(|p| p.acting) {
         per[p.support].1 += 1;
-        per[p.support].0 += usize::from(!p.trial);
+        per[p.support].0 += usize::from(!p.touching.trial);
     }
     let names: Vec<String> = per
         .iter()

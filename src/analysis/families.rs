@@ -1,22 +1,24 @@
 //! The analysis state, one block per element family. Each block keeps its committed/trial
 //! pairs in [`Staged`] values and its other state (stages, reference strains, time records)
-//! beside them; [`Families::commit`] and [`Families::revert`] act on all of them. The
-//! checkpoint saves these blocks as they are (serde), so adding a state field to a block
-//! adds it to the checkpoint; the layout test of `results::checkpoint` then asks for a new
-//! format version. One exception: the Gauss outputs of linear elastic points (stateless,
-//! a function of the displacements) are left out, and a restart recomputes them
-//! ([`ContinuumBlock`]).
+//! beside them, and says once, in its [`StateBlock`] implementation below its declaration,
+//! how they are committed, reverted and checked against the model when read back;
+//! [`Families`] calls the four blocks. The checkpoint saves these blocks as they are
+//! (serde), so adding a state field to a block adds it to the checkpoint; the layout test
+//! of `results::checkpoint` then asks for a new format version. One exception: the Gauss
+//! outputs of linear elastic points (stateless, a function of the displacements) are left
+//! out, and a restart recomputes them ([`ContinuumBlock`]).
 //!
 //! Not in the blocks: the model's topology (Gauss-point and bar-point offsets, element
 //! numbers), which `System::new` derives from the model.
 
-use super::staged::Staged;
-use super::tendon_time::{BarPointTime, TendonTime};
+use super::staged::{same_count, same_len, Mismatch, Staged, StateBlock};
+use super::tendon_time::{BarPointTime, SpanTime, TendonTime};
 use crate::elements::continuum::GaussOutput;
 use crate::elements::interface::InterfacePointState;
 use crate::elements::tendon::TendonState;
 use crate::materials::point::PointState;
 use crate::materials::steel::SteelState;
+use crate::model::Model;
 use serde::{Deserialize, Serialize};
 
 /// The state of every element family.
@@ -32,26 +34,32 @@ pub struct Families {
     pub bars: BarBlock,
 }
 
-impl Families {
+impl StateBlock for Families {
+    /// The model the blocks were built for.
+    type Shape<'a> = &'a Model;
+
     /// Accept the trial states of every family.
-    pub fn commit(&mut self) {
+    fn commit(&mut self) {
         self.continuum.commit();
         self.joints.commit();
-        self.tendons.states.commit();
-        self.bars.steel.commit();
-        self.bars.out.commit();
+        self.tendons.commit();
+        self.bars.commit();
     }
 
     /// Throw away the trial states of every family.
-    pub fn revert(&mut self) {
-        self.continuum.points.revert();
-        self.continuum.gauss.revert();
-        self.continuum.holds = Holds::default();
-        self.joints.points.revert();
-        self.joints.held.clear();
-        self.tendons.states.revert();
-        self.bars.steel.revert();
-        self.bars.out.revert();
+    fn revert(&mut self) {
+        self.continuum.revert();
+        self.joints.revert();
+        self.tendons.revert();
+        self.bars.revert();
+    }
+
+    fn check_shape(&self, saved: &Self, model: &Model) -> Result<(), Mismatch> {
+        self.continuum.check_shape(&saved.continuum, ())?;
+        self.joints.check_shape(&saved.joints, ())?;
+        let nodes: Vec<usize> = model.tendons.iter().map(|t| t.nodes.len()).collect();
+        self.tendons.check_shape(&saved.tendons, &nodes)?;
+        self.bars.check_shape(&saved.bars, ())
     }
 }
 
@@ -74,10 +82,12 @@ pub struct ContinuumBlock {
     pub holds: Holds,
 }
 
-impl ContinuumBlock {
+impl StateBlock for ContinuumBlock {
+    type Shape<'a> = ();
+
     /// Accept the trial states; the holds last one increment only, so the committed points
     /// end their increment ([`PointState::end_increment`]) when any was held.
-    pub fn commit(&mut self) {
+    fn commit(&mut self) {
         self.points.commit_parallel();
         self.gauss.commit_parallel();
         self.holds.latched.clear();
@@ -88,6 +98,33 @@ impl ContinuumBlock {
                 .iter_mut()
                 .for_each(PointState::end_increment);
         }
+    }
+
+    /// Back to the committed states; the holds are released.
+    fn revert(&mut self) {
+        self.points.revert();
+        self.gauss.revert();
+        self.holds = Holds::default();
+    }
+
+    /// As many points and outputs as the model, each point of the kind its material gives.
+    fn check_shape(&self, saved: &Self, (): ()) -> Result<(), Mismatch> {
+        same_len(
+            "material points",
+            &saved.points,
+            self.points.committed.len(),
+        )?;
+        same_len("Gauss outputs", &saved.gauss, self.gauss.committed.len())?;
+        if let Some(p) = (saved.points.committed.iter())
+            .zip(&self.points.committed)
+            .position(|(a, b)| std::mem::discriminant(a) != std::mem::discriminant(b))
+        {
+            return Err(format!(
+                "material point {} has another kind of state in the checkpoint than in the model: the model changed since the checkpoint was written",
+                p + 1
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -184,11 +221,29 @@ pub struct JointBlock {
     pub held: Vec<Vec<bool>>,
 }
 
-impl JointBlock {
+impl StateBlock for JointBlock {
+    type Shape<'a> = ();
+
     /// Accept the trial states and release the held statuses (they last one increment).
-    pub fn commit(&mut self) {
+    fn commit(&mut self) {
         self.points.commit();
         self.held.clear();
+    }
+
+    /// Back to the committed states; the held statuses are released.
+    fn revert(&mut self) {
+        self.points.revert();
+        self.held.clear();
+    }
+
+    /// As many joint elements as the model, each with its number of points.
+    fn check_shape(&self, saved: &Self, (): ()) -> Result<(), Mismatch> {
+        let now = &self.points.committed;
+        same_len("joint elements", &saved.points, now.len())?;
+        for (a, b) in saved.points.committed.iter().zip(now) {
+            same_count("joint points in an element", a.len(), b.len())?;
+        }
+        Ok(())
     }
 }
 
@@ -197,13 +252,65 @@ impl JointBlock {
 pub struct TendonBlock {
     /// Displacements of each tendon's nodes when it was stressed [m].
     pub u0: Vec<Vec<[f64; 2]>>,
-    /// Initial span strains in force (after relaxation) [-]: the tendon elements are
-    /// rebuilt from `u0` and these when a checkpoint is read.
+    /// Initial span strains in force (after relaxation) [-], one list per stressed tendon:
+    /// the only copy, which the element is given at each response
+    /// ([`crate::elements::tendon::InForce`]); set from the element's strains at stressing
+    /// and by the relaxation at the start of each time increment (`analysis::time`).
     pub initial_strains: Vec<Vec<f64>>,
     /// Span states.
     pub states: Staged<Vec<Option<TendonState>>>,
     /// Relaxation and loss records (see `analysis::time`).
     pub time: Vec<Option<TendonTime>>,
+}
+
+impl StateBlock for TendonBlock {
+    /// The number of nodes of each tendon of the model.
+    type Shape<'a> = &'a [usize];
+
+    /// Accept the trial span states and relaxation strains.
+    fn commit(&mut self) {
+        self.states.commit();
+        self.relaxation_spans()
+            .for_each(|s| s.relax_strain.commit());
+    }
+
+    /// Back to the committed span states and relaxation strains.
+    fn revert(&mut self) {
+        self.states.revert();
+        self.relaxation_spans()
+            .for_each(|s| s.relax_strain.revert());
+    }
+
+    /// One entry per tendon of the model; a stressed tendon has one displacement per node,
+    /// one initial strain, span state and time record per span.
+    fn check_shape(&self, saved: &Self, tendon_nodes: &[usize]) -> Result<(), Mismatch> {
+        let n = tendon_nodes.len();
+        same_len("tendons", &saved.states, n)?;
+        same_count("tendon displacements", saved.u0.len(), n)?;
+        same_count("tendon strains", saved.initial_strains.len(), n)?;
+        same_count("tendon records", saved.time.len(), n)?;
+        for (t, state) in saved.states.committed.iter().enumerate() {
+            let Some(state) = state else { continue };
+            let nodes = tendon_nodes[t];
+            same_count("tendon nodes", saved.u0[t].len(), nodes)?;
+            same_count("tendon spans", saved.initial_strains[t].len(), nodes - 1)?;
+            same_count("tendon span states", state.spans.len(), nodes - 1)?;
+            if let Some(rec) = &saved.time[t] {
+                same_count("tendon span records", rec.spans.len(), nodes - 1)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl TendonBlock {
+    /// The time records of every span of every tendon that has them.
+    fn relaxation_spans(&mut self) -> impl Iterator<Item = &mut SpanTime> {
+        self.time
+            .iter_mut()
+            .flatten()
+            .flat_map(|r| r.spans.iter_mut())
+    }
 }
 
 /// Embedded bar points (order of `System::bar_gps`) and bar stages (order of the bars).
@@ -222,6 +329,35 @@ pub struct BarBlock {
     /// Relaxation and loss records of the bonded-tendon points (None for plain bars and
     /// tendons not yet stressed; see `analysis::bonded_time`).
     pub time: Vec<Option<BarPointTime>>,
+}
+
+impl StateBlock for BarBlock {
+    type Shape<'a> = ();
+
+    /// Accept the trial steel states, outputs and relaxation strains.
+    fn commit(&mut self) {
+        self.steel.commit();
+        self.out.commit();
+        (self.time.iter_mut().flatten()).for_each(|r| r.relax_strain.commit());
+    }
+
+    /// Back to the committed steel states, outputs and relaxation strains.
+    fn revert(&mut self) {
+        self.steel.revert();
+        self.out.revert();
+        (self.time.iter_mut().flatten()).for_each(|r| r.relax_strain.revert());
+    }
+
+    /// As many bar points (states, outputs, reference strains, records) and bars as the
+    /// model.
+    fn check_shape(&self, saved: &Self, (): ()) -> Result<(), Mismatch> {
+        let n = self.steel.committed.len();
+        same_len("bar points", &saved.steel, n)?;
+        same_len("bar outputs", &saved.out, n)?;
+        same_count("bars", saved.phase.len(), self.phase.len())?;
+        same_count("bar strains", saved.eps_ref.len(), n)?;
+        same_count("bar records", saved.time.len(), n)
+    }
 }
 
 /// Stage of an embedded bar or bonded tendon.
@@ -247,4 +383,113 @@ pub struct BarOutput {
     pub stress: f64,
     /// Plastic strain [-].
     pub plastic_strain: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::state::layout::sample;
+
+    /// Every staged pair of every block, the relaxation strains included: (committed,
+    /// trial) values that tell whether a commit or revert reached them.
+    fn pairs(f: &Families) -> Vec<(String, String)> {
+        let d =
+            |c: &dyn std::fmt::Debug, t: &dyn std::fmt::Debug| (format!("{c:?}"), format!("{t:?}"));
+        let mut v = vec![
+            d(&f.continuum.points.committed, &f.continuum.points.trial),
+            d(&f.continuum.gauss.committed, &f.continuum.gauss.trial),
+            d(&f.joints.points.committed, &f.joints.points.trial),
+            d(&f.tendons.states.committed, &f.tendons.states.trial),
+            d(&f.bars.steel.committed, &f.bars.steel.trial),
+            d(&f.bars.out.committed, &f.bars.out.trial),
+        ];
+        for r in f.tendons.time.iter().flatten().flat_map(|r| &r.spans) {
+            v.push(d(&r.relax_strain.committed, &r.relax_strain.trial));
+        }
+        for r in f.bars.time.iter().flatten() {
+            v.push(d(&r.relax_strain.committed, &r.relax_strain.trial));
+        }
+        v
+    }
+
+    /// A state whose every trial copy differs from its committed one (the sample's
+    /// relaxation strains already do: committed 3, trial 4).
+    fn with_trials() -> Families {
+        let mut f = sample().families.into_owned();
+        f.continuum.points.trial[0] = PointState::Concrete(Box::default());
+        f.continuum.gauss.trial[0].stress[0] = 99.0;
+        f.joints.points.trial[0][0].slip = 99.0;
+        f.tendons.states.trial[0] = None;
+        f.bars.steel.trial[0].plastic_strain = 99.0;
+        f.bars.out.trial[0].stress = 99.0;
+        f.joints.held = vec![vec![true]];
+        f
+    }
+
+    /// Revert reaches every pair (trial = committed, as before) and releases the holds;
+    /// commit reaches every pair (committed = trial).
+    #[test]
+    fn commit_and_revert_reach_every_pair() {
+        let before = pairs(&with_trials());
+        assert!(before.iter().all(|(c, t)| c != t), "{before:?}");
+        let mut f = with_trials();
+        f.continuum.holds.frozen = true;
+        f.revert();
+        for ((c, t), (c0, _)) in pairs(&f).iter().zip(&before) {
+            assert_eq!((c, t), (c0, c0));
+        }
+        assert!(!f.continuum.holds.frozen && f.joints.held.is_empty());
+        let mut f = with_trials();
+        f.commit();
+        for ((c, t), (_, t0)) in pairs(&f).iter().zip(&before) {
+            assert_eq!((c, t), (t0, t0));
+        }
+        assert!(f.joints.held.is_empty());
+    }
+
+    /// A saved tendon block that does not fit the model's tendons is refused, naming what
+    /// differs; one that fits is accepted.
+    #[test]
+    fn tendon_sizes_are_checked() {
+        let now = sample().families.into_owned().tendons;
+        // The sample's one tendon: 2 nodes, 1 span.
+        assert!(now.check_shape(&now, &[2]).is_ok());
+        let e = now.check_shape(&now, &[2, 3]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 1 tendons, the model 2"),
+            "{e}"
+        );
+        let e = now.check_shape(&now, &[3]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 tendon nodes, the model 3"),
+            "{e}"
+        );
+        let mut saved = now.clone();
+        saved.initial_strains[0].push(0.0);
+        let e = now.check_shape(&saved, &[2]).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 tendon spans, the model 1"),
+            "{e}"
+        );
+        let mut saved = now.clone();
+        saved.time[0].as_mut().unwrap().spans.clear();
+        let e = now.check_shape(&saved, &[2]).unwrap_err();
+        assert!(e.contains("0 tendon span records"), "{e}");
+    }
+
+    /// A continuum point whose kind of state differs from the model's is named.
+    #[test]
+    fn point_kinds_are_checked() {
+        let now = sample().families.into_owned().continuum;
+        let mut saved = now.clone();
+        saved.points.committed.swap(0, 1);
+        let e = now.check_shape(&saved, ()).unwrap_err();
+        assert!(e.starts_with("material point 1 has another kind"), "{e}");
+        saved.points.committed.pop();
+        let e = now.check_shape(&saved, ()).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 2 material points, the model 3"),
+            "{e}"
+        );
+    }
 }

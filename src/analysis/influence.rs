@@ -5,6 +5,7 @@
 //! displacements plus the solution. Nothing is committed: the state after is the state
 //! before.
 
+use super::staged::StateBlock;
 use super::system::System;
 use crate::fem::dofs::CONSTRAINED;
 use crate::linalg::solver::SparseCholesky;

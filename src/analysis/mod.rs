@@ -2,6 +2,7 @@
 //! call is [`crate::linalg`]).
 
 pub mod bonded_time;
+pub mod committed;
 mod context;
 mod driver;
 pub mod failure;

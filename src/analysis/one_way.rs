@@ -9,6 +9,7 @@
 //! its converged state, as in a contact problem). The trial statuses are kept apart from the
 //! committed ones: a thrown-away attempt goes back to the committed statuses.
 
+use super::staged::Staged;
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::Model;
 
@@ -45,10 +46,10 @@ pub struct ContactPoint {
     pub seat: f64,
     /// Whether the support acts in the current stage and the node is on an active element.
     pub acting: bool,
-    /// Committed status: touching its seat (held).
-    pub touching: bool,
-    /// Trial status of the increment being solved.
-    pub trial: bool,
+    /// Status: touching its seat (held), committed and of the increment being solved (both
+    /// saved: the layout of checkpoint format 10).
+    #[serde(with = "super::staged::both")]
+    pub touching: Staged<bool>,
 }
 
 /// The contact points of all one-way supports (empty for a model without any).
@@ -80,8 +81,7 @@ impl OneWay {
                         sign: p.sign(),
                         seat: 0.0,
                         acting: false,
-                        touching: false,
-                        trial: false,
+                        touching: Staged::new(false),
                     });
                 }
             }
@@ -90,11 +90,9 @@ impl OneWay {
             let acts = st.support(p.support).active_in(step) && alive[p.node];
             if acts && !p.acting {
                 p.seat = u[p.dof];
-                p.touching = true;
-                p.trial = true;
+                p.touching = Staged::new(true);
             } else if !acts {
-                p.touching = false;
-                p.trial = false;
+                p.touching = Staged::new(false);
             }
             p.acting = acts;
         }
@@ -103,7 +101,7 @@ impl OneWay {
     /// The held equations: `base` (held for other reasons) and the touching points (trial).
     pub fn held(&self, base: &[bool]) -> Vec<bool> {
         let mut held = base.to_vec();
-        for p in self.points.iter().filter(|p| p.acting && p.trial) {
+        for p in self.points.iter().filter(|p| p.acting && p.touching.trial) {
             held[p.eq] = true;
         }
         held
@@ -118,7 +116,7 @@ impl OneWay {
         let scale = self
             .points
             .iter()
-            .filter(|p| p.acting && p.trial)
+            .filter(|p| p.acting && p.touching.trial)
             .map(|p| reaction(p).abs())
             .chain(f_ext.iter().map(|f| f.abs()))
             .fold(0.0_f64, f64::max);
@@ -127,7 +125,7 @@ impl OneWay {
             .enumerate()
             .filter(|(_, p)| p.acting)
             .filter(|(_, p)| {
-                if p.trial {
+                if p.touching.trial {
                     reaction(p) < -FORCE_TOLERANCE * scale
                 } else {
                     p.sign * (u[p.dof] - p.seat) < -GAP_TOLERANCE * size
@@ -140,7 +138,7 @@ impl OneWay {
     /// Switch the trial status of the points `which`.
     pub fn switch(&mut self, which: &[usize]) {
         for &i in which {
-            self.points[i].trial = !self.points[i].trial;
+            self.points[i].touching.trial = !self.points[i].touching.trial;
         }
     }
 
@@ -150,7 +148,7 @@ impl OneWay {
         for p in self
             .points
             .iter()
-            .filter(|p| p.acting && p.trial && !p.touching)
+            .filter(|p| p.acting && p.touching.trial && !p.touching.committed)
         {
             u[p.dof] = p.seat;
         }
@@ -158,17 +156,19 @@ impl OneWay {
 
     /// The trial statuses become the committed ones (a kept increment).
     pub fn commit(&mut self) {
-        self.points.iter_mut().for_each(|p| p.touching = p.trial);
+        self.points.iter_mut().for_each(|p| p.touching.commit());
     }
 
     /// Back to the committed statuses (a thrown-away attempt).
     pub fn revert(&mut self) {
-        self.points.iter_mut().for_each(|p| p.trial = p.touching);
+        self.points.iter_mut().for_each(|p| p.touching.revert());
     }
 
     /// Whether some trial status differs from the committed one.
     pub fn changed(&self) -> bool {
-        self.points.iter().any(|p| p.trial != p.touching)
+        self.points
+            .iter()
+            .any(|p| p.touching.trial != p.touching.committed)
     }
 
     /// Per support: (points lifted off, points acting) of the committed statuses.
@@ -176,7 +176,7 @@ impl OneWay {
         let mut out = vec![(0, 0); n_supports];
         for p in self.points.iter().filter(|p| p.acting) {
             out[p.support].1 += 1;
-            if !p.touching {
+            if !p.touching.committed {
                 out[p.support].0 += 1;
             }
         }
@@ -199,8 +199,7 @@ mod tests {
                 sign,
                 seat: 0.0,
                 acting: true,
-                touching,
-                trial: touching,
+                touching: Staged::new(touching),
             }],
         }
     }
@@ -250,10 +249,10 @@ mod tests {
         w.seat(&mut u);
         assert_eq!(u, [0.0, 0.25]);
         w.revert();
-        assert!(!w.changed() && !w.points[0].trial);
+        assert!(!w.changed() && !w.points[0].touching.trial);
         w.switch(&[0]);
         w.commit();
-        assert!(!w.changed() && w.points[0].touching);
+        assert!(!w.changed() && w.points[0].touching.committed);
         assert_eq!(w.lifted_per_support(1), [(0, 1)]);
     }
 }

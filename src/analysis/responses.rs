@@ -304,7 +304,7 @@ impl HostChunk<'_> {
             // Relaxation of a tendon's steel: a stress-free strain.
             let relax = bar_time[bc0 + i]
                 .as_ref()
-                .map_or(0.0, |r| r.relax_strain_trial);
+                .map_or(0.0, |r| r.relax_strain.trial);
             let stage = match bar_phase[b] {
                 BarPhase::Inactive => BarStage::Absent,
                 BarPhase::Locked => BarStage::Locked {

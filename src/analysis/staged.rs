@@ -3,7 +3,13 @@
 //! reverts it. The two copies never alias.
 //!
 //! Only the committed copy is saved (checkpoints are written between increments, where the
-//! trial copy equals it); reading one back sets both copies.
+//! trial copy equals it); reading one back sets both copies. The few pairs that format 10
+//! of the checkpoint saved with both copies (relaxation strains, one-way contact statuses)
+//! keep that layout through [`both`], so older checkpoints still read.
+//!
+//! A state block (one per element family, `analysis::families`) declares its staged pairs
+//! once, in its [`StateBlock`] implementation: commit, revert and the size check of a saved
+//! block against the model's all follow from it.
 
 use serde::{Deserialize, Serialize, Serializer};
 
@@ -58,6 +64,66 @@ impl<E: Clone + Send + Sync> Staged<Vec<E>> {
     }
 }
 
+/// A saved state that does not fit the model: what differs, in words ("the checkpoint has
+/// 3 tendons, the model 2").
+pub type Mismatch = String;
+
+/// A part of the analysis state with committed/trial pairs: a family block, the
+/// displacements, the construction stage. Implemented where the block is declared, so a new
+/// field is committed, reverted and size-checked next to its declaration.
+pub trait StateBlock {
+    /// The sizes (and kinds) the model gives this block, against which a saved block is
+    /// checked (e.g. the number of tendon nodes per tendon).
+    type Shape<'a>;
+
+    /// Accept the trial values (a converged increment).
+    fn commit(&mut self);
+
+    /// Throw the trial values away (a cut increment or a thrown-away attempt).
+    fn revert(&mut self);
+
+    /// Whether `saved` (read from a checkpoint) fits `self`, the block of the model as it
+    /// is built now, of shape `shape`. The error names what differs.
+    fn check_shape(&self, saved: &Self, shape: Self::Shape<'_>) -> Result<(), Mismatch>;
+}
+
+/// `Ok` when the saved count equals the model's, else the error naming `what`.
+pub fn same_count(what: &str, saved: usize, now: usize) -> Result<(), Mismatch> {
+    if saved == now {
+        Ok(())
+    } else {
+        Err(format!(
+            "the checkpoint has {saved} {what}, the model {now}: the model changed since the checkpoint was written"
+        ))
+    }
+}
+
+/// A list's committed and trial copies both as long as the model's (`now`).
+pub fn same_len<E>(what: &str, saved: &Staged<Vec<E>>, now: usize) -> Result<(), Mismatch> {
+    same_count(what, saved.committed.len(), now)?;
+    same_count(what, saved.trial.len(), now)
+}
+
+/// Serde of a [`Staged`] field saved with both copies, committed then trial (the layout of
+/// a pair of plain fields): `#[serde(with = "staged::both")]`.
+pub mod both {
+    use super::Staged;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Write the committed, then the trial copy.
+    pub fn serialize<T: Serialize, S: Serializer>(v: &Staged<T>, s: S) -> Result<S::Ok, S::Error> {
+        (&v.committed, &v.trial).serialize(s)
+    }
+
+    /// Read the committed, then the trial copy.
+    pub fn deserialize<'de, T: Deserialize<'de>, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Staged<T>, D::Error> {
+        let (committed, trial) = <(T, T)>::deserialize(d)?;
+        Ok(Staged { committed, trial })
+    }
+}
+
 impl<T: Clone> From<T> for Staged<T> {
     fn from(value: T) -> Self {
         Self::new(value)
@@ -105,6 +171,50 @@ mod tests {
         );
         s.revert();
         assert_eq!(s.trial, vec![5.0, 2.0]);
+    }
+
+    /// A pair saved with both copies is laid out as the two plain fields it replaced (the
+    /// bytes of a struct of two f64 fields), and reads back both copies.
+    #[test]
+    fn both_copies_as_two_fields() {
+        #[derive(Serialize, Deserialize, PartialEq, Debug)]
+        struct Pair {
+            #[serde(with = "both")]
+            r: Staged<f64>,
+        }
+        #[derive(Serialize)]
+        struct Plain {
+            r: f64,
+            r_trial: f64,
+        }
+        let p = Pair {
+            r: Staged {
+                committed: 1.5,
+                trial: -2.25,
+            },
+        };
+        let bytes = postcard::to_stdvec(&p).unwrap();
+        let plain = Plain {
+            r: 1.5,
+            r_trial: -2.25,
+        };
+        assert_eq!(bytes, postcard::to_stdvec(&plain).unwrap());
+        assert_eq!(postcard::from_bytes::<Pair>(&bytes).unwrap(), p);
+    }
+
+    /// The size checks name what differs and accept equal sizes.
+    #[test]
+    fn size_checks() {
+        assert!(same_count("tendons", 2, 2).is_ok());
+        let e = same_count("tendons", 3, 2).unwrap_err();
+        assert!(
+            e.starts_with("the checkpoint has 3 tendons, the model 2"),
+            "{e}"
+        );
+        let mut s = Staged::new(vec![0; 4]);
+        assert!(same_len("points", &s, 4).is_ok());
+        s.trial.pop();
+        assert!(same_len("points", &s, 4).is_err(), "a short trial copy");
     }
 
     /// Saved: the committed copy only; read back: both copies equal to it.

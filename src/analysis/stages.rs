@@ -11,6 +11,7 @@
 //! by zero, so the equation numbering and sparsity pattern stay those of the whole model.
 
 use super::one_way::OneWay;
+use super::staged::{same_count, Mismatch, StateBlock};
 use crate::fem::dofs::CONSTRAINED;
 use crate::linalg::pattern::LowerPattern;
 use crate::model::Model;
@@ -43,6 +44,59 @@ pub struct StageState {
     pub base_held: Vec<bool>,
     /// The contact points of the one-way supports and their statuses.
     pub one_way: OneWay,
+}
+
+/// What a [`StageState`] is checked against: the model and its numbers of equations and
+/// dofs.
+#[derive(Clone, Copy)]
+pub struct StageShape<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// Number of free equations.
+    pub n_eq: usize,
+    /// Number of dofs.
+    pub n_dofs: usize,
+}
+
+impl StateBlock for StageState {
+    type Shape<'a> = StageShape<'a>;
+
+    /// The trial statuses of the one-way supports become the committed ones (the rest of
+    /// the stage changes only between steps, [`StageState::enter`]).
+    fn commit(&mut self) {
+        self.one_way.commit();
+    }
+
+    /// Back to the committed statuses of the one-way supports, the held equations with
+    /// them.
+    fn revert(&mut self) {
+        self.revert_contacts();
+    }
+
+    /// One entry per element, joint element, equation and dof of the model, and one-way
+    /// contact points if (and only if) the model has one-way supports.
+    fn check_shape(&self, saved: &Self, shape: StageShape<'_>) -> Result<(), Mismatch> {
+        let StageShape {
+            model,
+            n_eq,
+            n_dofs,
+        } = shape;
+        let (n_el, n_if) = (model.elements.len(), model.interfaces.len());
+        same_count("staged elements", saved.element_active.len(), n_el)?;
+        same_count("staged element references", saved.element_ref.len(), n_el)?;
+        same_count("staged joint elements", saved.interface_active.len(), n_if)?;
+        same_count("staged joint references", saved.interface_ref.len(), n_if)?;
+        same_count("staged equations", saved.held.len(), n_eq)?;
+        same_count("staged releases", saved.release.len(), n_dofs)?;
+        same_count("staged base equations", saved.base_held.len(), n_eq)?;
+        let one_way = model.staging.has_one_way();
+        if saved.step.is_some() && one_way == saved.one_way.points.is_empty() {
+            return Err(
+                "the checkpoint and the model differ in their one-way supports: the model changed since the checkpoint was written".into(),
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Displacements [m] of `nodes` in `u`, interleaved.

@@ -8,10 +8,12 @@
 //! recomputed from the same matrix.
 
 use super::families::Families;
-use super::stages::StageState;
+use super::staged::{same_count, StateBlock};
+use super::stages::{StageShape, StageState};
 use super::system::System;
 use crate::materials::point::TimeContext;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// Where the step driver stands between two steps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,171 +36,71 @@ pub struct DriverState {
     pub limit_points: Vec<String>,
 }
 
-/// The committed state of a [`System`] (owned; read from a checkpoint): the displacements,
-/// the clock of the last increment and the family blocks as they are ([`Families`]).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct SystemState {
+/// The committed state of a [`System`]: the displacements, the clock of the last increment,
+/// the family blocks as they are ([`Families`]) and the construction stage. Declared once
+/// for both uses: borrowed from the system for writing ([`SystemStateRef`],
+/// [`System::state`]) and owned when read from a checkpoint or kept as a snapshot
+/// ([`SystemState`]); the two encode alike (a `Cow` is saved as what it holds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SavedState<'a> {
     /// Displacements (all dofs) [m].
-    pub u: Vec<f64>,
+    pub u: Cow<'a, [f64]>,
     /// Displacements before the last committed increment [m].
-    pub u_prev: Vec<f64>,
+    pub u_prev: Cow<'a, [f64]>,
     /// Time interval of the last increment [d].
     pub time: TimeContext,
     /// The element families' states.
-    pub families: Families,
+    pub families: Cow<'a, Families>,
     /// The construction stage reached (None: the model has no stages).
-    pub stages: Option<StageState>,
+    pub stages: Option<Cow<'a, StageState>>,
 }
 
-/// The committed state of a [`System`], borrowed for writing: the fields of
-/// [`SystemState`] in the same order (a test reads one back as the other).
-#[derive(Serialize)]
-pub struct SystemStateRef<'a> {
-    u: &'a [f64],
-    u_prev: &'a [f64],
-    time: TimeContext,
-    families: &'a Families,
-    stages: Option<&'a StageState>,
-}
+/// The committed state of a [`System`], owned (read from a checkpoint, or a snapshot).
+pub type SystemState = SavedState<'static>;
+
+/// The committed state of a [`System`], borrowed for writing.
+pub type SystemStateRef<'a> = SavedState<'a>;
 
 impl System<'_> {
     /// The committed state, borrowed (call between increments).
     pub fn state(&self) -> SystemStateRef<'_> {
-        SystemStateRef {
-            u: &self.u,
-            u_prev: &self.u_prev,
+        SavedState {
+            u: Cow::Borrowed(&self.u),
+            u_prev: Cow::Borrowed(&self.u_prev),
             time: self.time,
-            families: &self.families,
-            stages: self.stages.as_ref(),
+            families: Cow::Borrowed(&self.families),
+            stages: self.stages.as_ref().map(Cow::Borrowed),
         }
     }
 
     /// The committed state, owned (for a time-substep pair that may be rejected and
     /// restored with [`System::restore`]).
     pub(crate) fn snapshot(&self) -> SystemState {
-        SystemState {
-            u: self.u.clone(),
-            u_prev: self.u_prev.clone(),
-            time: self.time,
-            families: self.families.clone(),
-            stages: self.stages.clone(),
+        let s = self.state();
+        SavedState {
+            u: Cow::Owned(s.u.into_owned()),
+            u_prev: Cow::Owned(s.u_prev.into_owned()),
+            time: s.time,
+            families: Cow::Owned(s.families.into_owned()),
+            stages: s.stages.map(|st| Cow::Owned(st.into_owned())),
         }
     }
 
     /// Replace the committed (and trial) states by a saved state of the same model. Errors
-    /// name what does not match (the model changed since the state was saved).
+    /// name what does not match (the model changed since the state was saved): each block
+    /// checks its own sizes ([`StateBlock::check_shape`]).
     pub fn restore(&mut self, s: SystemState) -> Result<(), String> {
-        let check = |what: &str, saved: usize, now: usize| {
-            if saved == now {
-                Ok(())
-            } else {
-                Err(format!(
-                    "the checkpoint has {saved} {what}, the model {now}: the model changed since the checkpoint was written"
-                ))
-            }
-        };
-        let (new, old) = (&s.families, &self.families);
-        check("dofs", s.u.len(), self.u.len())?;
-        check("dofs (previous)", s.u_prev.len(), self.u_prev.len())?;
-        let (nc, oc) = (&new.continuum, &old.continuum);
-        check(
-            "material points",
-            nc.points.committed.len(),
-            oc.points.committed.len(),
-        )?;
-        check(
-            "Gauss outputs",
-            nc.gauss.committed.len(),
-            oc.gauss.committed.len(),
-        )?;
-        let (nj, oj) = (&new.joints.points.committed, &old.joints.points.committed);
-        check("joint elements", nj.len(), oj.len())?;
-        for (a, b) in nj.iter().zip(oj) {
-            check("joint points in an element", a.len(), b.len())?;
-        }
-        let (nt, ot) = (&new.tendons, &old.tendons);
-        check(
-            "tendons",
-            nt.states.committed.len(),
-            ot.states.committed.len(),
-        )?;
-        check("tendon displacements", nt.u0.len(), ot.u0.len())?;
-        check(
-            "tendon strains",
-            nt.initial_strains.len(),
-            ot.initial_strains.len(),
-        )?;
-        check("tendon records", nt.time.len(), ot.time.len())?;
-        let (nb, ob) = (&new.bars, &old.bars);
-        check(
-            "bar points",
-            nb.steel.committed.len(),
-            ob.steel.committed.len(),
-        )?;
-        check(
-            "bar outputs",
-            nb.out.committed.len(),
-            ob.out.committed.len(),
-        )?;
-        check("bars", nb.phase.len(), ob.phase.len())?;
-        check("bar strains", nb.eps_ref.len(), ob.eps_ref.len())?;
-        check("bar records", nb.time.len(), ob.time.len())?;
-        if let Some(p) = nc
-            .points
-            .committed
-            .iter()
-            .zip(&oc.points.committed)
-            .position(|(a, b)| std::mem::discriminant(a) != std::mem::discriminant(b))
-        {
-            return Err(format!(
-                "material point {} has another kind of state in the checkpoint than in the model: the model changed since the checkpoint was written",
-                p + 1
-            ));
-        }
-        for (t, saved) in nt.states.committed.iter().enumerate() {
-            let Some(saved) = saved else { continue };
-            let n = self.model.tendons[t].nodes.len();
-            check("tendon nodes", nt.u0[t].len(), n)?;
-            check("tendon spans", nt.initial_strains[t].len(), n - 1)?;
-            check("tendon span states", saved.spans.len(), n - 1)?;
-        }
-        // The tendon elements are rebuilt on the geometry they were stressed on, with the
-        // initial strains they had.
-        for t in 0..self.tendons.len() {
-            self.tendons[t] = s.families.tendons.states.committed[t].as_ref().map(|_| {
-                let tb = &s.families.tendons;
-                let mut el = self.build_tendon(t, &tb.u0[t]);
-                el.set_initial_strains(&tb.initial_strains[t]);
-                el
-            });
-        }
+        same_count("dofs", s.u.len(), self.u.len())?;
+        same_count("dofs (previous)", s.u_prev.len(), self.u_prev.len())?;
+        self.families.check_shape(&s.families, self.model)?;
         match (&s.stages, &self.stages) {
-            (Some(st), Some(_)) => {
-                check("staged elements", st.element_active.len(), self.model.elements.len())?;
-                check(
-                    "staged element references",
-                    st.element_ref.len(),
-                    self.model.elements.len(),
-                )?;
-                check(
-                    "staged joint elements",
-                    st.interface_active.len(),
-                    self.model.interfaces.len(),
-                )?;
-                check(
-                    "staged joint references",
-                    st.interface_ref.len(),
-                    self.model.interfaces.len(),
-                )?;
-                check("staged equations", st.held.len(), self.dofs.n_eq)?;
-                check("staged releases", st.release.len(), self.u.len())?;
-                check("staged base equations", st.base_held.len(), self.dofs.n_eq)?;
-                let one_way = self.model.staging.has_one_way();
-                if st.step.is_some() && one_way == st.one_way.points.is_empty() {
-                    return Err(
-                        "the checkpoint and the model differ in their one-way supports: the model changed since the checkpoint was written".into(),
-                    );
-                }
+            (Some(saved), Some(now)) => {
+                let shape = StageShape {
+                    model: self.model,
+                    n_eq: self.dofs.n_eq,
+                    n_dofs: self.u.len(),
+                };
+                now.check_shape(saved, shape)?;
             }
             (None, None) => {}
             (saved, _) => {
@@ -209,12 +111,19 @@ impl System<'_> {
                 ))
             }
         }
-        self.u = s.u;
-        self.u_prev = s.u_prev;
+        // The tendon elements are rebuilt on the geometry they were stressed on (the initial
+        // strains in force are the block's).
+        let tb = &s.families.tendons;
+        for t in 0..self.tendons.len() {
+            self.tendons[t] =
+                (tb.states.committed[t].as_ref()).map(|_| self.build_tendon(t, &tb.u0[t]));
+        }
+        self.u = s.u.into_owned();
+        self.u_prev = s.u_prev.into_owned();
         self.time = s.time;
-        self.families = s.families;
-        if s.stages.is_some() {
-            self.stages = s.stages;
+        self.families = s.families.into_owned();
+        if let Some(st) = s.stages {
+            self.stages = Some(st.into_owned());
         }
         Ok(())
     }
@@ -267,8 +176,10 @@ pub(crate) mod layout {
         let span_time = SpanTime {
             sigma_initial: 1.0,
             eps0: 2.0,
-            relax_strain: 3.0,
-            relax_strain_trial: 4.0,
+            relax_strain: Staged {
+                committed: 3.0,
+                trial: 4.0,
+            },
             steel_strain: 5.0,
             hidden: vec![6.0],
             relax_drop: 7.0,
@@ -279,8 +190,10 @@ pub(crate) mod layout {
         let bar_time = BarPointTime {
             sigma_initial: 1.0,
             stress: 2.0,
-            relax_strain: 3.0,
-            relax_strain_trial: 4.0,
+            relax_strain: Staged {
+                committed: 3.0,
+                trial: 4.0,
+            },
             steel_strain: 5.0,
             chain: Some(chain.clone()),
             hidden: vec![6.0],
@@ -289,15 +202,15 @@ pub(crate) mod layout {
             loss_creep: 9.0,
             loss_relax: 10.0,
         };
-        SystemState {
-            u: vec![1.0, 2.0],
-            u_prev: vec![3.0, 4.0],
+        SavedState {
+            u: Cow::Owned(vec![1.0, 2.0]),
+            u_prev: Cow::Owned(vec![3.0, 4.0]),
             time: TimeContext {
                 t_from: 1.0,
                 t_to: 2.0,
                 extrapolation: 0.5,
             },
-            families: Families {
+            families: Cow::Owned(Families {
                 continuum: ContinuumBlock {
                     points: Staged::new(vec![
                         PointState::Elastic,
@@ -348,8 +261,8 @@ pub(crate) mod layout {
                     eps_ref: vec![1.0],
                     time: vec![Some(bar_time)],
                 },
-            },
-            stages: Some(StageState {
+            }),
+            stages: Some(Cow::Owned(StageState {
                 step: Some(1),
                 element_active: vec![true, false],
                 element_ref: vec![None, Some(vec![1.0, 2.0])],
@@ -367,27 +280,26 @@ pub(crate) mod layout {
                         sign: -1.0,
                         seat: 7.0,
                         acting: true,
-                        touching: false,
-                        trial: false,
+                        touching: Staged::new(false),
                     }],
                 },
-            }),
+            })),
         }
     }
 
     /// The writer's view of `s`.
     pub(crate) fn as_ref(s: &SystemState) -> SystemStateRef<'_> {
-        SystemStateRef {
-            u: &s.u,
-            u_prev: &s.u_prev,
+        SavedState {
+            u: Cow::Borrowed(&s.u),
+            u_prev: Cow::Borrowed(&s.u_prev),
             time: s.time,
-            families: &s.families,
-            stages: s.stages.as_ref(),
+            families: Cow::Borrowed(&s.families),
+            stages: s.stages.as_deref().map(Cow::Borrowed),
         }
     }
 
-    /// What is written can be read back, equal: the borrowed writer and the owned reader
-    /// agree field for field.
+    /// What is written can be read back, equal: the borrowed form writes what the owned one
+    /// reads.
     #[test]
     fn writer_and_reader_agree() {
         let s = sample();

@@ -4,7 +4,7 @@
 use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
 use crate::elements::interface::{InterfaceElement, InterfacePointState, Joint};
-use crate::elements::tendon::{ExternalTendon, TendonLaw};
+use crate::elements::tendon::{ExternalTendon, InForce, TendonLaw};
 use crate::elements::{ElementResponse, Response};
 use crate::fem::assembly::Assembler;
 use crate::fem::dofs::{DofMap, CONSTRAINED};
@@ -19,7 +19,7 @@ use super::scatter::{
     chunks, compute_chunk, continuum_chunk, keep_forces, max_dofs, slot, tie_transform, Outcome,
     Scatter, CHUNK,
 };
-use super::staged::Staged;
+use super::staged::{Staged, StateBlock};
 use super::stages::StageState;
 use crate::fem::numbering::{ElementNumbers, Family};
 use rayon::prelude::*;
@@ -57,7 +57,9 @@ pub struct System<'m> {
     pub interfaces: Vec<InterfaceElement>,
     /// True if the last assembled tangent was made symmetric (friction slip).
     pub symmetrised: bool,
-    /// External tendons, built when stressed (None before).
+    /// External tendons, built when stressed (None before), on the geometry they were
+    /// stressed on; the initial strains in force are the state's
+    /// (`families.tendons.initial_strains`).
     pub tendons: Vec<Option<ExternalTendon>>,
     /// Embedded-bar integration points sorted by host element: (bar index, point index in
     /// the bar). Element e owns `bar_gps[bar_offset[e]..bar_offset[e + 1]]`.
@@ -630,6 +632,10 @@ impl<'m> System<'m> {
                 else {
                     return Ok(None);
                 };
+                let el = InForce {
+                    tendon: el,
+                    strains: &tb.initial_strains[t],
+                };
                 let data = &model.tendons[t];
                 let ut: Vec<f64> = (0..data.nodes.len())
                     .zip(&tb.u0[t])
@@ -640,7 +646,7 @@ impl<'m> System<'m> {
                     .collect();
                 if data.untied() {
                     let into = slot(fe, ke, ut.len(), tangent);
-                    return ElementResponse::response(el, &ut, committed, trial, into).map(Some);
+                    return ElementResponse::response(&el, &ut, committed, trial, into).map(Some);
                 }
                 let np = ut.len();
                 let mut fp = vec![0.0; np];
@@ -649,7 +655,7 @@ impl<'m> System<'m> {
                     f: &mut fp,
                     k: tangent.then_some(&mut kp[..]),
                 };
-                let sym = ElementResponse::response(el, &ut, committed, trial, into)?;
+                let sym = ElementResponse::response(&el, &ut, committed, trial, into)?;
                 tie_transform(&data.ties, &tie_nodes[t], &fp, &kp, fe, ke, tangent);
                 Ok(Some(sym))
             });
@@ -839,10 +845,7 @@ impl<'m> System<'m> {
                 *out = *trial;
             }
         }
-        c.points.revert();
-        c.gauss.revert();
-        self.families.bars.steel.revert();
-        self.families.bars.out.revert();
+        self.families.revert();
         Ok(())
     }
 
@@ -996,7 +999,7 @@ impl<'m> System<'m> {
         self.u.copy_from_slice(u);
         self.families.commit();
         if let Some(st) = self.stages.as_mut() {
-            st.one_way.commit();
+            st.commit();
         }
     }
 

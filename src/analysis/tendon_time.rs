@@ -7,6 +7,7 @@
 //!
 //! Units: days, Pa, strains dimensionless.
 
+use super::staged::Staged;
 use crate::materials::chain::SteelRelaxationChain;
 use crate::model::{Bar, LossPart};
 
@@ -17,10 +18,10 @@ pub struct SpanTime {
     pub sigma_initial: f64,
     /// Initial (prestress) strain at stressing, before relaxation [-].
     pub eps0: f64,
-    /// Committed accumulated relaxation strain R [-].
-    pub relax_strain: f64,
-    /// R of the current (trial) increment [-].
-    pub relax_strain_trial: f64,
+    /// Accumulated relaxation strain R [-]: committed, and of the current (trial)
+    /// increment (both saved: the layout of checkpoint format 10).
+    #[serde(with = "super::staged::both")]
+    pub relax_strain: Staged<f64>,
     /// Committed total steel strain the chain has seen [-].
     pub steel_strain: f64,
     /// Chain unit stresses [Pa] (empty without relaxation).
@@ -73,10 +74,10 @@ pub struct BarPointTime {
     pub sigma_initial: f64,
     /// Committed stress [Pa].
     pub stress: f64,
-    /// Committed accumulated relaxation strain R [-].
-    pub relax_strain: f64,
-    /// R of the current (trial) increment [-].
-    pub relax_strain_trial: f64,
+    /// Accumulated relaxation strain R [-]: committed, and of the current (trial)
+    /// increment (both saved: the layout of checkpoint format 10).
+    #[serde(with = "super::staged::both")]
+    pub relax_strain: Staged<f64>,
     /// Committed total steel strain (bond strain + R) the chain has seen [-].
     pub steel_strain: f64,
     /// Relaxation chain (None: no `relaxation_class`, or σ_0 ≤ 0.5 f_ptk).
@@ -109,8 +110,7 @@ impl BarPointTime {
         Self {
             sigma_initial: sigma0,
             stress: sigma0,
-            relax_strain: 0.0,
-            relax_strain_trial: 0.0,
+            relax_strain: Staged::new(0.0),
             steel_strain: sigma0 / ep,
             chain,
             hidden,

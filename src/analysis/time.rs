@@ -13,6 +13,7 @@
 //!
 //! Units: days, Pa, strains dimensionless.
 
+use super::staged::Staged;
 use super::system::System;
 use super::tendon_time::{SpanTime, TendonTime};
 use crate::materials::chain::SteelRelaxationChain;
@@ -52,8 +53,7 @@ impl System<'_> {
                     .map(|((&s, &e0), c)| SpanTime {
                         sigma_initial: s,
                         eps0: e0,
-                        relax_strain: 0.0,
-                        relax_strain_trial: 0.0,
+                        relax_strain: Staged::new(0.0),
                         steel_strain: e0,
                         hidden: c
                             .as_ref()
@@ -84,7 +84,7 @@ impl System<'_> {
             let mut eps0 = Vec::with_capacity(tt.spans.len());
             for (i, (sp, chain)) in tt.spans.iter_mut().zip(&tt.chains).enumerate() {
                 sp.relax_drop = 0.0;
-                sp.relax_strain_trial = sp.relax_strain;
+                sp.relax_strain.revert();
                 if let (Some(c), true) = (chain, dt > 0.0) {
                     let drop: f64 = c
                         .taus
@@ -95,21 +95,18 @@ impl System<'_> {
                     let chain_stress: f64 = sp.hidden.iter().sum();
                     let mismatch = committed.spans[i].stress - chain_stress;
                     sp.relax_drop = drop;
-                    sp.relax_strain_trial = sp.relax_strain + (drop + mismatch) / ep;
+                    sp.relax_strain.trial = sp.relax_strain.committed + (drop + mismatch) / ep;
                 }
-                eps0.push(sp.eps0 - sp.relax_strain_trial);
+                eps0.push(sp.eps0 - sp.relax_strain.trial);
             }
-            // The element computes with its copy; the family block keeps the one saved in
-            // checkpoints.
-            if let Some(el) = self.tendons[t].as_mut() {
-                el.set_initial_strains(&eps0);
-            }
+            // The strains in force: the element reads them from the block.
             self.families.tendons.initial_strains[t] = eps0;
         }
     }
 
     /// Book-keeping of a converged increment, called by [`System::commit`] before the trial
-    /// tendon states replace the committed ones: the loss split and the relaxation chains.
+    /// tendon states replace the committed ones: the loss split and the relaxation chains
+    /// (the trial relaxation strains are committed with the block, `TendonBlock::commit`).
     pub(crate) fn commit_time_dependent(&mut self) {
         let dt = self.time.dt();
         self.commit_bonded_time(dt);
@@ -129,12 +126,11 @@ impl System<'_> {
                 } else {
                     sp.loss_elastic += -d_sigma;
                 }
-                let steel = new.spans[i].strain + sp.relax_strain_trial;
+                let steel = new.spans[i].strain + sp.relax_strain.trial;
                 if let Some(c) = chain {
                     sp.hidden = c.step(&sp.hidden, dt, steel - sp.steel_strain).new_hidden;
                 }
                 sp.steel_strain = steel;
-                sp.relax_strain = sp.relax_strain_trial;
                 sp.relax_drop = 0.0;
             }
         }

@@ -336,8 +336,9 @@ impl Observer for Watch {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         // Half model: the control force carries half the load.
         let p = -2.0 * s.control_force.unwrap_or(0.0);
-        let lock = Locking::of(&s.system.families.continuum.points.committed, self.ftm);
-        self.rows.push((p, -s.system.u[2 * self.mid + 1], lock));
+        let lock = Locking::of(s.system.point_states(), self.ftm);
+        self.rows
+            .push((p, -s.system.displacements()[2 * self.mid + 1], lock));
         self.ultimate.increment(s);
         Ok(())
     }

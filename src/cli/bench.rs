@@ -141,7 +141,7 @@ struct TipOnly {
 
 impl Observer for TipOnly {
     fn increment(&mut self, snap: &Snapshot) -> std::io::Result<()> {
-        self.value = snap.system.u[2 * self.node + 1];
+        self.value = snap.system.displacements()[2 * self.node + 1];
         Ok(())
     }
 }
@@ -234,7 +234,7 @@ impl Observer for DeflectionAt {
             .iter()
             .position(|p| (p[0] - self.0).abs() < 1e-6 && p[1].abs() < 1e-9)
         {
-            self.1 = snap.system.u[2 * n + 1];
+            self.1 = snap.system.displacements()[2 * n + 1];
         }
         Ok(())
     }
@@ -554,22 +554,14 @@ impl Observer for Reach {
             .iter()
             .position(|p| (p[0] - 3.6).abs() < 1e-9 && p[1].abs() < 1e-9)
         {
-            self.deflection = sys.u[2 * n + 1];
+            self.deflection = sys.displacements()[2 * n + 1];
         }
-        self.tendon_stress = sys.families.tendons.states.committed[0]
-            .as_ref()
-            .map_or(0.0, |t| t.stresses().into_iter().fold(0.0, f64::max));
+        self.tendon_stress =
+            (sys.tendon_state(0)).map_or(0.0, |t| t.stresses().into_iter().fold(0.0, f64::max));
         self.max_opening = (0..m.joints.len())
             .map(|j| segfem::results::joints::summarise(sys, j).max_opening)
             .fold(0.0, f64::max);
-        self.crushed = sys
-            .families
-            .continuum
-            .points
-            .committed
-            .iter()
-            .filter(|p| p.is_crushed())
-            .count();
+        self.crushed = sys.point_states().iter().filter(|p| p.is_crushed()).count();
         Ok(())
     }
 }
@@ -825,7 +817,7 @@ impl Observer for RcWatch {
             .iter()
             .position(|p| (p[0] - 1.6).abs() < 1e-9 && p[1].abs() < 1e-9)
         {
-            self.deflection = -snap.system.u[2 * n + 1];
+            self.deflection = -snap.system.displacements()[2 * n + 1];
         }
         Ok(())
     }

@@ -205,17 +205,11 @@ struct Trace {
 
 impl Observer for Trace {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-        let u = &s.system.u;
+        let u = s.system.displacements();
         // Uniform strain: ε_x from the roller corner (L, 0), ε_y from the corner (0, L).
         let ex = u[2 * self.n] / self.l;
         let ey = u[2 * self.n * (self.n + 1) + 1] / self.l;
-        let crushed = s
-            .system
-            .families
-            .continuum
-            .points
-            .committed
-            .iter()
+        let crushed = (s.system.point_states().iter())
             .filter(|p| p.is_crushed())
             .count();
         self.rows.push((1e6 * s.factors[0], [ex, ey], crushed));

@@ -187,12 +187,23 @@ pub struct TendonResponse {
     pub state: TendonState,
 }
 
-impl super::ElementResponse for ExternalTendon {
+/// An external tendon with the initial span strains in force (after relaxation), which the
+/// analysis state keeps (`analysis::families::TendonBlock::initial_strains`): the element
+/// the assembly calls.
+#[derive(Debug, Clone, Copy)]
+pub struct InForce<'a> {
+    /// The tendon as stressed.
+    pub tendon: &'a ExternalTendon,
+    /// Initial span strains ε0_i in force [-], one per span.
+    pub strains: &'a [f64],
+}
+
+impl super::ElementResponse for InForce<'_> {
     type Committed = TendonState;
     type Trial<'t> = &'t mut Option<TendonState>;
 
-    /// [`ExternalTendon::response`]; `u` holds the displacements of the tendon points since
-    /// the tendon was stressed [m], (x, y) per point.
+    /// [`ExternalTendon::response_in_force`]; `u` holds the displacements of the tendon
+    /// points since the tendon was stressed [m], (x, y) per point.
     fn response(
         &self,
         u: &[f64],
@@ -201,7 +212,7 @@ impl super::ElementResponse for ExternalTendon {
         into: super::Response<'_>,
     ) -> Result<bool, crate::materials::point::UpdateError> {
         let ut: Vec<[f64; 2]> = u.chunks_exact(2).map(|d| [d[0], d[1]]).collect();
-        let r = ExternalTendon::response(self, &ut, committed);
+        let r = self.tendon.response_in_force(&ut, committed, self.strains);
         into.f.copy_from_slice(&r.f_int);
         if let Some(k) = into.k {
             k.copy_from_slice(&r.k);
@@ -221,6 +232,8 @@ pub struct ExternalTendon {
     mode: DeviatorMode,
     ref_lengths: Vec<f64>,
     initial_stress: Vec<f64>,
+    /// Span strains at stressing, from the initial stresses [-] (those in force later are
+    /// the analysis state's, [`InForce`]).
     initial_strain: Vec<f64>,
     deviation: Vec<f64>,
     /// Thermal strain α_p ΔT of each span, a stress-free strain [-] (thermal actions).
@@ -363,20 +376,11 @@ impl ExternalTendon {
     pub fn initial_stresses(&self) -> &[f64] {
         &self.initial_stress
     }
-    /// Initial (prestress) span strains ε0_i \[-\].
+    /// Initial (prestress) span strains ε0_i at stressing \[-\], from the initial stresses
+    /// (time-dependent analyses impose the steel relaxation on them as a stress-free strain:
+    /// the strains then in force are passed to [`Self::response_in_force`]).
     pub fn initial_strains(&self) -> &[f64] {
         &self.initial_strain
-    }
-    /// Replace the initial span strains ε0_i \[-\] (one per span; for `Frictionless` only the
-    /// first is used). Used by time-dependent analyses to impose the steel relaxation as a
-    /// stress-free strain; stresses follow at the next response. Panics on a length mismatch.
-    pub fn set_initial_strains(&mut self, e: &[f64]) {
-        assert_eq!(
-            e.len(),
-            self.n_spans(),
-            "tendon: one initial strain per span"
-        );
-        self.initial_strain.copy_from_slice(e);
     }
     /// Replace the thermal strains α_p ΔT of the spans \[-\] (one per span), stress-free
     /// strains subtracted from the span strains (`Frictionless`: their length-weighted mean
@@ -421,22 +425,42 @@ impl ExternalTendon {
     }
 
     /// Strain of span i for current length `l` and slips `s` (deviator j ↔ s\[j−1\]).
-    fn span_strain(&self, i: usize, l: f64, s: &[f64]) -> f64 {
+    /// `eps0`: the initial span strains in force.
+    fn span_strain(&self, eps0: &[f64], i: usize, l: f64, s: &[f64]) -> f64 {
         let m = self.n_spans();
         let s_left = if i >= 1 { s[i - 1] } else { 0.0 };
         let s_right = if i + 1 < m { s[i] } else { 0.0 };
-        self.initial_strain[i] - self.thermal_strain[i]
+        eps0[i] - self.thermal_strain[i]
             + (l - self.ref_lengths[i] - s_right + s_left) / self.ref_lengths[i]
     }
 
-    /// Response for displacements `u` \[m\] of the tendon points and the committed state.
+    /// Response for displacements `u` \[m\] of the tendon points and the committed state,
+    /// at the initial strains of stressing ([`Self::initial_strains`]).
     ///
     /// Panics if `u` or `committed` do not match the tendon.
     pub fn response(&self, u: &[[f64; 2]], committed: &TendonState) -> TendonResponse {
+        self.response_in_force(u, committed, &self.initial_strain)
+    }
+
+    /// As [`Self::response`], with the initial span strains in force `eps0` \[-\] (one per
+    /// span; for `Frictionless` only the first is used), e.g. after steel relaxation.
+    ///
+    /// Panics if `u`, `committed` or `eps0` do not match the tendon.
+    pub fn response_in_force(
+        &self,
+        u: &[[f64; 2]],
+        committed: &TendonState,
+        eps0: &[f64],
+    ) -> TendonResponse {
         let np = self.n_points();
         let m = self.n_spans();
         assert_eq!(u.len(), np, "tendon: one displacement per point expected");
         assert_eq!(committed.spans.len(), m, "tendon: wrong committed state");
+        assert_eq!(
+            eps0.len(),
+            m,
+            "tendon: one initial strain per span expected"
+        );
         let mut len = vec![0.0; m];
         let mut dir = vec![[0.0; 2]; m];
         for i in 0..m {
@@ -463,7 +487,7 @@ impl ExternalTendon {
                     .map(|(e, l)| e * l)
                     .sum::<f64>()
                     / lt;
-                let eps = self.initial_strain[0] - thermal + (len.iter().sum::<f64>() - lt) / lt;
+                let eps = eps0[0] - thermal + (len.iter().sum::<f64>() - lt) / lt;
                 let (sig, et, st) = self.law.update(self.modulus, eps, &committed.spans[0].law);
                 let kk = self.area * et / lt;
                 dndl.iter_mut().for_each(|x| *x = kk);
@@ -479,7 +503,7 @@ impl ExternalTendon {
             }
             DeviatorMode::Held => {
                 for i in 0..m {
-                    let eps = self.span_strain(i, len[i], &slips);
+                    let eps = self.span_strain(eps0, i, len[i], &slips);
                     let (sig, et, st) = self.law.update(self.modulus, eps, &committed.spans[i].law);
                     dndl[i * m + i] = self.area * et / self.ref_lengths[i];
                     spans.push(SpanState {
@@ -492,7 +516,7 @@ impl ExternalTendon {
                 }
             }
             DeviatorMode::Friction { mu } => {
-                let (s, act, st) = self.friction_return(mu, &len, committed);
+                let (s, act, st) = self.friction_return(mu, &len, committed, eps0);
                 slips = s;
                 slipping = act;
                 // Tangent dN/dℓ = D (I − C_a (G D C_a)⁻¹ G D).
@@ -516,7 +540,7 @@ impl ExternalTendon {
                 }
                 for i in 0..m {
                     spans.push(SpanState {
-                        strain: self.span_strain(i, len[i], &slips),
+                        strain: self.span_strain(eps0, i, len[i], &slips),
                         stress: st[i].0,
                         force: self.area * st[i].0,
                         length: len[i],
@@ -608,6 +632,7 @@ impl ExternalTendon {
         mu: f64,
         len: &[f64],
         committed: &TendonState,
+        eps0: &[f64],
     ) -> (Vec<f64>, Vec<i8>, Vec<(f64, f64, SteelState)>) {
         let m = self.n_spans();
         let nd = m.saturating_sub(1);
@@ -615,7 +640,7 @@ impl ExternalTendon {
         let eval = |s: &[f64]| -> Vec<(f64, f64, SteelState)> {
             (0..m)
                 .map(|i| {
-                    let eps = self.span_strain(i, len[i], s);
+                    let eps = self.span_strain(eps0, i, len[i], s);
                     self.law.update(self.modulus, eps, &committed.spans[i].law)
                 })
                 .collect()

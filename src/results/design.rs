@@ -84,8 +84,7 @@ pub struct DesignWatch {
 
 /// The largest span stress of tendon `t` [Pa] (0 before it is stressed).
 fn tendon_stress(sys: &System, t: usize) -> f64 {
-    sys.families.tendons.states.committed[t]
-        .as_ref()
+    sys.tendon_state(t)
         .map(|st| st.stresses().into_iter().fold(f64::NEG_INFINITY, f64::max))
         .unwrap_or(0.0)
 }
@@ -212,11 +211,7 @@ pub fn joint_section(sys: &System, j: usize) -> JointSection {
             s1: s_of(model.nodes[ie.nodes[1]]),
             t: ie.thickness,
         });
-        for (p, st) in sys.interfaces[i]
-            .points()
-            .iter()
-            .zip(&sys.families.joints.points.committed[i])
-        {
+        for (p, st) in sys.interfaces[i].points().iter().zip(sys.joint_points(i)) {
             points.push(ContactPoint {
                 s: s_of(p.position),
                 area: p.weight * ie.thickness,
@@ -341,7 +336,6 @@ fn concrete_items(sys: &System, c: &DesignCheck) -> Items {
     else {
         unreachable!("called for its own kind")
     };
-    let gauss = &sys.families.continuum.gauss.committed;
     let mut skip = vec![false; model.elements.len()];
     for &e in excluded {
         skip[e] = true;
@@ -354,7 +348,7 @@ fn concrete_items(sys: &System, c: &DesignCheck) -> Items {
                 if el.region != r || skip[e] {
                     continue;
                 }
-                for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
+                for g in sys.element_gauss(e) {
                     let (_, s2) = principal(&g.stress);
                     if -s2 > worst.0 {
                         worst = (-s2, e);

@@ -54,8 +54,7 @@ pub fn recover(sys: &System) -> Fields {
             .enumerate()
             .for_each(|(i, (((el, cs), ce), x))| {
                 let e = start + i;
-                let g =
-                    &sys.families.continuum.gauss.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+                let g = sys.element_gauss(e);
                 let len = g.len() as f64;
                 *cs = [0.0; 3];
                 *ce = [0.0; 3];

@@ -21,7 +21,7 @@ pub fn wanted(model: &Model) -> bool {
 pub fn render_gauss_points(snap: &Snapshot) -> String {
     let sys = snap.system;
     let model = sys.model;
-    let n = sys.families.continuum.points.committed.len();
+    let n = sys.point_states().len();
     let mut points = Vec::with_capacity(n);
     for e in &model.elements {
         let coords = model.element_coords(e);
@@ -43,14 +43,7 @@ pub fn render_gauss_points(snap: &Snapshot) -> String {
         Vec::with_capacity(3 * n),
         Vec::with_capacity(3 * n),
     );
-    for (p, g) in sys
-        .families
-        .continuum
-        .points
-        .committed
-        .iter()
-        .zip(&sys.families.continuum.gauss.committed)
-    {
+    for (p, g) in sys.point_states().iter().zip(sys.gauss_outputs()) {
         let c = p.concrete();
         let k = p.n_cracks();
         cracks.push(k as i32);

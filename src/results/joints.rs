@@ -43,11 +43,7 @@ pub fn summarise(sys: &System, j: usize) -> JointSummary {
     };
     for &i in &sys.model.joints[j].interfaces {
         let el = &sys.interfaces[i];
-        for (p, st) in el
-            .points()
-            .iter()
-            .zip(&sys.families.joints.points.committed[i])
-        {
+        for (p, st) in el.points().iter().zip(sys.joint_points(i)) {
             let closed = st.closed || st.bonded;
             if closed {
                 s.contact_depth += p.weight;

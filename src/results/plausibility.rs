@@ -94,11 +94,7 @@ impl Plausibility {
                 let (mut fn_, mut ft) = (0.0, 0.0);
                 for &i in &joint.interfaces {
                     let t = model.interfaces[i].thickness;
-                    for (p, st) in sys.interfaces[i]
-                        .points()
-                        .iter()
-                        .zip(&sys.families.joints.points.committed[i])
-                    {
+                    for (p, st) in sys.interfaces[i].points().iter().zip(sys.joint_points(i)) {
                         if !(st.closed || st.bonded) {
                             fn_ += st.normal_stress() * p.weight * t;
                             ft += st.shear_stress() * p.weight * t;

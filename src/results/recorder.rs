@@ -328,7 +328,7 @@ impl<'m> Recorder<'m> {
     }
 
     fn monitor_values(&self, snap: &Snapshot) -> Vec<f64> {
-        let u = &snap.system.u;
+        let u = snap.system.displacements();
         let n_joints = self.model.joints.len();
         let joints_of = |j: Option<usize>| -> std::ops::Range<usize> {
             match j {
@@ -361,21 +361,13 @@ impl<'m> Recorder<'m> {
                     })
                     .sum(),
                 MonitorKind::LoadFactor { case } => snap.factors[*case],
-                MonitorKind::TendonStress { tendon, span } => {
-                    snap.system.families.tendons.states.committed[*tendon]
-                        .as_ref()
-                        .map(|st| pick_span(st.stresses(), *span))
-                        .unwrap_or(0.0)
-                }
-                MonitorKind::TendonForce { tendon, span } => {
-                    snap.system.families.tendons.states.committed[*tendon]
-                        .as_ref()
-                        .map(|st| pick_span(st.forces(), *span))
-                        .unwrap_or(0.0)
-                }
-                MonitorKind::TendonLoss { tendon, part } => snap.system.families.tendons.time
-                    [*tendon]
-                    .as_ref()
+                MonitorKind::TendonStress { tendon, span } => (snap.system.tendon_state(*tendon))
+                    .map(|st| pick_span(st.stresses(), *span))
+                    .unwrap_or(0.0),
+                MonitorKind::TendonForce { tendon, span } => (snap.system.tendon_state(*tendon))
+                    .map(|st| pick_span(st.forces(), *span))
+                    .unwrap_or(0.0),
+                MonitorKind::TendonLoss { tendon, part } => (snap.system.tendon_time(*tendon))
                     .map(|tt| tt.loss(*part))
                     .unwrap_or(0.0),
                 MonitorKind::JointOpening { joint } => joints_of(*joint)
@@ -406,8 +398,7 @@ impl<'m> Recorder<'m> {
                 MonitorKind::StressAtPoint {
                     component,
                     gauss_point,
-                } => component
-                    .of(snap.system.families.continuum.gauss.committed[*gauss_point].stress),
+                } => component.of(snap.system.gauss_outputs()[*gauss_point].stress),
                 MonitorKind::StressExtreme {
                     component,
                     region,
@@ -493,7 +484,8 @@ impl Observer for Recorder<'_> {
             matches!(m.kind, MonitorKind::Displacement { since_step: Some(s), .. } if s == snap.step)
         });
         if snap.end_of_step && wanted {
-            self.step_end_u.insert(snap.step, snap.system.u.clone());
+            self.step_end_u
+                .insert(snap.step, snap.system.displacements().to_vec());
         }
         let monitors = self.monitor_values(snap);
         let (joint_opening, opening_joint) = if self.model.staging.is_staged() {
@@ -505,7 +497,7 @@ impl Observer for Recorder<'_> {
             step: snap.step,
             increment: snap.increment,
             iterations: snap.iterations,
-            time: snap.system.time.t_to,
+            time: snap.system.time_interval().t_to,
             factors: snap.factors.to_vec(),
             monitors,
             negative_pivots: snap.negative_pivots,
@@ -603,7 +595,7 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
         types.push(if face.len() == 3 { 21u8 } else { 3u8 });
         cells.push(face);
         kind.push(1);
-        let st = &sys.families.joints.points.committed[i];
+        let st = sys.joint_points(i);
         let n = st.len().max(1) as f64;
         opening.push(st.iter().map(|p| p.opening()).fold(0.0, f64::max));
         sn.push(st.iter().map(|p| p.normal_stress()).sum::<f64>() / n);
@@ -612,7 +604,7 @@ fn render_lines(snap: &Snapshot, disp: &[f64]) -> Option<String> {
         t_force.push(0.0);
     }
     for (t, data) in model.tendons.iter().enumerate() {
-        let state = sys.families.tendons.states.committed[t].as_ref();
+        let state = sys.tendon_state(t);
         for (k, w) in data.nodes.windows(2).enumerate() {
             cells.push(w.to_vec());
             types.push(3);
@@ -681,11 +673,11 @@ fn pick_span(values: Vec<f64>, span: Option<usize>) -> f64 {
 fn bar_stress(snap: &Snapshot, bar: usize, point: Option<usize>) -> f64 {
     let sys = snap.system;
     let mut best: f64 = 0.0;
-    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
+    for ((b, p), out) in sys.bar_outputs() {
         if b != bar {
             continue;
         }
-        let s = sys.families.bars.out.committed[i].stress;
+        let s = out.stress;
         match point {
             Some(q) if q == p => return s,
             Some(_) => {}
@@ -710,9 +702,7 @@ fn region_points<'a>(
         .iter()
         .enumerate()
         .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
-        .flat_map(move |(i, _)| {
-            &sys.families.continuum.points.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]]
-        })
+        .flat_map(move |(i, _)| sys.element_points(i))
 }
 
 fn point_extreme(
@@ -738,9 +728,7 @@ fn stress_extreme(
         .iter()
         .enumerate()
         .filter(move |(_, e)| region.is_none_or(|r| e.region == r))
-        .flat_map(move |(i, _)| {
-            &sys.families.continuum.gauss.committed[sys.gp_offset[i]..sys.gp_offset[i + 1]]
-        })
+        .flat_map(move |(i, _)| sys.element_gauss(i))
         .map(|g| component.of(g.stress));
     let pick = match extreme {
         Extreme::Max => values.reduce(f64::max),
@@ -967,7 +955,7 @@ fn cell_states(snap: &Snapshot) -> CellStates {
         crushed: Vec::with_capacity(n),
     };
     for e in 0..n {
-        let pts = &sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]];
+        let pts = sys.element_points(e);
         c.cracks
             .push(pts.iter().map(|p| p.n_cracks()).max().unwrap_or(0) as i32);
         let widest = pts
@@ -1002,8 +990,8 @@ fn bars_vtu(snap: &Snapshot) -> String {
         .iter()
         .map(|b| vec![Default::default(); b.points.len()])
         .collect();
-    for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
-        vals[b][p] = sys.families.bars.out.committed[i];
+    for ((b, p), out) in sys.bar_outputs() {
+        vals[b][p] = *out;
     }
     let mut points: Vec<[f64; 2]> = Vec::new();
     let mut cells: Vec<Vec<usize>> = Vec::new();

@@ -186,12 +186,11 @@ impl StrengthWatch {
                 worst[slot] = Some((ratio, value, limit, at));
             }
         };
-        let gauss = &sys.families.continuum.gauss.committed;
         for (e, el) in model.elements.iter().enumerate() {
             let Some(s) = self.regions[el.region] else {
                 continue;
             };
-            for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
+            for g in sys.element_gauss(e) {
                 let (s1, s2) = principal(&g.stress);
                 note(0, -s2, s.fcm, e);
                 note(2, s1, s.ftm, e);
@@ -199,7 +198,7 @@ impl StrengthWatch {
         }
         for (i, fcm) in self.interfaces.iter().enumerate() {
             let Some(fcm) = *fcm else { continue };
-            for st in &sys.families.joints.points.committed[i] {
+            for st in sys.joint_points(i) {
                 note(1, st.normal_stress(), fcm, i);
             }
         }

@@ -42,7 +42,7 @@ impl SustainedStress {
     pub fn increment(&mut self, snap: &Snapshot) {
         let sys = snap.system;
         let model = sys.model;
-        if sys.time.t_to <= sys.time.t_from {
+        if sys.time_interval().t_to <= sys.time_interval().t_from {
             return;
         }
         if self.fcm.is_empty() {
@@ -62,23 +62,22 @@ impl SustainedStress {
         if self.fcm.iter().all(Option::is_none) {
             return;
         }
-        let gauss = &sys.families.continuum.gauss.committed;
         for (e, el) in model.elements.iter().enumerate() {
             let Some(fcm) = self.fcm[el.region] else {
                 continue;
             };
-            for g in &gauss[sys.gp_offset[e]..sys.gp_offset[e + 1]] {
+            for g in sys.element_gauss(e) {
                 let s = g.stress;
                 let c = 0.5 * (s[0] + s[1]);
                 let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
                 let ratio = -(c - r) / fcm;
                 if ratio > LINEAR_CREEP_LIMIT {
-                    self.first.get_or_insert(sys.time.t_to);
+                    self.first.get_or_insert(sys.time_interval().t_to);
                     if self.worst.is_none_or(|w| ratio > w.ratio) {
                         self.worst = Some(Worst {
                             ratio,
                             region: el.region,
-                            time: sys.time.t_to,
+                            time: sys.time_interval().t_to,
                         });
                     }
                 }

@@ -194,11 +194,7 @@ impl UltimateWatch {
             negative_pivots: snap.negative_pivots,
         });
         if self.tendon_yield.is_none() {
-            for (t, st) in model
-                .tendons
-                .iter()
-                .zip(&sys.families.tendons.states.committed)
-            {
+            for (t, st) in model.tendons.iter().zip(sys.tendon_states()) {
                 let Some(st) = st else { continue };
                 if let Some(s) = st
                     .spans
@@ -220,11 +216,9 @@ impl UltimateWatch {
             self.bar_events(snap, k);
         }
         if self.first_crack.is_none() {
-            if let Some(e) = (0..model.elements.len()).find(|&e| {
-                sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
-                    .iter()
-                    .any(|p| p.n_cracks() > 0)
-            }) {
+            if let Some(e) = (0..model.elements.len())
+                .find(|&e| (sys.element_points(e).iter()).any(|p| p.n_cracks() > 0))
+            {
                 self.first_crack = Some(Event {
                     mode: CRACKING_PEAK,
                     detail: format!("element {}", e + 1),
@@ -262,12 +256,12 @@ impl UltimateWatch {
         };
         let k = 2 * n + d.index();
         if snap.increment == 1 {
-            self.arc_start = Some(sys.u_prev[k]);
+            self.arc_start = Some(sys.previous_displacements()[k]);
         }
         if !snap.end_of_step {
             return;
         }
-        let x = sys.u[k];
+        let x = sys.displacements()[k];
         let start = self.arc_start.unwrap_or(0.0);
         let reached_u = (x - v) * (v - start).signum() >= 0.0;
         let reached_f = match (a.target_factor, snap.arc_length_factor) {
@@ -291,7 +285,7 @@ impl UltimateWatch {
     fn bar_events(&mut self, snap: &Snapshot, k: usize) {
         let sys = snap.system;
         let model = sys.model;
-        for (&(b, _), out) in sys.bar_gps.iter().zip(&sys.families.bars.out.committed) {
+        for ((b, _), out) in sys.bar_outputs() {
             if out.plastic_strain == 0.0 {
                 continue;
             }
@@ -564,8 +558,7 @@ fn after_yield(y: &Event, v: &[f64], load: &str) -> String {
 fn crushing(model: &Model, snap: &Snapshot, k: usize) -> Vec<Event> {
     let sys = snap.system;
     let crushed_points = |e: usize| {
-        sys.families.continuum.points.committed[sys.gp_offset[e]..sys.gp_offset[e + 1]]
-            .iter()
+        (sys.element_points(e).iter())
             .filter(|p| p.is_crushed())
             .count()
     };
