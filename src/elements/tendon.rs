@@ -1207,7 +1207,12 @@ mod tests {
                 f: &mut f,
                 k: Some(&mut k),
             };
-            let got = ElementResponse::response(&t, &u, &t.initial_state(), &mut trial, into);
+            let strains = t.initial_strains().to_vec();
+            let el = InForce {
+                tendon: &t,
+                strains: &strains,
+            };
+            let got = ElementResponse::response(&el, &u, &t.initial_state(), &mut trial, into);
             assert_eq!(got.unwrap(), symmetric, "{mode:?}");
             assert!(trial.is_some());
         }
