@@ -218,7 +218,9 @@ fn summary_and_report_state_the_path_error_of_an_arc_length_run() {
 /// Measurement (not a check): a shear beam of docs/validation.md ("Shear beams"):
 /// `SEGFEM_BEAM` (OA1, B1), `SEGFEM_ROWS` (10), `SEGFEM_INC_MM` (plate increment, 0.2),
 /// `SEGFEM_PUSH_MM` (20), `SEGFEM_OPTION` (the bench's model option, "fixed, seed β"),
-/// `SEGFEM_TOL` (none: off); prints its peak.
+/// `SEGFEM_TOL` (`increment_tolerance`), `SEGFEM_IMPLEX_TOL` (`implex_tolerance`),
+/// `SEGFEM_IMPLEX_FORCE_TOL` (`implex_force_tolerance`) (each none: off); prints its peak,
+/// increments, CPU time and the controls' counts.
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_shear_beam() {
@@ -230,6 +232,8 @@ fn measure_shear_beam() {
     let push: f64 = var("SEGFEM_PUSH_MM", "20").parse().unwrap();
     let option = var("SEGFEM_OPTION", "fixed, seed β");
     let tol = std::env::var("SEGFEM_TOL").ok();
+    let implex_tol = std::env::var("SEGFEM_IMPLEX_TOL").ok();
+    let force_tol = std::env::var("SEGFEM_IMPLEX_FORCE_TOL").ok();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
     let beam = read_beams(&path)
         .unwrap()
@@ -237,19 +241,32 @@ fn measure_shear_beam() {
         .find(|b| b.id == id)
         .unwrap();
     let keys = options().into_iter().find(|o| o.0 == option).unwrap().1;
-    let solver = tol
-        .as_ref()
-        .map_or(String::new(), |t| format!("increment_tolerance = {t}\n"));
-    let cpu0 = std::time::Instant::now();
+    let mut solver = String::new();
+    for (key, v) in [
+        ("increment_tolerance", &tol),
+        ("implex_tolerance", &implex_tol),
+        ("implex_force_tolerance", &force_tol),
+    ] {
+        if let Some(v) = v {
+            solver.push_str(&format!("{key} = {v}\n"));
+        }
+    }
+    let cpu0 = bench::process_cpu_s();
     let r = run_beam_solver(&beam, keys, rows, -push * 1e-3, inc * 1e-3, &solver).unwrap();
+    let counts = r.controls.map_or("counts lost (no equilibrium at the end)".to_string(), |c| {
+        format!(
+            "implex cuts / over / max {:?}, force {:?}, pairs rejected {}",
+            c.implex, c.implex_force, c.pairs_rejected
+        )
+    });
     eprintln!(
-        "MEASURE {id} {rows} rows, {inc} mm, tol {tol:?}, {option}: peak {:.1} kN (test {:.0} kN, {:+.1} %), end {:.2} of peak, {:?}, {} increments, {:.1} s",
+        "MEASURE {id} {rows} rows, {inc} mm, tol {tol:?}, implex {implex_tol:?}, force {force_tol:?}, {option}: peak {:.1} kN (test {:.0} kN, {:+.1} %), end {:.2} of peak, {:?}, {} increments, {:.1} s CPU, {counts}",
         r.p_peak / 1e3,
         beam.test.0 / 1e3,
         100.0 * (r.p_peak / beam.test.0 - 1.0),
         r.end_ratio,
         r.ultimate.as_ref().map(|u| u.mode.clone()),
         r.increments,
-        cpu0.elapsed().as_secs_f64()
+        bench::process_cpu_s() - cpu0
     );
 }
