@@ -351,9 +351,6 @@ pub(super) fn implex_retry(
         .flatten()
         .map(|&(e, t)| e / t)
         .fold(0.0, f64::max);
-    if std::env::var("SEGFEM_TRACE_IMPLEX").is_ok() {
-        eprintln!("TRACE {size:.4e} {:.4e} {:.4e}", sys.implex_error(), sys.implex_force_error());
-    }
     let over = |m: Option<(f64, f64)>| m.is_some_and(|(e, t)| e > t);
     let smallest = nominal * 0.5_f64.powi(controls.max_cuts as i32);
     let falls = last.is_none_or(|l| ratio < IMPLEX_MIN_REDUCTION * l);
@@ -392,5 +389,7 @@ pub(super) fn implex_retry(
 /// An IMPL-EX error and its tolerance for the verbose log, in `unit` (empty when the
 /// measure is off).
 fn describe(m: Option<(f64, f64)>, unit: &str) -> String {
-    m.map_or(String::new(), |(e, t)| format!("{e:.3e} (tolerance {t} {unit})"))
+    m.map_or(String::new(), |(e, t)| {
+        format!("{e:.3e} (tolerance {t} {unit})")
+    })
 }

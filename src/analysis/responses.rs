@@ -99,7 +99,8 @@ pub(super) fn element_geometry(
     let el = &model.elements[e];
     let n = el.nodes.len();
     if el.integration != Integration::Incompatible {
-        if let Some(g) = cache.and_then(|c| c.get(e, n, rule_points(el.kind, el.integration).len())) {
+        if let Some(g) = cache.and_then(|c| c.get(e, n, rule_points(el.kind, el.integration).len()))
+        {
             return g;
         }
     }

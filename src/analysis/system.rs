@@ -1058,12 +1058,7 @@ impl<'m> System<'m> {
                 }
             }
         }
-        let norm = self
-            .to_free(&r)
-            .iter()
-            .map(|v| v * v)
-            .sum::<f64>()
-            .sqrt();
+        let norm = self.to_free(&r).iter().map(|v| v * v).sum::<f64>().sqrt();
         if self.last.force_scale > 0.0 {
             norm / self.last.force_scale
         } else {

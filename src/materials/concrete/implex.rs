@@ -110,12 +110,7 @@ pub fn direction_error(p: &ConcreteParams, alpha: f64, (ex, emax): (f64, f64), e
 
 /// Signed IMPL-EX error of one crack direction [Pa]: σ_implex − σ_implicit at crack strain
 /// `e` [-] (arguments as [`direction_error`]; 0 for a compressed direction).
-pub fn direction_difference(
-    p: &ConcreteParams,
-    alpha: f64,
-    (ex, emax): (f64, f64),
-    e: f64,
-) -> f64 {
+pub fn direction_difference(p: &ConcreteParams, alpha: f64, (ex, emax): (f64, f64), e: f64) -> f64 {
     if e <= 0.0 {
         return 0.0;
     }
