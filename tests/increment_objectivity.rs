@@ -338,3 +338,45 @@ fn shear_beam_peak_with_the_global_implex_control_does_not_depend_on_the_increme
         );
     }
 }
+
+/// summary.json and the report state what the global IMPL-EX control did (the concrete seed
+/// beam at the example's increments with `implex_force_tolerance = 5e-3`, through the
+/// `segfem` command; measured 51 cuts, 5 increments kept above the tolerance, largest kept
+/// error 1.03e-2, docs/validation.md): the cuts, the increments kept above the tolerance
+/// and the largest kept error, consistent with each other (kept above the tolerance exactly
+/// when the largest kept error exceeds it), and the same figures in the report's row.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "release test: an IMPL-EX-controlled run to failure"
+)]
+fn summary_and_report_state_the_global_implex_error() {
+    use common::{code, segfem, stderr, TempDir};
+    let tmp = TempDir::new("implex-force-error");
+    let text = seed_text(1, 1.0, None) + "\n[solver]\nimplex_force_tolerance = 5e-3\n";
+    std::fs::write(tmp.join("m.toml"), text).unwrap();
+    let o = segfem(tmp.path(), &["run", "m.toml", "-o", "out", "-q"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(tmp.join("out/summary.json")).unwrap())
+            .unwrap();
+    let t = &summary["timings"];
+    let e = t["implex_force_max_error"].as_f64().expect("a force error");
+    let cuts = t["implex_force_cuts"].as_u64().unwrap_or(0);
+    let over = t["implex_force_over_tolerance"].as_u64().unwrap_or(0);
+    assert!(e > 0.0 && cuts > 0, "{t}");
+    assert_eq!(over > 0, e > 5e-3, "{t}");
+    assert!(
+        t.get("implex_max_error").is_none(),
+        "the point measure was off: {t}"
+    );
+    let o = segfem(tmp.path(), &["report", "out"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let html = std::fs::read_to_string(tmp.join("out/report.html")).unwrap();
+    assert!(
+        html.contains(&format!(
+            "largest kept {e:.2e} of the force scale; {cuts} increments cut for it; {over} kept above the tolerance"
+        )),
+        "no IMPL-EX force row"
+    );
+}
