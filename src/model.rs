@@ -447,6 +447,12 @@ pub struct SolverControls {
     /// most `max_cuts` times (docs/theory-concrete.md §5.2). None (the default): off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub implex_tolerance: Option<f64>,
+    /// Global IMPL-EX error control (`[solver] implex_force_tolerance`, a fraction of the
+    /// Newton test's force scale): an increment whose out-of-balance force of the IMPL-EX
+    /// crack stresses against the implicit laws exceeds it is retried at half the size, as
+    /// with `implex_tolerance` (docs/theory-concrete.md §5.2). None (the default): off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub implex_force_tolerance: Option<f64>,
     /// Error-controlled increments of load steps (without `time`), displacement steps and
     /// arc-length steps on nonlinear materials (`[solver] increment_tolerance`,
     /// docs/theory.md): each pair of increments (of arcs) is solved whole and as its halves
@@ -468,6 +474,7 @@ impl Default for SolverControls {
             max_cuts: 6,
             predictor: Predictor::LastConverged,
             implex_tolerance: None,
+            implex_force_tolerance: None,
             increment_tolerance: None,
             verbose: false,
         }

@@ -205,6 +205,19 @@ pub struct Timings {
     /// control is off).
     #[serde(skip_serializing_if = "is_zero_f")]
     pub implex_max_error: f64,
+    /// Global IMPL-EX error control (`[solver] implex_force_tolerance`): increments retried
+    /// at half the size because the out-of-balance force of their IMPL-EX crack stresses
+    /// exceeded the tolerance.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_force_cuts: usize,
+    /// Increments accepted with that force error above the tolerance (at the smallest size,
+    /// or not reduced by a halving).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub implex_force_over_tolerance: usize,
+    /// The largest global IMPL-EX error of an accepted increment [-] (fraction of the
+    /// Newton test's force scale; 0 when the control is off).
+    #[serde(skip_serializing_if = "is_zero_f")]
+    pub implex_force_max_error: f64,
     /// Error-controlled increments (`[solver] increment_tolerance`, time steps'
     /// `substep_tolerance`): pairs of increments rejected because the halves missed the
     /// whole by more than the tolerance.
@@ -310,14 +323,15 @@ pub(super) fn note_limit_point(
 /// attempt's, or the increment is kept as it is (the error is not controlled by the size).
 const IMPLEX_MIN_REDUCTION: f64 = 0.9;
 
-/// IMPL-EX error control after a converged increment (`[solver] implex_tolerance`,
-/// docs/theory-concrete.md §5.2): true if the increment is to be thrown away and retried at
-/// half its size — its largest IMPL-EX error exceeds the tolerance, it is larger than the
-/// smallest size (the step's nominal increment halved `max_cuts` times; `size` and
-/// `nominal` in any common unit), and the error fell with the last halving (below 0.9 of the
-/// error `last` of the previous attempt of this increment, which this updates; a crack that
-/// jumps open at fixed load keeps its error whatever the size). An increment kept above the
-/// tolerance is counted in `timings`. Always false without the option.
+/// IMPL-EX error control after a converged increment (`[solver] implex_tolerance` and
+/// `implex_force_tolerance`, docs/theory-concrete.md §5.2): true if the increment is to be
+/// thrown away and retried at half its size — one of its IMPL-EX errors exceeds its
+/// tolerance, it is larger than the smallest size (the step's nominal increment halved
+/// `max_cuts` times; `size` and `nominal` in any common unit), and the error fell with the
+/// last halving (the larger ratio of error to tolerance below 0.9 of the previous attempt's
+/// of this increment, `last`, which this updates; a crack that jumps open at fixed load
+/// keeps its error whatever the size). An increment kept above a tolerance is counted in
+/// `timings`. Always false without the options.
 pub(super) fn implex_retry(
     sys: &super::system::System,
     timings: &mut Timings,
@@ -325,29 +339,57 @@ pub(super) fn implex_retry(
     last: &mut Option<f64>,
 ) -> bool {
     let controls = &sys.model.controls;
-    let Some(tol) = controls.implex_tolerance else {
+    let (point_tol, force_tol) = (controls.implex_tolerance, controls.implex_force_tolerance);
+    if point_tol.is_none() && force_tol.is_none() {
         return false;
-    };
-    let err = sys.implex_error();
+    }
+    let point = point_tol.map(|tol| (sys.implex_error(), tol));
+    let force = force_tol.map(|tol| (sys.implex_force_error(), tol));
+    // The decisive measure: the larger ratio of error to tolerance.
+    let ratio = [point, force]
+        .iter()
+        .flatten()
+        .map(|&(e, t)| e / t)
+        .fold(0.0, f64::max);
+    let over = |m: Option<(f64, f64)>| m.is_some_and(|(e, t)| e > t);
     let smallest = nominal * 0.5_f64.powi(controls.max_cuts as i32);
-    let falls = last.is_none_or(|l| err < IMPLEX_MIN_REDUCTION * l);
-    if err > tol && falls && 0.5 * size >= smallest * (1.0 - 1e-9) {
-        timings.implex_cuts += 1;
-        *last = Some(err);
+    let falls = last.is_none_or(|l| ratio < IMPLEX_MIN_REDUCTION * l);
+    if ratio > 1.0 && falls && 0.5 * size >= smallest * (1.0 - 1e-9) {
+        timings.implex_cuts += usize::from(over(point));
+        timings.implex_force_cuts += usize::from(over(force));
+        *last = Some(ratio);
         if controls.verbose {
-            eprintln!("    IMPL-EX error {err:.3} f_tm > {tol} f_tm: increment halved");
+            eprintln!(
+                "    IMPL-EX error {} {}: increment halved",
+                describe(point, "f_tm"),
+                describe(force, "of the force scale")
+            );
         }
         return true;
     }
     *last = None;
-    if err > tol {
-        timings.implex_over_tolerance += 1;
-        if controls.verbose {
-            eprintln!(
-                "    IMPL-EX error {err:.3} f_tm > {tol} f_tm kept (smallest increment, or not reduced by halving)"
-            );
-        }
+    timings.implex_over_tolerance += usize::from(over(point));
+    timings.implex_force_over_tolerance += usize::from(over(force));
+    if ratio > 1.0 && controls.verbose {
+        eprintln!(
+            "    IMPL-EX error {} {} kept (smallest increment, or not reduced by halving)",
+            describe(point, "f_tm"),
+            describe(force, "of the force scale")
+        );
     }
-    timings.implex_max_error = timings.implex_max_error.max(err);
+    if let Some((e, _)) = point {
+        timings.implex_max_error = timings.implex_max_error.max(e);
+    }
+    if let Some((e, _)) = force {
+        timings.implex_force_max_error = timings.implex_force_max_error.max(e);
+    }
     false
+}
+
+/// An IMPL-EX error and its tolerance for the verbose log, in `unit` (empty when the
+/// measure is off).
+fn describe(m: Option<(f64, f64)>, unit: &str) -> String {
+    m.map_or(String::new(), |(e, t)| {
+        format!("{e:.3e} (tolerance {t} {unit})")
+    })
 }

@@ -88,6 +88,33 @@ pub(super) fn crack_band_width(model: &Model, cache: Option<&GeometryCache>, e: 
     gauss_geometry(kind, rule, &coords[..el.nodes.len()]).h
 }
 
+/// The Gauss-point geometry of continuum element `e` ([`GaussGeometry`]) from `cache` where
+/// stored, else computed; an element with incompatible modes gives its Q4 rule's (the
+/// compatible part of its strains).
+pub(super) fn element_geometry(
+    model: &Model,
+    cache: Option<&GeometryCache>,
+    e: usize,
+) -> GaussGeometry {
+    let el = &model.elements[e];
+    let n = el.nodes.len();
+    if el.integration != Integration::Incompatible {
+        if let Some(g) = cache.and_then(|c| c.get(e, n, rule_points(el.kind, el.integration).len()))
+        {
+            return g;
+        }
+    }
+    let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+    for (a, &node) in el.nodes.iter().enumerate() {
+        coords[a] = model.nodes[node];
+    }
+    let (kind, rule) = match el.integration {
+        Integration::Incompatible => (crate::model::ElementKind::Q4, Integration::Full),
+        i => (el.kind, i),
+    };
+    gauss_geometry(kind, rule, &coords[..n])
+}
+
 /// What the continuum elements of one chunk share (read-only).
 pub(super) struct HostChunk<'a> {
     model: &'a Model,

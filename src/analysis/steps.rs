@@ -275,7 +275,9 @@ fn load_step(
     let tolerance = step.time.and_then(|t| t.tolerance).or(path_tolerance);
     // With the IMPL-EX error control the increments grow back after cuts, as in
     // displacement control (time steps with substep pairs set their own).
-    let growth = if model.controls.implex_tolerance.is_some() && tolerance.is_none() {
+    let implex_control = model.controls.implex_tolerance.is_some()
+        || model.controls.implex_force_tolerance.is_some();
+    let growth = if implex_control && tolerance.is_none() {
         Growth::WhenEasy
     } else {
         Growth::Kept

@@ -107,6 +107,8 @@ struct LastAssembly {
     u: Vec<f64>,
     forces: Vec<f64>,
     latched: Vec<usize>,
+    /// The force scale of the last assembly [N] ([`Assembled::force_scale`]).
+    force_scale: f64,
 }
 
 /// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
@@ -677,6 +679,7 @@ impl<'m> System<'m> {
             last.valid = true;
         }
         self.last.forces = forces;
+        self.last.force_scale = force_scale;
         Ok(Assembled {
             f_int: sc.f_int,
             k_values: sc.k_values,
@@ -767,6 +770,7 @@ impl<'m> System<'m> {
         self.last.latched.clear();
         self.symmetrised = false;
         let force_scale = sc.f_abs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.last.force_scale = force_scale;
         Some(Ok(Assembled {
             f_int: sc.f_int,
             k_values: None,
@@ -991,6 +995,80 @@ impl<'m> System<'m> {
             .reduce(|| 0.0, f64::max)
     }
 
+    /// The global IMPL-EX error of the trial states of the last assembly [-]
+    /// (`[solver] implex_force_tolerance`, docs/theory-concrete.md §5.2): the out-of-balance
+    /// force the IMPL-EX crack stresses leave against the implicit crack laws at the same
+    /// strains, r = Σ_e ∫ Bᵀ Δσ dV with Δσ of every IMPL-EX concrete point
+    /// ([`crate::materials::concrete::implex::point_stress_error`]), its Euclidean norm over
+    /// the free equations relative to the last assembly's force scale (the scale of the
+    /// Newton test, [`Assembled::force_scale`]). 0 without IMPL-EX points or before any
+    /// assembly. Small-strain B (also under `geometry = "nonlinear"`, where the measure is
+    /// an estimate); elements a construction stage has not placed are skipped.
+    pub fn implex_force_error(&self) -> f64 {
+        use crate::materials::point::Material;
+        let model = self.model;
+        let c = &self.families.continuum;
+        let ratio = self.time.extrapolation;
+        let stages = self.stages.as_ref();
+        // Each element's nodal forces, in parallel; summed into the dofs in element order.
+        let forces: Vec<Option<Vec<f64>>> = (0..model.elements.len())
+            .into_par_iter()
+            .map(|e| {
+                let el = &model.elements[e];
+                let Material::Concrete { params, .. } =
+                    &model.materials[model.regions[el.region].material].law
+                else {
+                    return None;
+                };
+                if !params.implex || stages.is_some_and(|s| !s.element_acts(e)) {
+                    return None;
+                }
+                let geo = responses::element_geometry(model, self.geometry.as_ref(), e);
+                let thickness = model.regions[el.region].thickness;
+                let n = el.nodes.len();
+                let mut f = vec![0.0; 2 * n];
+                let mut any = false;
+                for (g, gp) in (self.gp_offset[e]..self.gp_offset[e + 1]).enumerate() {
+                    let (PointState::Concrete(cs), PointState::Concrete(ts)) =
+                        (&c.points.committed[gp], &c.points.trial[gp])
+                    else {
+                        continue;
+                    };
+                    let ds = crate::materials::concrete::implex::point_stress_error(
+                        params, cs, ts, geo.h, ratio,
+                    );
+                    if ds == [0.0; 3] || g >= geo.n_pts {
+                        continue;
+                    }
+                    any = true;
+                    let (dn, wdet) = geo.points[g];
+                    let w = wdet * thickness;
+                    for a in 0..n {
+                        let (ax, ay) = (dn[a][0], dn[a][1]);
+                        f[2 * a] += w * (ax * ds[0] + ay * ds[2]);
+                        f[2 * a + 1] += w * (ay * ds[1] + ax * ds[2]);
+                    }
+                }
+                any.then_some(f)
+            })
+            .collect();
+        let mut r = vec![0.0; model.n_dofs()];
+        for (e, f) in forces.iter().enumerate() {
+            if let Some(f) = f {
+                for (a, &node) in model.elements[e].nodes.iter().enumerate() {
+                    r[2 * node] += f[2 * a];
+                    r[2 * node + 1] += f[2 * a + 1];
+                }
+            }
+        }
+        let norm = self.to_free(&r).iter().map(|v| v * v).sum::<f64>().sqrt();
+        if self.last.force_scale > 0.0 {
+            norm / self.last.force_scale
+        } else {
+            0.0
+        }
+    }
+
     /// Accept the trial states of the last assembly and the displacements `u`.
     pub fn commit(&mut self, u: &[f64]) {
         self.last.valid = false;
@@ -1104,5 +1182,149 @@ impl<'m> System<'m> {
         }
         self.stage_jump = jump;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::materials::concrete::ConcreteState;
+    use crate::materials::point::Material;
+
+    /// The global IMPL-EX error (`System::implex_force_error`, docs/theory-concrete.md §5.2)
+    /// against a hand value: one Q4 concrete element a × b = 0.2 × 0.1 m, thickness 0.15 m,
+    /// the left edge held in x and its lower node in y, every point with one crack at
+    /// φ = 30° that formed at 1.1 ε0 and opened to 3.1 ε0, now at 8 ε0 with the extrapolated
+    /// ẽ = 5.1 ε0 (ratio 1). Each point's crack-normal stress differs by
+    /// Δs = σ_env(ẽ) + ∫_ẽ^8ε0 σ_env(x)/x dx − σ_env(8 ε0) (the Hinton envelope written out,
+    /// the integral by Simpson's rule, error ~1e-12 f_tm), so Δσ = Δs n ⊗ n is uniform and
+    /// r_a = t Δσ ∫∇N_a dA with ∫∇N_a dA = (±b/2, ±a/2) for the rectangle (exact under the
+    /// 2 × 2 rule); the measure is ‖r‖ over the five free dofs divided by the force scale
+    /// (set here to 1 kN). Tolerance 1e-9 relative: round-off and Simpson's error.
+    #[test]
+    fn implex_force_error_matches_the_hand_nodal_forces() {
+        let (a, b, t): (f64, f64, f64) = (0.2, 0.1, 0.15);
+        let text = format!(
+            r#"
+[[materials]]
+name = "c"
+kind = "concrete"
+fcm = 38e6
+
+[[regions]]
+name = "r"
+material = "c"
+thickness = {t}
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [{a}, 0.0], [{a}, {b}], [0.0, {b}]]
+blocks = [{{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }}]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, {b}]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+
+[[load_cases]]
+name = "pull"
+line_loads = [{{ line = [[{a}, 0.0], [{a}, {b}]], q = [1e5, 0.0] }}]
+
+[[steps]]
+name = "s"
+kind = "load"
+loads = {{ pull = 1.0 }}
+increments = 1
+"#
+        );
+        let model = crate::input::parse(&text, "test.toml").unwrap().model;
+        let Material::Concrete { params: p, .. } = &model.materials[0].law else {
+            panic!("concrete expected");
+        };
+        assert!(p.implex, "IMPL-EX is the default");
+        let mut sys = System::new(&model);
+        let h = (a * b).sqrt();
+        let (e0, ft, alpha) = (p.eps0(), p.ftm, p.softening_alpha(h));
+        let phi = 30f64.to_radians();
+        let mut committed = ConcreteState::new();
+        committed.n_cracks = 1;
+        committed.crack_angle = phi;
+        committed.crack_max = [3.1 * e0, 0.0];
+        committed.crack_max_old = [1.1 * e0, 0.0];
+        let mut trial = committed.clone();
+        trial.crack_strain = [8.0 * e0, 0.0];
+        trial.crack_max = [8.0 * e0, 0.0];
+        let points = &mut sys.families.continuum.points;
+        for g in 0..4 {
+            points.committed[g] = PointState::Concrete(Box::new(committed.clone()));
+            points.trial[g] = PointState::Concrete(Box::new(trial.clone()));
+        }
+        sys.time.extrapolation = 1.0;
+        let scale = 1e3;
+        sys.last.force_scale = scale;
+        // Δs by hand.
+        let env = |x: f64| ft * (-(x - e0) / alpha).exp();
+        let (lo, hi, n) = (5.1 * e0, 8.0 * e0, 4000);
+        let dx = (hi - lo) / n as f64;
+        let simpson = (0..=n)
+            .map(|i| {
+                let x = lo + i as f64 * dx;
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * env(x) / x
+            })
+            .sum::<f64>()
+            * dx
+            / 3.0;
+        let ds = env(lo) + simpson - env(hi);
+        assert!(ds > 0.1 * ft, "an overshoot to measure: {ds}");
+        let (c, s) = (phi.cos(), phi.sin());
+        let sig = [ds * c * c, ds * s * s, ds * c * s];
+        // Free dofs: node 2 (x, y), node 3 (x, y), node 4 (y).
+        let force = |g: [f64; 2]| {
+            [
+                t * (sig[0] * g[0] + sig[2] * g[1]),
+                t * (sig[2] * g[0] + sig[1] * g[1]),
+            ]
+        };
+        let (f2, f3, f4) = (
+            force([b / 2.0, -a / 2.0]),
+            force([b / 2.0, a / 2.0]),
+            force([-b / 2.0, a / 2.0]),
+        );
+        let want = [f2[0], f2[1], f3[0], f3[1], f4[1]]
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
+            .sqrt()
+            / scale;
+        let got = sys.implex_force_error();
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "measure {got:.12e}, want {want:.12e}"
+        );
+        // Without extrapolation (ratio 0: ẽ = ε_max) the law leaves the envelope earlier
+        // and overshoots more.
+        sys.time.extrapolation = 0.0;
+        let larger = sys.implex_force_error();
+        assert!(larger > got, "{larger} vs {got}");
+        // Unchanged crack strain at ε_max with no extrapolation: both laws give σ_env(ε_max).
+        let points = &mut sys.families.continuum.points;
+        for g in 0..4 {
+            let mut same = committed.clone();
+            same.crack_strain = [3.1 * e0, 0.0];
+            points.trial[g] = PointState::Concrete(Box::new(same));
+        }
+        assert!(sys.implex_force_error() < 1e-12, "no error on the envelope");
     }
 }

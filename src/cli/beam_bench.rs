@@ -265,6 +265,20 @@ pub struct BeamRun {
     pub seconds: f64,
     /// Stress locking of the cracked concrete at the peak increment.
     pub locking: Locking,
+    /// The error controls' counts (None when the run ended without equilibrium: the
+    /// driver returns only the error then).
+    pub controls: Option<ControlCounts>,
+}
+
+/// What the error controls of a beam run did (summary.json `timings`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlCounts {
+    /// `implex_tolerance`: increments cut, kept above the tolerance, largest kept error [-].
+    pub implex: (usize, usize, f64),
+    /// `implex_force_tolerance`: the same for the global measure [-].
+    pub implex_force: (usize, usize, f64),
+    /// `increment_tolerance`: pairs rejected.
+    pub pairs_rejected: usize,
 }
 
 /// Stress locking measure of the cracked concrete points of one committed state: how far
@@ -389,10 +403,21 @@ pub fn run_beam_solver(
     };
     // A brittle shear failure ends the run where no equilibrium is found: the peak is the
     // result either way.
-    let converged = match steps::run(model, &mut w) {
-        Ok(_) => true,
+    let (converged, timings) = match steps::run(model, &mut w) {
+        Ok(t) => (
+            true,
+            Some(ControlCounts {
+                implex: (t.implex_cuts, t.implex_over_tolerance, t.implex_max_error),
+                implex_force: (
+                    t.implex_force_cuts,
+                    t.implex_force_over_tolerance,
+                    t.implex_force_max_error,
+                ),
+                pairs_rejected: t.increments_rejected,
+            }),
+        ),
         Err(steps::AnalysisError::NotConverged(_)) | Err(steps::AnalysisError::Mechanism(_)) => {
-            false
+            (false, None)
         }
         Err(e) => return Err(e.to_string()),
     };
@@ -410,6 +435,7 @@ pub fn run_beam_solver(
         increments: w.rows.len(),
         seconds: t0.elapsed().as_secs_f64(),
         locking,
+        controls: timings,
     })
 }
 

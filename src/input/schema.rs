@@ -367,6 +367,7 @@ pub struct SolverIn {
     pub max_cuts: Option<usize>,
     pub predictor: Option<String>,
     pub implex_tolerance: Option<f64>,
+    pub implex_force_tolerance: Option<f64>,
     pub increment_tolerance: Option<f64>,
 }
 

@@ -390,6 +390,16 @@ fn summary_section(dir: &Path) -> (String, String) {
             ),
         );
     }
+    if let Some(e) = t["implex_force_max_error"].as_f64() {
+        row(
+            "IMPL-EX out-of-balance force (implex_force_tolerance)",
+            format!(
+                "largest kept {e:.2e} of the force scale; {} increments cut for it; {} kept above the tolerance",
+                t["implex_force_cuts"].as_u64().unwrap_or(0),
+                t["implex_force_over_tolerance"].as_u64().unwrap_or(0)
+            ),
+        );
+    }
     if let Some(m) = v["peak_memory_bytes"].as_f64() {
         row("peak memory [MiB]", format!("{:.1}", m / 1048576.0));
     }

@@ -45,6 +45,10 @@ const ENERGY_TOLERANCE: (f64, f64) = (1e-30, 1e-2);
 /// Range of `solver.implex_tolerance` [-], a fraction of f_tm: an error above f_tm is no
 /// control.
 const IMPLEX_TOLERANCE: (f64, f64) = (1e-6, 1.0);
+/// Range of `solver.implex_force_tolerance` [-], a fraction of the Newton test's force
+/// scale: below 1e-8 round-off in the crack laws alone exceeds it; above 0.5 the crack
+/// stresses' out-of-balance force would be of the order of the structure's forces.
+const IMPLEX_FORCE_TOLERANCE: (f64, f64) = (1e-8, 0.5);
 
 /// `v` if it lies in `range` (inclusive), else an error naming the range and `what` the
 /// tolerance bounds.
@@ -122,6 +126,15 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
                 v,
                 IMPLEX_TOLERANCE,
                 "of the crack stress error relative to f_tm",
+            )?);
+        }
+        if let Some(v) = sv.implex_force_tolerance {
+            c.implex_force_tolerance = Some(in_range(
+                ctx,
+                "solver.implex_force_tolerance",
+                v,
+                IMPLEX_FORCE_TOLERANCE,
+                "of the crack stresses' out-of-balance force relative to the force scale",
             )?);
         }
         if let Some(v) = sv.increment_tolerance {

@@ -105,10 +105,84 @@ pub fn implicit_tension(p: &ConcreteParams, alpha: f64, emax: f64, e: f64) -> f6
 /// [-], extrapolated largest strain `ex` [-] and committed largest strain `emax` [-] (0 for
 /// a compressed direction, which both integrations treat alike).
 pub fn direction_error(p: &ConcreteParams, alpha: f64, (ex, emax): (f64, f64), e: f64) -> f64 {
+    direction_difference(p, alpha, (ex, emax), e).abs()
+}
+
+/// Signed IMPL-EX error of one crack direction [Pa]: σ_implex − σ_implicit at crack strain
+/// `e` [-] (arguments as [`direction_error`]; 0 for a compressed direction).
+pub fn direction_difference(p: &ConcreteParams, alpha: f64, (ex, emax): (f64, f64), e: f64) -> f64 {
     if e <= 0.0 {
         return 0.0;
     }
-    (tension(p, alpha, ex, e).0 - implicit_tension(p, alpha, emax, e)).abs()
+    tension(p, alpha, ex, e).0 - implicit_tension(p, alpha, emax, e)
+}
+
+/// The crack-normal stress differences σ_implex − σ_implicit [Pa] of a concrete point's two
+/// crack directions at the end of an increment, and the angle φ [rad] of the first
+/// direction's normal from x (the second's is φ + 90°): the directions and laws of
+/// [`point_error`] (arguments as there), signed; zero where that measure is zero.
+pub fn direction_differences(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    trial: &ConcreteState,
+    char_length: f64,
+    ratio: f64,
+) -> ([f64; 2], f64) {
+    let mut d = [0.0; 2];
+    if !p.implex || trial.crushed || committed.crushed {
+        return (d, 0.0);
+    }
+    let alpha = p.softening_alpha(char_length);
+    let extrapolated = |i: usize| extrapolated_max(committed, i, ratio);
+    match p.crack_model {
+        CrackModel::Rotating => {
+            // Before the point has cracked its law is the one capped past ε0
+            // (`rotating::evaluate`), so the extrapolated strain is ε0.
+            for (i, di) in d.iter_mut().enumerate() {
+                let ex = if committed.n_cracks > 0 {
+                    extrapolated(i)
+                } else {
+                    p.eps0()
+                };
+                let e = trial.crack_strain[i];
+                *di = direction_difference(p, alpha, (ex, committed.crack_max[i]), e);
+            }
+        }
+        CrackModel::Fixed => {
+            // A crack formed in this increment (elastic in it) is not measured: where it
+            // forms at a jump of the strain, the jump does not shrink with the increment.
+            let n = trial.n_cracks.min(committed.n_cracks).min(2) as usize;
+            for (i, di) in d.iter_mut().enumerate().take(n) {
+                let e = trial.crack_strain[i];
+                let emax = committed.crack_max[i];
+                *di = direction_difference(p, alpha, (extrapolated(i), emax), e);
+            }
+        }
+    }
+    (d, trial.crack_angle)
+}
+
+/// The IMPL-EX stress error of a concrete point as a stress [Pa] (σ_xx, σ_yy, τ_xy):
+/// Δσ = Σ_i (σ_implex,i − σ_implicit,i) n_i ⊗ n_i over its two crack directions
+/// ([`direction_differences`], n_1 at φ from x, n_2 at φ + 90°). In the crack axes the two
+/// integrations differ only in the crack-normal stresses at the same strain (the shear
+/// retention's β(ε̃) is not compared, as in [`point_error`]), so this is the stress the
+/// implicit law would remove from (add to) the point at the converged strain.
+pub fn point_stress_error(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    trial: &ConcreteState,
+    char_length: f64,
+    ratio: f64,
+) -> [f64; 3] {
+    let ([d1, d2], phi) = direction_differences(p, committed, trial, char_length, ratio);
+    let (s, c) = phi.sin_cos();
+    // n_1 = (c, s), n_2 = (−s, c): n n = [[c², cs], [cs, s²]] and [[s², −cs], [−cs, c²]].
+    [
+        d1 * c * c + d2 * s * s,
+        d1 * s * s + d2 * c * c,
+        (d1 - d2) * c * s,
+    ]
 }
 
 /// IMPL-EX error of a concrete point at the end of an increment [-]: the largest
@@ -127,40 +201,6 @@ pub fn point_error(
     char_length: f64,
     ratio: f64,
 ) -> f64 {
-    if !p.implex || trial.crushed || committed.crushed {
-        return 0.0;
-    }
-    let alpha = p.softening_alpha(char_length);
-    let extrapolated = |i: usize| extrapolated_max(committed, i, ratio);
-    let mut err: f64 = 0.0;
-    match p.crack_model {
-        CrackModel::Rotating => {
-            // Before the point has cracked its law is the one capped past ε0
-            // (`rotating::evaluate`), so the extrapolated strain is ε0.
-            for i in 0..2 {
-                let ex = if committed.n_cracks > 0 {
-                    extrapolated(i)
-                } else {
-                    p.eps0()
-                };
-                let e = trial.crack_strain[i];
-                err = err.max(direction_error(p, alpha, (ex, committed.crack_max[i]), e));
-            }
-        }
-        CrackModel::Fixed => {
-            for i in 0..trial.n_cracks.min(2) as usize {
-                let e = trial.crack_strain[i];
-                if e <= 0.0 {
-                    continue;
-                }
-                // A crack formed in this increment (elastic in it) is not measured: where it
-                // forms at a jump of the strain, the jump does not shrink with the increment.
-                if i < committed.n_cracks as usize {
-                    let emax = committed.crack_max[i];
-                    err = err.max(direction_error(p, alpha, (extrapolated(i), emax), e));
-                }
-            }
-        }
-    }
-    err / p.ftm
+    let (d, _) = direction_differences(p, committed, trial, char_length, ratio);
+    d[0].abs().max(d[1].abs()) / p.ftm
 }
