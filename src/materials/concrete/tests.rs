@@ -893,3 +893,41 @@ mod creep;
 mod implex;
 /// Compression softening, rotating cracks and aggregate-interlock shear retention.
 mod shear;
+
+/// Start of the linear post-peak branch (`compression::softening_start`): where the MC90
+/// curve's slope reaches E_t = −hE/(1 − h). The slope of the ascending formula,
+/// dσ/dε = (f_cm/ε_c1)((k_p − 2η)(1 + aη) − (k_p η − η²) a)/(1 + aη)², a = k_p − 2, is
+/// written out here from the curve's inputs (f_cm, ε_c1, k_p) and evaluated at the start
+/// returned, beyond the peak, for three limits h. Tolerance 1e-9 of |E_t| (a quadratic's
+/// root, round-off).
+#[test]
+fn softening_start_is_where_the_mc90_slope_reaches_the_limit() {
+    for (fcm, h) in [(30e6, 0.25), (45e6, 0.1), (60e6, 0.4)] {
+        let mut p = ConcreteParams::from_mc90(fcm, 0.2);
+        p.softening_limit = h;
+        let c = p.curve();
+        let es = compression::softening_start(&p).expect("the curve gets that steep");
+        let eta = es / c.eps_c1;
+        assert!(eta > 1.0 && eta <= c.eta_lim, "beyond the peak: η = {eta}");
+        let a = c.kp - 2.0;
+        let slope = c.fcm / c.eps_c1
+            * ((c.kp - 2.0 * eta) * (1.0 + a * eta) - (c.kp * eta - eta * eta) * a)
+            / (1.0 + a * eta).powi(2);
+        let et = -h * p.ec / (1.0 - h);
+        assert!(
+            (slope - et).abs() < 1e-9 * et.abs(),
+            "f_cm {fcm}, h {h}: slope {slope} vs {et}"
+        );
+    }
+}
+
+/// The rotating crack model refuses the viscoplastic and initial-yield options (it has no
+/// compression plasticity of its own), and takes the defaults.
+#[test]
+fn rotating_cracks_refuse_an_initial_yield() {
+    let mut p = ConcreteParams::from_mc90(30e6, 0.2);
+    p.crack_model = CrackModel::Rotating;
+    assert!(p.validate().is_ok());
+    p.initial_yield_ratio = 0.3;
+    assert!(p.validate().is_err());
+}
