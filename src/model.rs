@@ -453,6 +453,11 @@ pub struct SolverControls {
     /// with `implex_tolerance` (docs/theory-concrete.md §5.2). None (the default): off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub implex_force_tolerance: Option<f64>,
+    /// The norm `implex_force_tolerance` bounds (`[solver] implex_force_norm`): the
+    /// out-of-balance force against the force scale (the default) or the energy of its
+    /// correction against the energy of the state (docs/theory-concrete.md §5.2).
+    #[serde(skip_serializing_if = "ImplexForceNorm::is_force")]
+    pub implex_force_norm: ImplexForceNorm,
     /// Error-controlled increments of load steps (without `time`), displacement steps and
     /// arc-length steps on nonlinear materials (`[solver] increment_tolerance`,
     /// docs/theory.md): each pair of increments (of arcs) is solved whole and as its halves
@@ -475,9 +480,29 @@ impl Default for SolverControls {
             predictor: Predictor::LastConverged,
             implex_tolerance: None,
             implex_force_tolerance: None,
+            implex_force_norm: ImplexForceNorm::Force,
             increment_tolerance: None,
             verbose: false,
         }
+    }
+}
+
+/// The norm of the global IMPL-EX error (`[solver] implex_force_norm`, docs/theory-concrete.md
+/// §5.2 "Global error control"), both dimensionless [-].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum ImplexForceNorm {
+    /// ‖r‖₂ over the free equations / the Newton test's force scale (the default).
+    Force,
+    /// √|r·K⁻¹r| / √|u·f_int|: the energy of the correction the out-of-balance force r
+    /// calls for with the last factorised tangent K, against the work of the current
+    /// internal forces on the current displacements (all dofs).
+    Energy,
+}
+
+impl ImplexForceNorm {
+    /// True for the default norm (then left out of the serialised controls).
+    pub fn is_force(&self) -> bool {
+        *self == Self::Force
     }
 }
 

@@ -61,9 +61,10 @@ fn count(n: usize, scale: f64) -> usize {
     ((n as f64 * scale).round() as usize).max(1)
 }
 
-/// Measurement (not a check): `SEGFEM_REFINE`, `SEGFEM_SCALE`, `SEGFEM_TOL` and
-/// `SEGFEM_IMPLEX_FORCE_TOL` (`increment_tolerance`, `implex_force_tolerance`; none: off)
-/// select a run of the seed beam; prints its row (docs/validation.md).
+/// Measurement (not a check): `SEGFEM_REFINE`, `SEGFEM_SCALE`, `SEGFEM_TOL`,
+/// `SEGFEM_IMPLEX_FORCE_TOL` and `SEGFEM_IMPLEX_NORM` (`increment_tolerance`,
+/// `implex_force_tolerance`, `implex_force_norm`; none: off / the default) select a run of
+/// the seed beam; prints its row (docs/validation.md).
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_seed_beam() {
@@ -78,6 +79,9 @@ fn measure_seed_beam() {
             text.push_str("\n[solver]\n");
         }
         text.push_str(&format!("implex_force_tolerance = {f}\n"));
+        if let Some(n) = var("SEGFEM_IMPLEX_NORM") {
+            text.push_str(&format!("implex_force_norm = \"{n}\"\n"));
+        }
     }
     let row = bench::seed_failure_of(&text, refine, true).unwrap_or_else(|e| panic!("{e}"));
     let t = &row.timings;
@@ -230,8 +234,9 @@ fn summary_and_report_state_the_path_error_of_an_arc_length_run() {
 /// `SEGFEM_BEAM` (OA1, B1), `SEGFEM_ROWS` (10), `SEGFEM_INC_MM` (plate increment, 0.2),
 /// `SEGFEM_PUSH_MM` (20), `SEGFEM_OPTION` (the bench's model option, "fixed, seed β"),
 /// `SEGFEM_TOL` (`increment_tolerance`), `SEGFEM_IMPLEX_TOL` (`implex_tolerance`),
-/// `SEGFEM_IMPLEX_FORCE_TOL` (`implex_force_tolerance`) (each none: off); prints its peak,
-/// increments, CPU time and the controls' counts.
+/// `SEGFEM_IMPLEX_FORCE_TOL` (`implex_force_tolerance`), `SEGFEM_IMPLEX_NORM`
+/// (`implex_force_norm`) (each none: off / the default); prints its peak, increments, CPU
+/// time and the controls' counts.
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_shear_beam() {
@@ -245,6 +250,9 @@ fn measure_shear_beam() {
     let tol = std::env::var("SEGFEM_TOL").ok();
     let implex_tol = std::env::var("SEGFEM_IMPLEX_TOL").ok();
     let force_tol = std::env::var("SEGFEM_IMPLEX_FORCE_TOL").ok();
+    let norm = std::env::var("SEGFEM_IMPLEX_NORM")
+        .ok()
+        .map(|v| format!("\"{v}\""));
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
     let beam = read_beams(&path)
         .unwrap()
@@ -257,6 +265,7 @@ fn measure_shear_beam() {
         ("increment_tolerance", &tol),
         ("implex_tolerance", &implex_tol),
         ("implex_force_tolerance", &force_tol),
+        ("implex_force_norm", &norm),
     ] {
         if let Some(v) = v {
             solver.push_str(&format!("{key} = {v}\n"));
@@ -273,7 +282,7 @@ fn measure_shear_beam() {
             )
         });
     eprintln!(
-        "MEASURE {id} {rows} rows, {inc} mm, tol {tol:?}, implex {implex_tol:?}, force {force_tol:?}, {option}: peak {:.1} kN (test {:.0} kN, {:+.1} %), end {:.2} of peak, {:?}, {} increments, {:.1} s CPU, {counts}",
+        "MEASURE {id} {rows} rows, {inc} mm, tol {tol:?}, implex {implex_tol:?}, force {force_tol:?} {norm:?}, {option}: peak {:.1} kN (test {:.0} kN, {:+.1} %), end {:.2} of peak, {:?}, {} increments, {:.1} s CPU, {counts}",
         r.p_peak / 1e3,
         beam.test.0 / 1e3,
         100.0 * (r.p_peak / beam.test.0 - 1.0),

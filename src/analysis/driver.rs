@@ -331,9 +331,12 @@ const IMPLEX_MIN_REDUCTION: f64 = 0.9;
 /// last halving (the larger ratio of error to tolerance below 0.9 of the previous attempt's
 /// of this increment, `last`, which this updates; a crack that jumps open at fixed load
 /// keeps its error whatever the size). An increment kept above a tolerance is counted in
-/// `timings`. Always false without the options.
+/// `timings`. `solver` (holding the last Newton iteration's factor), the displacements `u`
+/// [m] and internal forces `f_int` [N] of the converged attempt (all dofs) serve the
+/// energy norm (`implex_force_norm = "energy"`). Always false without the options.
 pub(super) fn implex_retry(
     sys: &super::system::System,
+    (solver, u, f_int): (&mut crate::linalg::solver::SparseCholesky, &[f64], &[f64]),
     timings: &mut Timings,
     (size, nominal): (f64, f64),
     last: &mut Option<f64>,
@@ -344,7 +347,17 @@ pub(super) fn implex_retry(
         return false;
     }
     let point = point_tol.map(|tol| (sys.implex_error(), tol));
-    let force = force_tol.map(|tol| (sys.implex_force_error(), tol));
+    let force = force_tol.map(|tol| {
+        let e = match controls.implex_force_norm {
+            crate::model::ImplexForceNorm::Force => sys.implex_force_error(),
+            crate::model::ImplexForceNorm::Energy => implex_energy_error(sys, solver, u, f_int),
+        };
+        (e, tol)
+    });
+    let force_unit = match controls.implex_force_norm {
+        crate::model::ImplexForceNorm::Force => "of the force scale",
+        crate::model::ImplexForceNorm::Energy => "in the energy norm",
+    };
     // The decisive measure: the larger ratio of error to tolerance.
     let ratio = [point, force]
         .iter()
@@ -362,7 +375,7 @@ pub(super) fn implex_retry(
             eprintln!(
                 "    IMPL-EX error {} {}: increment halved",
                 describe(point, "f_tm"),
-                describe(force, "of the force scale")
+                describe(force, force_unit)
             );
         }
         return true;
@@ -374,7 +387,7 @@ pub(super) fn implex_retry(
         eprintln!(
             "    IMPL-EX error {} {} kept (smallest increment, or not reduced by halving)",
             describe(point, "f_tm"),
-            describe(force, "of the force scale")
+            describe(force, force_unit)
         );
     }
     if let Some((e, _)) = point {
@@ -384,6 +397,39 @@ pub(super) fn implex_retry(
         timings.implex_force_max_error = timings.implex_force_max_error.max(e);
     }
     false
+}
+
+/// The global IMPL-EX error in the energy norm [-] (`[solver] implex_force_norm =
+/// "energy"`, docs/theory-concrete.md §5.2): with r the out-of-balance force of
+/// [`super::system::System::implex_force_error`] (free equations) and δu = K⁻¹ r one
+/// back-substitution with the factor `solver` holds (the tangent of the increment's last
+/// Newton iteration), √|r·δu| / √|u·f_int|: the energy of the correction the crack
+/// stresses' error calls for against the work of the internal forces `f_int` [N] on the
+/// displacements `u` [m] (all dofs, so that the prescribed displacements' reactions
+/// count). Absolute values: an indefinite (LDLᵀ) tangent past a limit point
+/// can make r·δu negative. 0 without IMPL-EX points, without a factor (an increment
+/// that converged before any factorisation) or with no work done.
+pub(super) fn implex_energy_error(
+    sys: &super::system::System,
+    solver: &mut crate::linalg::solver::SparseCholesky,
+    u: &[f64],
+    f_int: &[f64],
+) -> f64 {
+    let Some(r) = sys.implex_residual() else {
+        return 0.0;
+    };
+    if !solver.has_factor() {
+        return 0.0;
+    }
+    let mut du = r.clone();
+    solver.solve_in_place(&mut du);
+    let correction = r.iter().zip(&du).map(|(a, b)| a * b).sum::<f64>().abs();
+    let state = u.iter().zip(f_int).map(|(a, b)| a * b).sum::<f64>().abs();
+    if state > 0.0 && correction.is_finite() {
+        (correction / state).sqrt()
+    } else {
+        0.0
+    }
 }
 
 /// An IMPL-EX error and its tolerance for the verbose log, in `unit` (empty when the

@@ -583,7 +583,8 @@ pub(super) fn run<S: Sizing>(
         let verdict = ctl.converged(iterations, ctx.u, &ctx.sys.u, |c| {
             implex && {
                 let sizes = c.implex_sizes();
-                implex_retry(ctx.sys, ctx.timings, sizes, c.implex_last())
+                let energy = (&mut *ctx.solver, &ctx.u[..], &f_int[..]);
+                implex_retry(ctx.sys, energy, ctx.timings, sizes, c.implex_last())
             }
         });
         match verdict {

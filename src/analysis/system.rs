@@ -1005,6 +1005,20 @@ impl<'m> System<'m> {
     /// assembly. Small-strain B (also under `geometry = "nonlinear"`, where the measure is
     /// an estimate); elements a construction stage has not placed are skipped.
     pub fn implex_force_error(&self) -> f64 {
+        let Some(r) = self.implex_residual() else {
+            return 0.0;
+        };
+        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if self.last.force_scale > 0.0 {
+            norm / self.last.force_scale
+        } else {
+            0.0
+        }
+    }
+
+    /// The out-of-balance force of [`System::implex_force_error`] over the free equations
+    /// [N]; None when no point has an error.
+    pub(super) fn implex_residual(&self) -> Option<Vec<f64>> {
         use crate::materials::point::Material;
         let model = self.model;
         let c = &self.families.continuum;
@@ -1052,6 +1066,9 @@ impl<'m> System<'m> {
                 any.then_some(f)
             })
             .collect();
+        if forces.iter().all(Option::is_none) {
+            return None;
+        }
         let mut r = vec![0.0; model.n_dofs()];
         for (e, f) in forces.iter().enumerate() {
             if let Some(f) = f {
@@ -1061,12 +1078,7 @@ impl<'m> System<'m> {
                 }
             }
         }
-        let norm = self.to_free(&r).iter().map(|v| v * v).sum::<f64>().sqrt();
-        if self.last.force_scale > 0.0 {
-            norm / self.last.force_scale
-        } else {
-            0.0
-        }
+        Some(self.to_free(&r))
     }
 
     /// Accept the trial states of the last assembly and the displacements `u`.
@@ -1202,7 +1214,7 @@ mod tests {
     /// 2 × 2 rule); the measure is ‖r‖ over the five free dofs divided by the force scale
     /// (set here to 1 kN). Tolerance 1e-9 relative: round-off and Simpson's error.
     #[test]
-    fn implex_force_error_matches_the_hand_nodal_forces() {
+    fn implex_force_and_energy_errors_match_the_hand_nodal_forces() {
         let (a, b, t): (f64, f64, f64) = (0.2, 0.1, 0.15);
         let text = format!(
             r#"
@@ -1312,6 +1324,36 @@ increments = 1
         assert!(
             (got - want).abs() < 1e-9 * want,
             "measure {got:.12e}, want {want:.12e}"
+        );
+        // The energy norm with a diagonal stand-in tangent K = diag(k_q), k_q = (q + 1) ×
+        // 1e9 N/m by equation: r·K⁻¹r = Σ r_q² / k_q, against u·f_int over all dofs (a
+        // prescribed dof's reaction included: node 1's x, held by the support).
+        let pattern = &sys.asm.pattern;
+        let k = |q: usize| (q + 1) as f64 * 1e9;
+        let mut values = vec![0.0; pattern.row_idx.len()];
+        for j in 0..pattern.n {
+            let at = pattern.col_ptr[j];
+            assert_eq!(pattern.row_idx[at], j, "the diagonal first in its column");
+            values[at] = k(j);
+        }
+        let mut solver = crate::linalg::solver::SparseCholesky::new(pattern).unwrap();
+        let no_factor =
+            super::super::driver::implex_energy_error(&sys, &mut solver, &[1.0; 8], &[1.0; 8]);
+        assert_eq!(no_factor, 0.0, "no factor, no measure");
+        solver.factorize(pattern, &values).unwrap();
+        let by_dof = [(2, f2[0]), (3, f2[1]), (4, f3[0]), (5, f3[1]), (7, f4[1])];
+        let correction: f64 = by_dof.iter().map(|&(d, f)| f * f / k(sys.dofs.eq[d])).sum();
+        let mut u = [0.0; 8];
+        let mut f_int = [0.0; 8];
+        (u[0], f_int[0]) = (2e-4, -3e3);
+        (u[2], f_int[2]) = (1e-4, 4e3);
+        (u[7], f_int[7]) = (-5e-5, 2e3);
+        let state = (2e-4_f64 * -3e3 + 1e-4 * 4e3 - 5e-5 * 2e3).abs();
+        let want = (correction / state).sqrt();
+        let got = super::super::driver::implex_energy_error(&sys, &mut solver, &u, &f_int);
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "energy measure {got:.12e}, want {want:.12e}"
         );
         // Without extrapolation (ratio 0: ẽ = ε_max) the law leaves the envelope earlier
         // and overshoots more.

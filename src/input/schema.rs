@@ -368,6 +368,7 @@ pub struct SolverIn {
     pub predictor: Option<String>,
     pub implex_tolerance: Option<f64>,
     pub implex_force_tolerance: Option<f64>,
+    pub implex_force_norm: Option<String>,
     pub increment_tolerance: Option<f64>,
 }
 

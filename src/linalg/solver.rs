@@ -869,6 +869,12 @@ impl SparseCholesky {
         }
     }
 
+    /// Whether the solver holds a factor a solve can use (a successful factorisation, not
+    /// released since).
+    pub fn has_factor(&self) -> bool {
+        self.factor != Factor::None
+    }
+
     /// Solve A x = b in place (b is overwritten by x). Requires a successful `factorize`
     /// or `factorize_indefinite`.
     pub fn solve_in_place(&mut self, b: &mut [f64]) {

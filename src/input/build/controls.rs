@@ -5,7 +5,7 @@ use crate::elements::continuum::Integration;
 use crate::input::error::Ctx;
 use crate::input::limits;
 use crate::input::schema::{AnalysisIn, SolverIn};
-use crate::model::{Geometry, Model, Predictor};
+use crate::model::{Geometry, ImplexForceNorm, Model, Predictor};
 
 /// `[analysis] geometry`: linear (default) or nonlinear (total Lagrangian).
 pub(super) fn geometry(ctx: &Ctx, analysis: Option<&AnalysisIn>, model: &mut Model) -> R<()> {
@@ -136,6 +136,18 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
                 IMPLEX_FORCE_TOLERANCE,
                 "of the crack stresses' out-of-balance force relative to the force scale",
             )?);
+        }
+        if let Some(v) = sv.implex_force_norm.as_deref() {
+            c.implex_force_norm = match v {
+                "force" => ImplexForceNorm::Force,
+                "energy" => ImplexForceNorm::Energy,
+                o => {
+                    return Err(ctx.err(
+                        "solver.implex_force_norm",
+                        format!("unknown norm '{o}' (expected force or energy)"),
+                    ))
+                }
+            };
         }
         if let Some(v) = sv.increment_tolerance {
             c.increment_tolerance = Some(super::time::error_tolerance(
