@@ -148,6 +148,13 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
                     ))
                 }
             };
+            // A norm for a control that is off would be silently ignored.
+            if c.implex_force_tolerance.is_none() {
+                return Err(ctx.err(
+                    "solver.implex_force_norm",
+                    "used by solver.implex_force_tolerance only (give the tolerance too)",
+                ));
+            }
         }
         if let Some(v) = sv.increment_tolerance {
             c.increment_tolerance = Some(super::time::error_tolerance(
