@@ -931,3 +931,38 @@ fn rotating_cracks_refuse_an_initial_yield() {
     p.initial_yield_ratio = 0.3;
     assert!(p.validate().is_err());
 }
+
+/// A crack whose shear stress sits on the aggregate-interlock limit (`crack_shear_limit`,
+/// Vecchio & Collins 1986: τ = ±v_max(w), w = h ε_max): the tangent's coupling of τ to the
+/// crack-normal strain, ∂τ/∂ε_n = ±dv_max/dε, against central differences of the update
+/// (crack normal along x, so the local and global axes coincide; both signs of the shear).
+/// The τ–γ entry is β_min G by design (not consistent: a capped element is no mechanism),
+/// so only the first column is compared. Tolerance 1e-6 of E (closed-form law, h = 1e-8).
+#[test]
+fn shear_limit_tangent_follows_the_crack_opening() {
+    let mut p = fd_params();
+    p.crack_shear_limit = cracking::CrackShearLimit::VecchioCollins1986 { d_agg: 0.016 };
+    let c = upd(&p, &ConcreteState::new(), [1.5e-3, 0.0, 0.0]).0;
+    assert_eq!(c.n_cracks(), 1);
+    for g in [-3e-3, 3e-3] {
+        let e = [2e-3, 0.0, g];
+        let (_, s, d) = upd(&p, &c, e);
+        // On the limit: v_max at w = 0.1 m × ε_max written out (MPa, mm).
+        let w_mm = 0.1 * 2e-3 * 1e3;
+        let vmax = 0.18 * (p.fcm / 1e6).sqrt() / (0.31 + 24.0 * w_mm / (16.0 + 16.0)) * 1e6;
+        assert!(
+            (s[2].abs() - vmax).abs() < 1e-3 * vmax,
+            "τ = {} against v_max = {vmax}",
+            s[2]
+        );
+        let h = 1e-8;
+        let sp = upd(&p, &c, [e[0] + h, e[1], e[2]]).1;
+        let sm = upd(&p, &c, [e[0] - h, e[1], e[2]]).1;
+        let fd = (sp[2] - sm[2]) / (2.0 * h);
+        assert!(
+            (fd - d[2][0]).abs() < 1e-6 * p.ec,
+            "γ = {g}: ∂τ/∂εx {} against FD {fd}",
+            d[2][0]
+        );
+    }
+}
