@@ -966,3 +966,26 @@ fn shear_limit_tangent_follows_the_crack_opening() {
         );
     }
 }
+
+/// The implicit softening cut-off (`cracking::cap_softening`): a free principal stress
+/// σ1 = 1.6 f_tm above the cap f(κ) = f_tm exp(−κ/α) (the envelope past its peak, written
+/// out here) is brought back to the cap at the κ that solves E κ + f(κ) = σ1, and the
+/// stress returned is f(κ). Tolerance 1e-10 of f_tm (the bracketed Newton's stop is 1e-13).
+#[test]
+fn softening_cut_off_solves_its_cap_equation() {
+    let p = params();
+    let alpha = 5e-4;
+    for s1 in [1.6 * p.ftm, 3.0 * p.ftm] {
+        let mut sl = [s1, -0.2 * p.ftm, 0.0];
+        let mut dl = d_matrix(p.ec, 0.0);
+        let k = cracking::cap_softening(&p, alpha, 0.0, None, &mut sl, &mut dl, 0.0)
+            .expect("above the cap: active");
+        let f = p.ftm * (-k / alpha).exp();
+        assert!(
+            (p.ec * k + f - s1).abs() < 1e-10 * p.ftm,
+            "κ = {k}: E κ + f = {} against σ1 = {s1}",
+            p.ec * k + f
+        );
+        assert!((sl[0] - f).abs() < 1e-10 * p.ftm, "σ = {sl:?}, cap {f}");
+    }
+}
