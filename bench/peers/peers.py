@@ -12,6 +12,11 @@ checked, not assumed.
     python3 bench/peers/peers.py                # all problems, default sizes and rounds
     python3 bench/peers/peers.py --only q4 --sizes 1e4,1e5 --rounds 3
     python3 bench/peers/peers.py --only q4 --sizes 1e6 --programs OpenSees --opensees-system SparseSYM
+    python3 bench/peers/peers.py --only q4 --sizes 5e5 --modes one     # one core only
+
+Each peer runs its fastest solver, found by timing every candidate at each size
+(--opensees-system auto, --ccx-solver auto), and every program runs pinned to one core with
+one thread ("one") and on all cores ("all"); the table gives wall and CPU time of both.
 
 The nonlinear side by side (RC panel and beam) is bench/peers/nonlinear.py; the scaling
 figure bench/peers/scaling.py.
@@ -43,9 +48,38 @@ REPO = HERE.parent.parent
 WORK = HERE / "work"
 VENV_PY = HERE / ".venv" / "bin" / "python"
 
-# OpenSees' linear solver on the squares (--opensees-system): UmfPack is its fastest here up
-# to 5e5 dofs; at 1e6 dofs its analysis fails (the displacement stays 0), SparseSYM is used.
-OPENSEES_SYSTEM = "UmfPack"
+# OpenSees' linear solver on the squares (--opensees-system): "auto" times every candidate
+# once at each size (one core) and keeps the fastest that gives the right answer (UmfPack
+# fails at 1e6 dofs: its displacement stays 0). OpenSees takes BLAS and LAPACK from the
+# system's libblas.so.3 / liblapack.so.3, which install.sh points at OpenBLAS.
+OPENSEES_SYSTEM = "auto"
+OPENSEES_CANDIDATES = ("UmfPack", "SparseSYM", "SuperLU", "Mumps")
+# The numberer each system is run with: UmfPack, SuperLU and Mumps order the matrix
+# themselves; SparseSYM and the profile/band systems take RCM.
+OPENSEES_NUMBERER = {"UmfPack": "Plain", "SuperLU": "Plain", "Mumps": "Plain"}
+# CalculiX's *STATIC solvers this build has (PARDISO and PaStiX are not linked in Debian's
+# ccx 2.20); "auto" keeps the fastest, as for OpenSees.
+CCX_CANDIDATES = ("SPOOLES", "ITERATIVE CHOLESKY")
+CCX_SOLVER = "auto"
+# A time limit [s] on each timed process (None: none); set while candidates are selected.
+TIMEOUT = None
+
+# How the programs may use the machine (--modes): "one" pins every process to one core with
+# one thread (taskset -c 0 and every thread-count variable at 1); "all" lets each program use
+# every core (its threads at the core count). None: the environment as it is (nonlinear.py,
+# scaling.py).
+MODE = None
+THREAD_VARS = ("RAYON_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "CCX_NPROC_EQUATION_SOLVER")
+
+
+def mode_env_and_prefix(mode):
+    """The environment and command prefix of a run mode (see MODE)."""
+    env = dict(os.environ)
+    if mode is None:
+        return env, []
+    threads = "1" if mode == "one" else str(os.cpu_count() or 1)
+    env.update({v: threads for v in THREAD_VARS})
+    return env, (["taskset", "-c", "0"] if mode == "one" else [])
 
 # Material and load of the linear square (docs/performance.md, side by side): E [Pa], nu, t [m], total
 # shear force on the right edge [N].
@@ -126,7 +160,12 @@ def q4_n_for(dofs):
 # ---------------------------------------------------------------------------------------
 
 
-def write_linear(kind, n, d):
+def write_linear(kind, n, d, ops_system=None, ccx_solver="SPOOLES"):
+    """The square in each program's input under d; `ops_system` (OpenSees' system, default
+    OPENSEES_SYSTEM) and `ccx_solver` (CalculiX's *STATIC solver) name the peers' files
+    (opensees_<system>.py, ccx_<solver>.inp) so that every candidate can be timed."""
+    # Outside peers.py's selection (scaling.py): the given system, or UmfPack for "auto".
+    ops_system = ops_system or (OPENSEES_SYSTEM if OPENSEES_SYSTEM != "auto" else "UmfPack")
     d.mkdir(parents=True, exist_ok=True)
     nodes, elems = square_mesh(kind, n)
     per_row = n + 1 if kind == "Q4" else 2 * n + 1
@@ -176,9 +215,10 @@ loads = {{ shear = 1.0 }}
 """
     )
     files["segfem"] = d / "segfem.toml"
-    # CalculiX: CPS4 / CPS8 (plane stress), SPOOLES, the tip displacement printed to .dat.
+    # CalculiX: CPS4 / CPS8 (plane stress), `ccx_solver`, the tip displacement printed to .dat.
     etype = "CPS4" if kind == "Q4" else "CPS8"
-    with open(d / "ccx.inp", "w") as f:
+    ccx_file = d / f"ccx_{ccx_solver.replace(' ', '_').lower()}.inp"
+    with open(ccx_file, "w") as f:
         f.write("*NODE, NSET=NALL\n")
         f.writelines(f"{i + 1},{x!r},{y!r}\n" for i, (x, y) in enumerate(nodes))
         f.write(f"*ELEMENT, TYPE={etype}, ELSET=EALL\n")
@@ -191,16 +231,16 @@ loads = {{ shear = 1.0 }}
         f.write(f"*MATERIAL, NAME=M\n*ELASTIC\n{E!r},{NU!r}\n")
         f.write(f"*SOLID SECTION, ELSET=EALL, MATERIAL=M\n{T!r}\n")
         f.write("*BOUNDARY\nLEFT,1,2\n")
-        f.write("*STEP\n*STATIC\n*CLOAD\n")
+        f.write(f"*STEP\n*STATIC, SOLVER={ccx_solver}\n*CLOAD\n")
         f.writelines(f"{i + 1},2,{fy!r}\n" for i, fy in zip(right, forces) if fy != 0.0)
         f.write("*NODE PRINT, NSET=TIP\nU\n*END STEP\n")
-    files["CalculiX"] = d / "ccx.inp"
-    # OpenSees: quad / quad8n PlaneStress, UmfPack (the fastest of its direct solvers on
-    # these squares here: 4.2 s against SparseSYM's 5.9 s at 1e5 dofs). The script builds
-    # the mesh with the same generator, as a user's script would (not from a literal list,
-    # which Python would be slow to parse).
+    files["CalculiX"] = ccx_file
+    # OpenSees: quad / quad8n PlaneStress, `ops_system` (chosen by measurement at each size,
+    # `--opensees-system auto`). The script builds the mesh with the same generator, as a
+    # user's script would (not from a literal list, which Python would be slow to parse).
     ele = "quad" if kind == "Q4" else "quad8n"
-    with open(d / "opensees.py", "w") as f:
+    ops_file = d / f"opensees_{ops_system.lower()}.py"
+    with open(ops_file, "w") as f:
         f.write(
             "import openseespy.opensees as ops\n"
             + inspect.getsource(square_mesh)
@@ -217,12 +257,12 @@ loads = {{ shear = 1.0 }}
             "ops.timeSeries('Linear', 1)\nops.pattern('Plain', 1, 1)\n"
             "for i, fy in zip(right, forces):\n"
             "    if fy != 0.0:\n        ops.load(i + 1, 0.0, fy)\n"
-            f"ops.system('{OPENSEES_SYSTEM}')\nops.numberer('{'RCM' if OPENSEES_SYSTEM != 'UmfPack' else 'Plain'}')\nops.constraints('Plain')\n"
+            f"ops.system('{ops_system}')\nops.numberer('{OPENSEES_NUMBERER.get(ops_system, 'RCM')}')\nops.constraints('Plain')\n"
             "ops.integrator('LoadControl', 1.0)\nops.algorithm('Linear')\n"
             "ops.analysis('Static')\nassert ops.analyze(1) == 0, 'analysis failed'\n"
             "print('RESULT', repr(ops.nodeDisp(right[-1] + 1, 2)))\n"
         )
-    files["OpenSees"] = d / "opensees.py"
+    files["OpenSees"] = ops_file
     return files
 
 
@@ -531,12 +571,15 @@ CPU_TIMES = []
 def timed(cmd, cwd, ok=(0,)):
     """Run cmd under /usr/bin/time -v; return (wall s, peak RSS bytes, stdout, stderr).
     An exit status outside `ok` is an error."""
+    env, prefix = mode_env_and_prefix(MODE)
     t0 = time.perf_counter()
     p = subprocess.run(
-        ["/usr/bin/time", "-v"] + [str(c) for c in cmd],
+        prefix + ["/usr/bin/time", "-v"] + [str(c) for c in cmd],
         cwd=cwd,
         capture_output=True,
         text=True,
+        env=env,
+        timeout=TIMEOUT,
     )
     wall = time.perf_counter() - t0
     m = re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr)
@@ -568,7 +611,8 @@ def run_ccx(path, parse):
     job = path.stem
     for ext in (".dat", ".frd", ".sta", ".cvg", ".12d"):
         (path.parent / (job + ext)).unlink(missing_ok=True)
-    env_cmd = ["env", "OMP_NUM_THREADS=1", "ccx", "-i", job]
+    # Outside a run mode, one OpenMP thread (as before the modes).
+    env_cmd = (["env", "OMP_NUM_THREADS=1"] if MODE is None else []) + ["ccx", "-i", job]
     wall, rss, out, _ = timed(env_cmd, path.parent)
     return wall, rss, parse((path.parent / (job + ".dat")).read_text())
 
@@ -585,48 +629,106 @@ def ccx_last_u(dat, comp=2):
 
 
 def linear_problem(kind, dofs):
+    """The square near `dofs` unknowns; each peer's runners, one per solver candidate (the
+    fastest is kept by `select`)."""
     n = q4_n_for(dofs) if kind == "Q4" else q8_n_for(dofs)
     d = WORK / f"{kind.lower()}_{n}"
-    files = write_linear(kind, n, d)
+    ops = OPENSEES_CANDIDATES if OPENSEES_SYSTEM == "auto" else (OPENSEES_SYSTEM,)
+    ccx = CCX_CANDIDATES if CCX_SOLVER == "auto" else (CCX_SOLVER,)
+    runners = {"segfem": {}, "OpenSees": {}, "CalculiX": {}}
+    for i in range(max(len(ops), len(ccx))):
+        files = write_linear(kind, n, d, ops[min(i, len(ops) - 1)], ccx[min(i, len(ccx) - 1)])
+        runners["segfem"][""] = lambda f=files["segfem"]: run_segfem(f, "tip_uy")[:3]
+        runners["OpenSees"][ops[min(i, len(ops) - 1)]] = lambda f=files["OpenSees"]: run_python(f)
+        runners["CalculiX"][ccx[min(i, len(ccx) - 1)]] = lambda f=files["CalculiX"]: run_ccx(f, ccx_last_u)
     nodes = (n + 1) ** 2 if kind == "Q4" else (2 * n + 1) ** 2 - n * n
-    runners = {
-        "segfem": lambda: run_segfem(files["segfem"], "tip_uy")[:3],
-        "OpenSees": lambda: run_python(files["OpenSees"]),
-        "CalculiX": lambda: run_ccx(files["CalculiX"], ccx_last_u),
-    }
     return f"{kind} {n}x{n} square, {2 * nodes:,} dofs", "tip u_y [m]", runners
 
 
-def bench(name, unit, runners, rounds, skip_slow_after):
-    """A B A B: every round runs each program once, in the same order."""
-    rows = {p: {"wall": [], "cpu": [], "rss": [], "value": None} for p in runners}
-    for r in range(rounds):
-        for prog, run in runners.items():
-            if r > 0 and rows[prog]["wall"] and min(rows[prog]["wall"]) > skip_slow_after:
-                continue  # a very slow peer: fewer repetitions (the count is reported)
-            wall, rss, value = run()
-            rows[prog]["wall"].append(wall)
-            rows[prog]["cpu"].append(CPU_TIMES[-1])
-            rows[prog]["rss"].append(rss or 0)
-            rows[prog]["value"] = value
-            print(f"  {name}: {prog} round {r + 1}: {wall:.3f} s, {value!r}", file=sys.stderr, flush=True)
+def select(name, runners, tol, timeout):
+    """Each program's fastest candidate (solver) on this problem: every candidate run once on
+    one core (MODE "one"), kept if it ends within `timeout` [s] with segfem's answer (within
+    the problem's tolerance); returns {label: runner} with labels "OpenSees (UmfPack)"."""
+    global MODE, TIMEOUT
+    MODE, TIMEOUT = "one", timeout
+    chosen = {}
+    try:
+        _, _, ref = runners["segfem"][""]()
+        for prog, cands in runners.items():
+            if prog == "segfem" or len(cands) == 1:
+                for label, run in cands.items():
+                    chosen[f"{prog} ({label})" if label else prog] = run
+                continue
+            best = None
+            for label, run in cands.items():
+                try:
+                    wall, _, value = run()
+                except (RuntimeError, subprocess.TimeoutExpired) as e:
+                    print(f"  {name}: {prog} {label}: left out ({str(e).splitlines()[0][:120]})", file=sys.stderr, flush=True)
+                    continue
+                rel = abs(value - ref) / max(abs(ref), 1e-300)
+                ok = rel <= tol.get(prog, tol["*"])
+                print(f"  {name}: {prog} {label}: {wall:.3f} s, {value!r} ({'agrees' if ok else 'WRONG, left out'})", file=sys.stderr, flush=True)
+                if ok and (best is None or wall < best[0]):
+                    best = (wall, label, run)
+            if best is not None:
+                chosen[f"{prog} ({best[1]})"] = best[2]
+    finally:
+        MODE, TIMEOUT = None, None
+    return chosen
+
+
+def bench(name, unit, runners, rounds, skip_slow_after, modes):
+    """A B A B: every round runs each program once per mode, in the same order."""
+    global MODE
+    rows = {(p, m): {"wall": [], "cpu": [], "rss": [], "value": None} for p in runners for m in modes}
+    try:
+        for r in range(rounds):
+            for mode in modes:
+                MODE = mode
+                for prog, run in runners.items():
+                    row = rows[(prog, mode)]
+                    if r > 0 and row["wall"] and min(row["wall"]) > skip_slow_after:
+                        continue  # a very slow peer: fewer repetitions (the count is reported)
+                    wall, rss, value = run()
+                    row["wall"].append(wall)
+                    row["cpu"].append(CPU_TIMES[-1])
+                    row["rss"].append(rss or 0)
+                    row["value"] = value
+                    print(f"  {name}: {prog} [{mode}] round {r + 1}: {wall:.3f} s, {value!r}", file=sys.stderr, flush=True)
+    finally:
+        MODE = None
     return rows
 
 
-def report(name, unit, rows, tol):
-    ref = rows["segfem"]["value"]
-    seg = statistics.median(rows["segfem"]["wall"])
-    peers = [p for p in rows if p != "segfem"]
-    fastest = min(statistics.median(rows[p]["wall"]) for p in peers) if peers else float("nan")
+def report(name, unit, rows, tol, modes):
+    """Table rows: per program, the medians of wall and CPU time in each mode, peak memory,
+    the answer against segfem's and the fastest peer's time over segfem's (wall with all
+    cores, CPU on one core, where those modes ran)."""
+    progs = list(dict.fromkeys(p for p, _ in rows))
+    med = {k: (statistics.median(v["wall"]), statistics.median(v["cpu"])) for k, v in rows.items()}
+    seg = "segfem"
+    ref = rows[(seg, modes[0])]["value"]
+    peers_ = [p for p in progs if p != seg]
+    wall_mode = "all" if "all" in modes else modes[0]
+    cpu_mode = "one" if "one" in modes else modes[0]
+    ratio_wall = min(med[(p, wall_mode)][0] for p in peers_) / med[(seg, wall_mode)][0] if peers_ else float("nan")
+    ratio_cpu = min(med[(p, cpu_mode)][1] for p in peers_) / med[(seg, cpu_mode)][1] if peers_ else float("nan")
     lines = []
-    for prog, r in rows.items():
-        med = statistics.median(r["wall"])
-        rel = abs(r["value"] - ref) / max(abs(ref), 1e-300)
-        agree = "ref" if prog == "segfem" else ("yes" if rel <= tol.get(prog, tol["*"]) else "NO")
-        speed = f"{fastest / seg:.1f}x" if prog == "segfem" else f"{med / seg:.1f}"
+    for prog in progs:
+        times = " | ".join(f"{med[(prog, m)][0]:.3f} | {med[(prog, m)][1]:.3f}" for m in modes)
+        value = rows[(prog, modes[0])]["value"]
+        rel = abs(value - ref) / max(abs(ref), 1e-300)
+        base = prog.split(" (")[0]
+        agree = "ref" if prog == seg else ("yes" if rel <= tol.get(base, tol["*"]) else "NO")
+        if prog == seg:
+            speed = f"**{ratio_wall:.1f}× wall ({wall_mode}), {ratio_cpu:.1f}× CPU ({cpu_mode})**"
+        else:
+            speed = f"{med[(prog, wall_mode)][0] / med[(seg, wall_mode)][0]:.1f} / {med[(prog, cpu_mode)][1] / med[(seg, cpu_mode)][1]:.1f}"
+        runs = min(len(rows[(prog, m)]["wall"]) for m in modes)
+        rss = max(max(rows[(prog, m)]["rss"]) for m in modes)
         lines.append(
-            f"| {name} | {prog} | {med:.3f} | {statistics.median(r['cpu']):.3f} | {len(r['wall'])} | {max(r['rss']) / 2**20:.0f} | "
-            f"{r['value']:.7g} | {rel:.1e} | {agree} | {speed} |"
+            f"| {name} | {prog} | {times} | {runs} | {rss / 2**20:.0f} | {value:.7g} | {rel:.1e} | {agree} | {speed} |"
         )
     return lines
 
@@ -640,10 +742,31 @@ def main():
     ap.add_argument(
         "--slow", type=float, default=60.0, help="a run slower than this [s] is not repeated"
     )
-    ap.add_argument("--opensees-system", default="UmfPack", help="OpenSees' system (UmfPack, SparseSYM, ...)")
+    ap.add_argument(
+        "--modes", default="one,all",
+        help="one: every program pinned to one core with one thread; all: every core (both by default)",
+    )
+    ap.add_argument(
+        "--opensees-system", default="auto",
+        help="OpenSees' system on the squares (auto: the fastest of " + ", ".join(OPENSEES_CANDIDATES) + " at each size, measured)",
+    )
+    ap.add_argument(
+        "--ccx-solver", default="auto",
+        help="CalculiX's solver on the squares (auto: the fastest of " + ", ".join(CCX_CANDIDATES) + ", measured)",
+    )
+    ap.add_argument(
+        "--select-timeout", type=float, default=600.0,
+        help="a solver candidate slower than this [s] is left out of the selection",
+    )
     args = ap.parse_args()
-    global OPENSEES_SYSTEM
-    OPENSEES_SYSTEM = args.opensees_system
+    global OPENSEES_SYSTEM, CCX_SOLVER
+    OPENSEES_SYSTEM, CCX_SOLVER = args.opensees_system, args.ccx_solver
+    modes = args.modes.split(",")
+    load0 = os.getloadavg()[0]
+    if any(m not in ("one", "all") for m in modes):
+        sys.exit(f"--modes {args.modes}: each mode is one or all")
+    if "one" in modes and not shutil.which("taskset"):
+        sys.exit("taskset not found (util-linux): needed for --modes one")
     if not segfem_bin().exists():
         sys.exit(f"{segfem_bin()} not found: cargo build --release first (CARGO_TARGET_DIR is honoured)")
     if not VENV_PY.exists() or not shutil.which("ccx"):
@@ -664,18 +787,36 @@ def main():
     if "creep" in only:
         # Each program's chain approximates the creep function to ~1 %.
         problems.append((creep_problem(), {"*": 2e-2}))
+    cols = " | ".join(f"{m} core{'s' if m == 'all' else ''}: wall [s] | CPU [s]" for m in modes)
     table = [
-        "| problem | program | wall [s] (median) | CPU [s] (median) | runs | peak memory [MiB] | result | rel. diff. | agrees | time / segfem |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        f"| problem | program (solver) | {cols} | runs | peak memory [MiB] | result | rel. diff. | agrees | fastest peer / segfem |",
+        "|---|---|" + "---|---|" * len(modes) + "---|---|---|---|---|---|",
     ]
     for (name, unit, runners), tol in problems:
+        # Problems without solver candidates give one runner per program.
+        runners = {p: (r if isinstance(r, dict) else {"": r}) for p, r in runners.items()}
         if args.programs:
             keep = args.programs.split(",")
             runners = {p: r for p, r in runners.items() if p in keep or p == "segfem"}
-        rows = bench(name, unit, runners, args.rounds, args.slow)
-        table += report(f"{name}: {unit}", unit, rows, tol)
-        print("\n".join(table[-len(rows):]), flush=True)
-    print("\n" + "\n".join(table))
+        chosen = select(name, runners, tol, args.select_timeout)
+        rows = bench(name, unit, chosen, args.rounds, args.slow, modes)
+        table += report(f"{name}: {unit}", unit, rows, tol, modes)
+        print("\n".join(table[-len(chosen):]), flush=True)
+    print(f"\n{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {processor()}, load average at the start: {load0:.2f}, at the end: {os.getloadavg()[0]:.2f}")
+    print("\n".join(table))
+
+
+def processor():
+    """The processor's model name and core count (for the table's heading)."""
+    try:
+        name = next(
+            line.split(":", 1)[1].strip()
+            for line in Path("/proc/cpuinfo").read_text().splitlines()
+            if line.startswith("model name")
+        )
+    except (OSError, StopIteration):
+        name = "unknown processor"
+    return f"{name}, {os.cpu_count()} logical cores"
 
 
 if __name__ == "__main__":
