@@ -433,6 +433,11 @@ pub enum Geometry {
 pub struct SolverControls {
     /// Relative force-residual tolerance.
     pub force_tolerance: f64,
+    /// Absolute force-residual tolerance [N] (`[solver] absolute_force_tolerance`): the
+    /// Euclidean norm of the residual over the free equations that converges an
+    /// iteration, in place of `force_tolerance`; None (the default): the relative test.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub absolute_force_tolerance: Option<f64>,
     /// Relative energy tolerance.
     pub energy_tolerance: f64,
     /// Maximum Newton iterations per increment.
@@ -474,6 +479,7 @@ impl Default for SolverControls {
     fn default() -> Self {
         Self {
             force_tolerance: 1e-6,
+            absolute_force_tolerance: None,
             energy_tolerance: 1e-12,
             max_iterations: 25,
             max_cuts: 6,
@@ -497,6 +503,21 @@ pub enum ImplexForceNorm {
     /// calls for with the last factorised tangent K, against the work of the current
     /// internal forces on the current displacements (all dofs).
     Energy,
+}
+
+impl SolverControls {
+    /// The relative force tolerance [-] of an iteration whose free residual has the norm
+    /// `rnorm` [N] and the relative size `rel` [-] (`rnorm` over the force scale):
+    /// `force_tolerance`, or with `absolute_force_tolerance` that bound over the
+    /// iteration's force scale, so that `rel <= tolerance` is the absolute test.
+    pub fn relative_force_tolerance(&self, rel: f64, rnorm: f64) -> f64 {
+        match self.absolute_force_tolerance {
+            Some(a) if rnorm > 0.0 && rel > 0.0 => a * rel / rnorm,
+            // A zero residual converges under either test.
+            Some(_) => f64::INFINITY,
+            None => self.force_tolerance,
+        }
+    }
 }
 
 impl ImplexForceNorm {
@@ -800,4 +821,36 @@ pub fn model_size(model: &Model) -> f64 {
     ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2))
         .sqrt()
         .max(f64::MIN_POSITIVE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SolverControls;
+
+    /// With `absolute_force_tolerance` the relative test `rel <= tolerance` is the absolute
+    /// one ‖r‖ ≤ a: at a force scale S (rel = ‖r‖ / S), residuals just under and just over
+    /// a converge and do not; without it the relative bound is `force_tolerance` itself.
+    #[test]
+    fn absolute_force_tolerance_is_the_residual_norm_in_newtons() {
+        let mut c = SolverControls::default();
+        let scale = 4.0e6; // N, the RC example's order of force scale
+        for rnorm in [9.99, 10.01] {
+            let rel = rnorm / scale;
+            assert_eq!(
+                rel <= c.relative_force_tolerance(rel, rnorm),
+                rel <= c.force_tolerance
+            );
+        }
+        c.absolute_force_tolerance = Some(10.0);
+        for (rnorm, converged) in [(9.99, true), (10.01, false), (400.0, false)] {
+            let rel = rnorm / scale;
+            assert_eq!(
+                rel <= c.relative_force_tolerance(rel, rnorm),
+                converged,
+                "{rnorm} N"
+            );
+        }
+        // A zero residual converges under either test.
+        assert!(0.0 <= c.relative_force_tolerance(0.0, 0.0));
+    }
 }

@@ -53,7 +53,11 @@ PV = dict(L=0.89, t=0.07, fc=19.0e6, rx=0.0179, fyx=458e6, ry=0.0071, fyy=299e6,
 PANEL_STOP = 0.02  # shear strain (corner ux / L) that ends the run in both programs
 
 
-def write_panel(n, d, crack="rotating"):
+def write_panel(n, d, crack="rotating", tol_n=None):
+    """The panel in both programs; `tol_n` [N]: the convergence test of both, the Euclidean
+    norm of the unbalanced forces (segfem `absolute_force_tolerance` with the energy test
+    off, OpenSees `NormUnbalance`); None: each program's own (segfem's default relative
+    test, OpenSees 1e-4 t L)."""
     d.mkdir(parents=True, exist_ok=True)
     L, t = PV["L"], PV["t"]
     nodes = [f"[{L * i / n!r}, {L * j / n!r}]" for j in range(n + 1) for i in range(n + 1)]
@@ -131,6 +135,7 @@ max_growth = 4.0
 stop_displacement = {{ point = [{L!r}, {L!r}], component = "x", value = {PANEL_STOP * L!r} }}
 increments = 4000
 """
+        + ("" if tol_n is None else f"[solver]\nabsolute_force_tolerance = {tol_n!r}\nenergy_tolerance = 1e-30\n")
     )
     # OpenSees in N, mm, MPa: load factor = v [MPa].
     Lm, tm, fc = L * 1e3, t * 1e3, PV["fc"] / 1e6
@@ -164,7 +169,7 @@ edge([i + 1 for i in range(n + 1)], -t, 0.0)
 edge([j * (n + 1) + n + 1 for j in range(n + 1)], 0.0, t)
 edge([j * (n + 1) + 1 for j in range(n + 1)], 0.0, -t)
 ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Plain')
-ops.test('NormUnbalance', 1e-4 * t * L, 100)
+ops.test('NormUnbalance', {'1e-4 * t * L' if tol_n is None else repr(tol_n)}, 100)
 ops.algorithm('KrylovNewton')
 tip = (n + 1) ** 2
 nsteps = 200
@@ -286,9 +291,12 @@ def asd_laws(h):
     return te, ts, td, ce, cs
 
 
-def write_beam(r, d, implex=True, stop_mm=24.0):
+def write_beam(r, d, implex=True, stop_mm=24.0, tol_n=None):
     """The beam to 24 mm (the example), or only its first `stop_mm` <= 0.5 mm (the first
-    step's 0.02 mm increments: elastic start and first cracking, where OOFEM gets to)."""
+    step's 0.02 mm increments: elastic start and first cracking, where OOFEM gets to).
+    `tol_n` [N]: the convergence test of both programs, the Euclidean norm of the unbalanced
+    forces (segfem `absolute_force_tolerance` with the energy test off, OpenSees
+    `NormUnbalance`); None: each program's own (the example's relative 1e-4, OpenSees 10 N)."""
     d.mkdir(parents=True, exist_ok=True)
     text = (peers.REPO / "examples" / "rc-beam.toml").read_text()
     # Same output policy as the peer (final state only), the control point's displacement
@@ -305,6 +313,12 @@ def write_beam(r, d, implex=True, stop_mm=24.0):
         tail = tail[tail.index("\n[solver]"):]
         text = head.replace("value = -0.0005 }\nincrements = 25", f"value = {-stop_mm / 1e3!r} }}\nincrements = {n1}") + tail
         assert f"increments = {n1}" in text
+    if tol_n is not None:
+        assert "force_tolerance = 1e-4\n" in text
+        text = text.replace(
+            "force_tolerance = 1e-4\n",
+            f"absolute_force_tolerance = {tol_n!r}\nenergy_tolerance = 1e-30\n",
+        )
     (d / "segfem.toml").write_text(text)
 
     nodes, elems, idx, (nx, ny_b, ny) = beam_mesh(r)
@@ -357,8 +371,8 @@ for k in {sym!r}:
     ops.fix(k + 1, 1, 0)
 ops.timeSeries('Linear', 1); ops.pattern('Plain', 1, 1); ops.sp({ctrl} + 1, 2, -1.0)
 ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Transformation')
-# segfem's tolerance is 1e-4 of the force scale; ~1e5 N here.
-ops.test('NormUnbalance', 10.0, 30)
+# The same test as segfem's with --tolerance (segfem's example: 1e-4 of its force scale).
+ops.test('NormUnbalance', {10.0 if tol_n is None else tol_n!r}, 30)
 ops.algorithm('Newton')
 ops.analysis('Static')
 t1 = time.perf_counter()
@@ -495,6 +509,12 @@ def main():
                     help="segfem's panel concrete: rotating (+ VC93 compression softening, the panel series' best) or fixed (seed beta, OOFEM's ConcreteFCM counterpart)")
     ap.add_argument("--refine", type=int, default=1, help="beam mesh refinement (1 = the example)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
+    ap.add_argument(
+        "--tolerance", default="10",
+        help="the convergence test of segfem and OpenSees, the same in both: the Euclidean norm of the "
+             "unbalanced forces [N] (default 10 N, OpenSees' on the beam), or 'own' for each program's own "
+             "(segfem's relative test with its energy test; OpenSees 10 N on the beam, 1e-4 t L on the panel)",
+    )
     ap.add_argument("--programs", default="segfem,OpenSees,OOFEM", help="which programs (segfem always runs: the reference)")
     ap.add_argument("--oofem-law", default="fcm", help="OOFEM concrete of the beam and panel: fcm, idm1, rcsd (oofem_beam.py)")
     ap.add_argument("--oofem-beta", type=float, default=None, help="constant shear retention of OOFEM's fcm (default: segfem's law tabulated)")
@@ -511,8 +531,10 @@ def main():
     dump = {}
     only = args.only.split(",")
     progs = args.programs.split(",")
+    tol_n = None if args.tolerance == "own" else float(args.tolerance)
+    tol_text = "each program's own test" if tol_n is None else f"both at ||unbalance||_2 <= {tol_n:g} N, no energy test"
     if "panel" in only:
-        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack)
+        files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack, tol_n)
         ofiles = oofem_beam.write_panel(peers.WORK / f"nl_panel_{args.panel_n}" / "oofem", args.oofem_law)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], panel_answers_segfem),
@@ -520,13 +542,13 @@ def main():
             "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_panel),
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
-        name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs"
+        name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs, {tol_text}"
         lines, res = bench(name, runners, args.rounds, panel_answers)
         table += lines
         dump["panel"] = res
         print("\n".join(lines), flush=True)
     if "beam" in only:
-        files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm)
+        files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm, tol_n=tol_n)
         nodes, _, _, _ = beam_mesh(args.refine)
         ofiles = oofem_beam.write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}" / "oofem", args.oofem_law,
                                        beta=args.oofem_beta, maxiter=args.oofem_maxiter, rtolf=args.oofem_rtolf,
@@ -538,7 +560,7 @@ def main():
             "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_beam),
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
-        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm"
+        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm, {tol_text}"
         lines, res = bench(name, runners, args.rounds, beam_answers)
         table += lines
         dump["beam"] = res

@@ -137,13 +137,14 @@ pub(super) fn newton(
         // first one) once at least one correction has been made.
         let energy_ok = it > 1
             && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= c.energy_tolerance * e0);
-        if rnorm == 0.0 || (it > 0 && (rel <= c.force_tolerance || energy_ok)) {
+        let tol = c.relative_force_tolerance(rel, rnorm);
+        if rnorm == 0.0 || (it > 0 && (rel <= tol || energy_ok)) {
             if sys.release_contacts() {
                 // Converged on held contact statuses: the state stands only if the free
                 // law (statuses by the sign of λ) is converged there too.
                 let (a, _, rf, free) = residual_at(sys, u, f_ext, false, timings)?;
                 history.push(free);
-                if !hold_consistent(free, rel, c.force_tolerance, c.verbose) {
+                if !hold_consistent(free, rel, tol, c.verbose) {
                     return Err(NewtonFailure::diverged(history, rf));
                 }
                 return Ok((a.f_int, it));

@@ -409,12 +409,12 @@ fn newton_controlled(
         if it > 0 {
             let energy_ok = it > 1
                 && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
-            if rel <= controls.force_tolerance || energy_ok {
+            let tol = controls.relative_force_tolerance(rel, norm(&rf));
+            if rel <= tol || energy_ok {
                 if ctx.sys.release_contacts() {
                     // Converged on held contact statuses: checked under the free law.
                     let free = controlled_residual(ctx, &u, f_ext, ctl, None)?;
                     history.push(free.rel);
-                    let tol = controls.force_tolerance;
                     if !hold_consistent(free.rel, rel, tol, controls.verbose) {
                         return Err(NewtonFailure::diverged(history, free.rf));
                     }
@@ -973,12 +973,12 @@ fn arc_increment(
         }
         let energy_ok = it > 2
             && matches!((first_energy, last_energy), (Some(e0), Some(e)) if e <= controls.energy_tolerance * e0);
-        if rel <= controls.force_tolerance || energy_ok {
+        let tol = controls.relative_force_tolerance(rel, norm(&rf));
+        if rel <= tol || energy_ok {
             let f_int = if ctx.sys.release_contacts() {
                 // Converged on held contact statuses: checked under the free law.
                 let free = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full)?;
                 history.push(free.rel);
-                let tol = controls.force_tolerance;
                 if !hold_consistent(free.rel, rel, tol, controls.verbose) {
                     return Err(NewtonFailure::diverged(history, free.rf));
                 }

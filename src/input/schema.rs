@@ -362,6 +362,7 @@ pub struct ArcIn {
 #[serde(deny_unknown_fields)]
 pub struct SolverIn {
     pub force_tolerance: Option<f64>,
+    pub absolute_force_tolerance: Option<f64>,
     pub energy_tolerance: Option<f64>,
     pub max_iterations: Option<usize>,
     pub max_cuts: Option<usize>,

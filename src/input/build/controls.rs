@@ -88,6 +88,22 @@ pub(super) fn solver(ctx: &Ctx, solver: Option<&SolverIn>, model: &mut Model) ->
                 "of the residual relative to the forces",
             )?;
         }
+        if let Some(v) = sv.absolute_force_tolerance {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ctx.err(
+                    "solver.absolute_force_tolerance",
+                    format!("must be a positive force in N (got {v}): the norm of the residual that converges an iteration"),
+                ));
+            }
+            if sv.force_tolerance.is_some() {
+                // Only one force test applies; both given would leave one silently unused.
+                return Err(ctx.err(
+                    "solver.absolute_force_tolerance",
+                    "replaces solver.force_tolerance (the relative test): give one of the two",
+                ));
+            }
+            c.absolute_force_tolerance = Some(v);
+        }
         if let Some(v) = sv.energy_tolerance {
             c.energy_tolerance = in_range(
                 ctx,
