@@ -134,20 +134,37 @@ pub fn update_uniaxial(
     }
 }
 
+/// True for a point that has flowed and whose trial stress lies on its yield surface to
+/// round-off (`f` the yield function, ≤ 0): its committed stress met again with no strain
+/// increment (the first assembly of an increment), where the elastic modulus is the tangent
+/// of unloading and the plastic one that of continued loading, the better predictor for a
+/// point that goes on flowing.
+fn on_surface(p: &SteelParams, c: &SteelState, f: f64) -> bool {
+    c.acc_plastic > 0.0 && f >= -1e-12 * p.fy
+}
+
 /// Return mapping with linear kinematic hardening up to the back stress f_u − f_y.
 fn kinematic(p: &SteelParams, committed: &SteelState, strain: f64) -> (SteelState, f64, f64) {
     let e = p.es;
     let sig_tr = e * (strain - committed.plastic_strain);
     let xi = sig_tr - committed.back_stress;
     let f = xi.abs() - p.fy;
-    if f <= 0.0 {
-        return (*committed, sig_tr, e);
-    }
     let sgn = xi.signum();
     let h = p.hardening.max(0.0);
     // Room left for hardening in the flow direction before the back stress reaches the cap.
     let alpha_max = (p.fu - p.fy).max(0.0);
     let room = alpha_max - sgn * committed.back_stress;
+    if f <= 0.0 {
+        if on_surface(p, committed, f) {
+            let t = if h > 0.0 && room > 0.0 {
+                e * h / (e + h)
+            } else {
+                0.0
+            };
+            return (*committed, sig_tr, t);
+        }
+        return (*committed, sig_tr, e);
+    }
     let (dgamma, tangent, back) = if h > 0.0 && room > 0.0 {
         let dg = f / (e + h);
         if h * dg <= room {
@@ -175,6 +192,15 @@ fn isotropic(p: &SteelParams, c: &SteelState, strain: f64) -> (SteelState, f64, 
     let trial = e * (strain - c.plastic_strain);
     let f = trial.abs() - (p.fy + h * c.acc_plastic).min(cap);
     if f <= 0.0 {
+        if on_surface(p, c, f) {
+            let below_cap = p.fy + h * c.acc_plastic < cap;
+            let t = if h > 0.0 && below_cap {
+                e * h / (e + h)
+            } else {
+                0.0
+            };
+            return (*c, trial, t);
+        }
         return (*c, trial, e);
     }
     // Return on the hardening line, or onto the cap if that line passes it.
@@ -211,6 +237,49 @@ mod tests {
                 (sig, et, s)
             })
             .collect()
+    }
+
+    /// A bar that yielded, met again at its committed strain (the first assembly of an
+    /// increment), keeps its stress and answers with the tangent of continued loading:
+    /// 0 on the seed's plateau, E_s H/(E_s + H) with hardening (kinematic and isotropic),
+    /// 0 at the cap; unloading by a small strain gives E_s. Closed forms (1e-12 relative:
+    /// round-off of the order of the operations).
+    #[test]
+    fn yielded_bar_at_its_committed_strain_answers_with_the_loading_tangent() {
+        let h = 2e9;
+        let hard = |rule| SteelParams {
+            es: ES,
+            fy: FY,
+            hardening: h,
+            fu: 600e6,
+            rule,
+        };
+        let cases = [
+            (SteelParams::rebar(ES, FY), 0.0),
+            (hard(HardeningRule::Kinematic), ES * h / (ES + h)),
+            (hard(HardeningRule::Isotropic), ES * h / (ES + h)),
+        ];
+        for (p, loading) in cases {
+            for eps in [0.01, -0.01] {
+                let (c, sig, _) = update_uniaxial(&p, &SteelState::new(), eps);
+                let (_, again, t) = update_uniaxial(&p, &c, eps);
+                assert_eq!(again, sig, "{:?}", p.rule);
+                // The same closed form, summed in another order: 1e-12 relative.
+                assert!(
+                    (t - loading).abs() <= 1e-12 * ES,
+                    "{:?} at {eps}: {t} vs {loading}",
+                    p.rule
+                );
+                let (_, _, t_back) = update_uniaxial(&p, &c, eps * (1.0 - 1e-6));
+                assert_eq!(t_back, ES, "{:?}: unloading", p.rule);
+            }
+        }
+        // At the cap (ε = 0.1 reaches f_u in one step): 0.
+        let p = hard(HardeningRule::Kinematic);
+        let (c, _, _) = update_uniaxial(&p, &SteelState::new(), 0.1);
+        assert_eq!(update_uniaxial(&p, &c, 0.1).2, 0.0);
+        // A virgin bar at zero strain is elastic.
+        assert_eq!(update_uniaxial(&p, &SteelState::new(), 0.0).2, ES);
     }
 
     /// Kinematic hardening past its cap in one step (E_s = 200 GPa, f_y = 500 MPa,
