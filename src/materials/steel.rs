@@ -263,7 +263,12 @@ mod tests {
             for eps in [0.01, -0.01] {
                 let (c, sig, _) = update_uniaxial(&p, &SteelState::new(), eps);
                 let (_, again, t) = update_uniaxial(&p, &c, eps);
-                assert_eq!(again, sig, "{:?}", p.rule);
+                // The stress recomputed as E (ε − ε_p): round-off of the return.
+                assert!(
+                    (again - sig).abs() <= 1e-12 * FY,
+                    "{:?}: {again} vs {sig}",
+                    p.rule
+                );
                 // The same closed form, summed in another order: 1e-12 relative.
                 assert!(
                     (t - loading).abs() <= 1e-12 * ES,
