@@ -12,6 +12,7 @@ use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext,
 use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
+use super::displacements::Displacements;
 use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBlock};
 pub use super::families::{BarOutput, BarPhase};
 use super::responses;
@@ -41,11 +42,10 @@ pub struct System<'m> {
     pub gp_offset: Vec<usize>,
     /// Assembler numbers of the elements, one block per family.
     pub numbers: ElementNumbers,
-    /// Committed displacements (all dofs) [m].
-    pub u: Vec<f64>,
-    /// Displacements before the last committed increment [m] (its size sets the history
-    /// extrapolation of the next increment).
-    pub u_prev: Vec<f64>,
+    /// The displacements: the Newton iterate of the increment under way, the committed
+    /// ones and those before the last committed increment (their difference sets the path
+    /// extrapolation of the next increment) [m].
+    pub disp: Displacements,
     /// Time interval of the current increment on the analysis clock [d].
     pub time: TimeContext,
     /// The state of every element family (committed and trial).
@@ -109,6 +109,32 @@ struct LastAssembly {
     latched: Vec<usize>,
     /// The force scale of the last assembly [N] ([`Assembled::force_scale`]).
     force_scale: f64,
+}
+
+/// The displacements an assembly is made at ([`System::assemble_at`]).
+#[derive(Debug, Clone, Copy)]
+pub enum At<'u> {
+    /// The trial displacements, `disp.trial` (the Newton iterate).
+    Trial,
+    /// The committed displacements, `disp.committed`.
+    Committed,
+    /// Displacements the caller holds (a line-search point, an influence probe; all dofs)
+    /// [m].
+    Given(&'u [f64]),
+}
+
+impl<'u> At<'u> {
+    /// The displacements this names, taken from the block `disp` [m].
+    pub fn of<'s>(self, disp: &'s Displacements) -> &'s [f64]
+    where
+        'u: 's,
+    {
+        match self {
+            At::Trial => &disp.trial,
+            At::Committed => &disp.committed,
+            At::Given(u) => u,
+        }
+    }
 }
 
 /// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
@@ -338,8 +364,7 @@ impl<'m> System<'m> {
             ordering_s,
             gp_offset,
             numbers,
-            u: vec![0.0; model.n_dofs()],
-            u_prev: vec![0.0; model.n_dofs()],
+            disp: Displacements::zero(model.n_dofs()),
             time: TimeContext::default(),
             families,
             linear,
@@ -494,12 +519,33 @@ impl<'m> System<'m> {
     /// buffers; the scatter is sequential in element order (continuum elements, joints,
     /// tendons), so results are bit-identical whatever the thread count. The error names
     /// the continuum element whose material point failed.
-    // long: one pass per element family in the scatter order (continuum with its bars, joints, tendons) that keeps results thread-independent; the passes share the scatter and buffers
     pub fn assemble(
         &mut self,
         u: &[f64],
         tangent: bool,
     ) -> Result<Assembled, (usize, UpdateError)> {
+        self.assemble_at(At::Given(u), tangent)
+    }
+
+    /// As [`System::assemble`], at the trial displacements (`disp.trial`, the Newton
+    /// iterate), read in place: no copy of the iterate per iteration.
+    pub fn assemble_trial(&mut self, tangent: bool) -> Result<Assembled, (usize, UpdateError)> {
+        self.assemble_at(At::Trial, tangent)
+    }
+
+    /// As [`System::assemble`], at the displacements `at`. The trial and committed
+    /// displacements are read where they are, in [`System::disp`]: the assembly borrows that
+    /// field for reading and the state blocks it writes (families, buffers) for writing,
+    /// disjoint fields of `self`, so the borrow checker sees that the assembly cannot move
+    /// the displacements it is made at (the drivers used to keep the iterate outside the
+    /// system for that; now it is the system's own block, [`Displacements`]).
+    // long: one pass per element family in the scatter order (continuum with its bars, joints, tendons) that keeps results thread-independent; the passes share the scatter and buffers
+    pub fn assemble_at(
+        &mut self,
+        at: At<'_>,
+        tangent: bool,
+    ) -> Result<Assembled, (usize, UpdateError)> {
+        let u = at.of(&self.disp);
         let model = self.model;
         self.last.valid = false;
         let keep = self.last.kept;
@@ -811,7 +857,7 @@ impl<'m> System<'m> {
                     &self.bar_gps,
                     &self.bar_offset,
                     &thermal,
-                    &self.u,
+                    &self.disp.committed,
                     &time,
                     false,
                     (start, end),
@@ -864,8 +910,9 @@ impl<'m> System<'m> {
             if data.stressed_in_step != step || self.tendons[t].is_some() {
                 continue;
             }
+            let u = &self.disp.committed;
             let u0: Vec<[f64; 2]> = (0..data.nodes.len())
-                .map(|p| data.at_point(p, |n| [self.u[2 * n], self.u[2 * n + 1]]))
+                .map(|p| data.at_point(p, |n| [u[2 * n], u[2 * n + 1]]))
                 .collect();
             let el = self.build_tendon(t, &u0);
             let tb = &mut self.families.tendons;
@@ -903,7 +950,7 @@ impl<'m> System<'m> {
                     let mut ue: Vec<f64> = el
                         .nodes
                         .iter()
-                        .flat_map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+                        .flat_map(|&n| [self.disp.committed[2 * n], self.disp.committed[2 * n + 1]])
                         .collect();
                     if let Some(r) = self
                         .stages
@@ -1081,27 +1128,29 @@ impl<'m> System<'m> {
         Some(self.to_free(&r))
     }
 
-    /// Accept the trial states of the last assembly and the displacements `u`.
-    pub fn commit(&mut self, u: &[f64]) {
+    /// Accept the trial states of the last assembly and the trial displacements (the
+    /// committed ones become the previous).
+    pub fn commit(&mut self) {
         self.last.valid = false;
         self.commit_time_dependent();
-        std::mem::swap(&mut self.u, &mut self.u_prev);
-        self.u.copy_from_slice(u);
+        self.disp.commit();
         self.families.commit();
         if let Some(st) = self.stages.as_mut() {
             st.commit();
         }
     }
 
-    /// Add `ratio` × the last converged increment (u − u_prev) to the free dofs of `u` [m]:
-    /// the extrapolated start of the next increment ([`crate::model::Predictor`]).
-    pub fn extrapolate(&self, u: &mut [f64], ratio: f64) {
+    /// Add `ratio` × the last converged increment (committed − previous) to the free dofs
+    /// of the trial displacements [m]: the extrapolated start of the next increment
+    /// ([`crate::model::Predictor`]).
+    pub fn extrapolate(&mut self, ratio: f64) {
         // Held equations stay where they are (a one-way support touching down in this
         // increment moved in the last one).
         let held = |q: usize| self.stages.as_ref().is_some_and(|st| st.held[q]);
+        let d_ = &mut self.disp;
         for (d, &q) in self.dofs.eq.iter().enumerate() {
             if q != CONSTRAINED && !held(q) {
-                u[d] += ratio * (self.u[d] - self.u_prev[d]);
+                d_.trial[d] += ratio * (d_.committed[d] - d_.previous[d]);
             }
         }
     }
@@ -1130,9 +1179,8 @@ impl<'m> System<'m> {
             return Ok(());
         };
         let reaction = if entered && StageState::removes_support(self.model, step) {
-            let u = self.u.clone();
             // The committed state at the committed displacements: internal forces only.
-            let a = self.assemble(&u, false);
+            let a = self.assemble_at(At::Committed, false);
             self.families.revert();
             Some(
                 a?.f_int
@@ -1144,7 +1192,7 @@ impl<'m> System<'m> {
         } else {
             None
         };
-        let (model, u, eq) = (self.model, &self.u, &self.dofs.eq);
+        let (model, u, eq) = (self.model, &self.disp.committed, &self.dofs.eq);
         self.stage_jump.clear();
         if let Some(st) = self.stages.as_mut() {
             let before = st.element_active.clone();
@@ -1176,8 +1224,7 @@ impl<'m> System<'m> {
             return Ok(());
         }
         self.last.valid = false;
-        let u = self.u.clone();
-        let a = self.assemble(&u, false);
+        let a = self.assemble_at(At::Committed, false);
         self.families.revert();
         let f_int = a?.f_int;
         let st = self.stages.as_ref().expect("placing needs stages");
