@@ -75,6 +75,32 @@ impl StateBlock for Displacements {
     }
 }
 
+/// The displacements an assembly is made at ([`super::system::System::assemble_at`]).
+#[derive(Debug, Clone, Copy)]
+pub enum At<'u> {
+    /// The trial displacements, `disp.trial` (the Newton iterate).
+    Trial,
+    /// The committed displacements, `disp.committed`.
+    Committed,
+    /// Displacements the caller holds (a line-search point, an influence probe; all dofs)
+    /// [m].
+    Given(&'u [f64]),
+}
+
+impl<'u> At<'u> {
+    /// The displacements this names, taken from the block `disp` [m].
+    pub fn of<'s>(self, disp: &'s Displacements) -> &'s [f64]
+    where
+        'u: 's,
+    {
+        match self {
+            At::Trial => &disp.trial,
+            At::Committed => &disp.committed,
+            At::Given(u) => u,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,5 +1,6 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
+// long: System's build, assembly, commit and stage entry share its private buffers and assembly record (elem_buf, blocks, geometry, last); its methods on public fields only are in state.rs, time.rs, bonded_time.rs and committed.rs
 
 use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
@@ -12,6 +13,7 @@ use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext,
 use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
+pub use super::displacements::At;
 use super::displacements::Displacements;
 use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBlock};
 pub use super::families::{BarOutput, BarPhase};
@@ -109,32 +111,6 @@ struct LastAssembly {
     latched: Vec<usize>,
     /// The force scale of the last assembly [N] ([`Assembled::force_scale`]).
     force_scale: f64,
-}
-
-/// The displacements an assembly is made at ([`System::assemble_at`]).
-#[derive(Debug, Clone, Copy)]
-pub enum At<'u> {
-    /// The trial displacements, `disp.trial` (the Newton iterate).
-    Trial,
-    /// The committed displacements, `disp.committed`.
-    Committed,
-    /// Displacements the caller holds (a line-search point, an influence probe; all dofs)
-    /// [m].
-    Given(&'u [f64]),
-}
-
-impl<'u> At<'u> {
-    /// The displacements this names, taken from the block `disp` [m].
-    pub fn of<'s>(self, disp: &'s Displacements) -> &'s [f64]
-    where
-        'u: 's,
-    {
-        match self {
-            At::Trial => &disp.trial,
-            At::Committed => &disp.committed,
-            At::Given(u) => u,
-        }
-    }
 }
 
 /// What an assembly produced: internal forces (all dofs) and, if asked, tangent values.
