@@ -383,7 +383,7 @@ fn newton_controlled(
                 // The correction overshot (a band of open cracks or yielded bars is nearly a
                 // mechanism: the linearised step closes cracks into compression at E): back
                 // along it to where the residual's work vanishes, or half-way.
-                ctx.sys.disp.trial.copy_from_slice(&c.u);
+                ctx.sys.disp.trial = c.u;
                 let (s, at) = line_search(ctx, &c.du, &c.rf, f_ext, ctl, true)?;
                 let s = s.unwrap_or(0.5);
                 ctx.add_to_trial(&c.du, s);
