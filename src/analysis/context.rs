@@ -1,8 +1,8 @@
 //! The analysis state a step works on while it runs: the system (with the displacements of
-//! the attempt, `sys.disp.trial`), the solver, the load cases and factors, timings; and the round of the
-//! one-way supports after an attempt has converged ([`super::one_way`]). Shared by the
-//! increment controller (`increments.rs`) and the step drivers (`steps.rs`, `path.rs`);
-//! the methods that assemble, report and follow the path are in `path.rs`.
+//! the attempt, `sys.disp.trial`), the solver, the load cases and factors, timings; and the
+//! round of the one-way supports after an attempt has converged ([`super::one_way`]). Shared
+//! by the increment controller (`increments.rs`) and the step drivers (`steps.rs`,
+//! `path.rs`); the methods that assemble, report and follow the path are in `path.rs`.
 
 use super::driver::Timings;
 use super::one_way::MAX_ROUNDS;
@@ -37,11 +37,11 @@ impl PathContext<'_, '_> {
         }
     }
 
-    /// The one-way supports after an attempt converged at the trial displacements with internal forces
-    /// `f_int` and external forces `f_ext` [N]: the trial statuses to solve it again with
-    /// (one round more in `rounds`), or None when its statuses hold (or have chattered for
-    /// [`MAX_ROUNDS`] rounds: then counted in `support_chatter` and kept). `rounds` is set
-    /// back to 0 when None is returned.
+    /// The one-way supports after an attempt converged at the trial displacements with
+    /// internal forces `f_int` and external forces `f_ext` [N]: the trial statuses to solve it
+    /// again with (one round more in `rounds`), or None when its statuses hold (or have
+    /// chattered for [`MAX_ROUNDS`] rounds: then counted in `support_chatter` and kept).
+    /// `rounds` is set back to 0 when None is returned.
     pub(super) fn one_way_check(
         &mut self,
         f_int: &[f64],

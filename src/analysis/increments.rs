@@ -491,8 +491,8 @@ impl Sizing for Controller {
 /// increment does. The sizing `S` is the step kind's ([`Controller`] or [`ArcSizing`]).
 pub(super) trait Stepper<S> {
     /// Solve the next increment (its size from `ctl`), starting from the trial displacements
-    /// (`ctx.sys.disp.trial`, left at the attempt's end). Returns the
-    /// internal forces [N] and the Newton iterations.
+    /// (`ctx.sys.disp.trial`, left at the attempt's end). Returns the internal forces [N] and
+    /// the Newton iterations.
     fn attempt(
         &mut self,
         ctx: &mut PathContext,

@@ -89,8 +89,8 @@ impl System<'_> {
 
     /// Replace the committed (and trial) states by a saved state of the same model. Errors
     /// name what does not match (the model changed since the state was saved): each block
-    /// checks its own sizes ([`StateBlock::check_shape`]).
-    /// The displacements' trial equals the committed ones after it.
+    /// checks its own sizes ([`StateBlock::check_shape`]). The trial displacements equal the
+    /// committed ones after it.
     pub fn restore(&mut self, s: SystemState) -> Result<(), String> {
         let n_dofs = self.disp.committed.len();
         let disp = Displacements::saved(s.u.into_owned(), s.u_prev.into_owned());

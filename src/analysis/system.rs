@@ -1226,6 +1226,102 @@ mod tests {
     use crate::materials::concrete::ConcreteState;
     use crate::materials::point::Material;
 
+    /// The displacement block inside the system, on one elastic Q4 (1 × 1 m) held in x on
+    /// its left edge and in y at node 1: an assembly at `At::Trial` / `At::Committed` is the
+    /// assembly at a copy of that vector (forces bit for bit; trial and committed differ, so
+    /// a mix-up shows), `commit` shifts committed to previous and takes the trial, the path
+    /// extrapolation adds r (committed − previous) to the free dofs of the trial only, and a
+    /// restore of a snapshot sets the trial back to the committed displacements.
+    #[test]
+    fn displacements_are_assembled_committed_and_restored_in_place() {
+        let text = r#"
+[[materials]]
+name = "e"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+
+[[regions]]
+name = "r"
+material = "e"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+blocks = [{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 1.0]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+
+[[load_cases]]
+name = "pull"
+line_loads = [{ line = [[1.0, 0.0], [1.0, 1.0]], q = [1e5, 0.0] }]
+
+[[steps]]
+name = "s"
+kind = "load"
+loads = { pull = 1.0 }
+increments = 1
+"#;
+        let model = crate::input::parse(text, "test.toml").unwrap().model;
+        let mut sys = System::new(&model);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        // Node 2 (dofs 2, 3) and node 3 (dofs 4, 5) pulled right, the top lifted.
+        let u1 = vec![0.0, 0.0, 1e-4, 0.0, 1e-4, 2e-5, 0.0, 2e-5];
+        sys.disp.trial.copy_from_slice(&u1);
+        let f1 = sys.assemble(&u1, false).unwrap().f_int;
+        assert_eq!(bits(&sys.assemble_trial(false).unwrap().f_int), bits(&f1));
+        sys.commit();
+        assert_eq!(sys.displacements(), &u1[..]);
+        assert_eq!(sys.previous_displacements(), &[0.0; 8][..]);
+        let u2: Vec<f64> = u1.iter().map(|x| 3.0 * x).collect();
+        sys.disp.trial.copy_from_slice(&u2);
+        let f2 = sys.assemble(&u2, false).unwrap().f_int;
+        assert_ne!(
+            bits(&f1),
+            bits(&f2),
+            "the two states must differ for the test to see"
+        );
+        assert_eq!(bits(&sys.assemble_trial(false).unwrap().f_int), bits(&f2));
+        assert_eq!(
+            bits(&sys.assemble_at(At::Committed, false).unwrap().f_int),
+            bits(&f1)
+        );
+        sys.commit();
+        assert_eq!(
+            (sys.displacements(), sys.previous_displacements()),
+            (&u2[..], &u1[..])
+        );
+        // Extrapolation by ½ of the last increment u2 − u1, on the free dofs; the held ones
+        // (0, 1: node 1; 6: node 4's x) keep their trial values.
+        sys.disp.trial[6] = 7.0;
+        sys.extrapolate(0.5);
+        let expected: Vec<f64> = (0..8)
+            .map(|d| match d {
+                0 | 1 => 0.0,
+                6 => 7.0,
+                _ => u2[d] + 0.5 * (u2[d] - u1[d]),
+            })
+            .collect();
+        assert_eq!(sys.disp.trial, expected);
+        // A snapshot restored: committed and previous as saved, the trial back on them.
+        let saved = sys.snapshot();
+        sys.disp.trial.fill(1.0);
+        sys.disp.commit();
+        sys.restore(saved).unwrap();
+        assert_eq!(sys.disp.committed, u2);
+        assert_eq!(sys.disp.previous, u1);
+        assert_eq!(sys.disp.trial, u2);
+    }
+
     /// The global IMPL-EX error (`System::implex_force_error`, docs/theory-concrete.md §5.2)
     /// against a hand value: one Q4 concrete element a × b = 0.2 × 0.1 m, thickness 0.15 m,
     /// the left edge held in x and its lower node in y, every point with one crack at
