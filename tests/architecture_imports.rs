@@ -335,15 +335,16 @@ fn analysis_files_import_without_a_circle() {
 
 /// The output code (`src/results/`, `src/cli/`) reads the analysis state through the
 /// accessors of `analysis/committed.rs` (docs/architecture.md, "Analysis state"), not through
-/// the family blocks, their committed copies or the point offsets, whose layout is the
-/// analysis's own.
+/// the family and displacement blocks, their committed copies or the point offsets, whose
+/// layout is the analysis's own.
 #[test]
 fn results_read_the_state_through_accessors() {
     let inner = [
         ".families",
         ".gp_offset",
         ".bar_gps",
-        ".u_prev",
+        ".disp.",
+        ".disp)",
         "system.u[",
         "sys.u[",
     ];

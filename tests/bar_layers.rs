@@ -17,7 +17,7 @@ impl Observer for Trace {
         let sys = snap.system;
         self.rows.push((
             snap.control_force.unwrap_or(f64::NAN),
-            sys.u[self.uy_dof],
+            sys.displacements()[self.uy_dof],
             sys.families
                 .bars
                 .out

@@ -27,7 +27,7 @@ impl Observer for Trace {
         self.rows.push((
             snap.step,
             snap.control_force.unwrap_or(f64::NAN),
-            sys.u[self.dof],
+            sys.displacements()[self.dof],
             snap.negative_pivots,
             snap.arc_length_factor.unwrap_or(f64::NAN),
         ));
@@ -677,7 +677,7 @@ impl Observer for BeamTrace {
             .position(|p| (p[0] - 1.6).abs() < 1e-9 && p[1].abs() < 1e-9)
             .unwrap();
         self.rows
-            .push((moment, steel, flexural, -sys.u[2 * mid + 1]));
+            .push((moment, steel, flexural, -sys.displacements()[2 * mid + 1]));
         Ok(())
     }
 }
@@ -1033,7 +1033,7 @@ increments = 3000
                 .count();
             self.0.push((
                 v,
-                sys.u[2 * 2],
+                sys.displacements()[2 * 2],
                 sys.families
                     .bars
                     .out

@@ -29,7 +29,7 @@ impl Observer for Keep {
         let g = &sys.families.continuum.gauss.committed;
         self.0.push(Rec {
             time: sys.time.t_to,
-            u: sys.u.clone(),
+            u: sys.displacements().to_vec(),
             stress: g.iter().map(|o| o.stress).collect(),
             cracked: sys
                 .families
@@ -694,7 +694,7 @@ impl Observer for JointKeep {
                 .profile
                 .iter()
                 .fold(0.0_f64, |m, p| m.max(p.normal_stress)),
-            delta: sys.u[2 * b] - sys.u[2 * a],
+            delta: sys.displacements()[2 * b] - sys.displacements()[2 * a],
             force: sys
                 .families
                 .tendons

@@ -51,7 +51,7 @@ struct Last(Vec<f64>);
 
 impl Observer for Last {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-        self.0.clone_from(&s.system.u);
+        self.0 = s.system.displacements().to_vec();
         Ok(())
     }
 }
@@ -372,8 +372,10 @@ stop_displacement = {{ node = {apex}, component = "y", value = -0.2 }}
     struct Path(Vec<(f64, f64)>, usize);
     impl Observer for Path {
         fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-            self.0
-                .push((-s.system.u[2 * self.1 + 1], s.factors[0] * 1e3));
+            self.0.push((
+                -s.system.displacements()[2 * self.1 + 1],
+                s.factors[0] * 1e3,
+            ));
             Ok(())
         }
     }

@@ -82,8 +82,11 @@ impl Observer for Hist {
         let open = (0..m.joints.len())
             .map(|j| segfem::results::joints::summarise(s.system, j).max_opening)
             .fold(0.0, f64::max);
-        self.0
-            .push(vec![s.factors[1], s.system.u[2 * mid + 1], open]);
+        self.0.push(vec![
+            s.factors[1],
+            s.system.displacements()[2 * mid + 1],
+            open,
+        ]);
         Ok(())
     }
 }
@@ -280,7 +283,7 @@ struct Last {
 
 impl Observer for Last {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-        self.u = s.system.u.clone();
+        self.u = s.system.displacements().to_vec();
         let g = &s.system.families.continuum.gauss.committed;
         self.stress = g.iter().map(|p| p.stress).collect();
         Ok(())

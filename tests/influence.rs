@@ -532,7 +532,7 @@ monitors = ["midspan_uy"]
     impl Observer for Both {
         fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
             if s.end_of_step {
-                self.ends.push(s.system.u[2 * self.node + 1]);
+                self.ends.push(s.system.displacements()[2 * self.node + 1]);
             }
             Ok(())
         }

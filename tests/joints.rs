@@ -58,7 +58,7 @@ struct Keep {
 impl Observer for Keep {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
         let m = s.system.model;
-        self.u = s.system.u.clone();
+        self.u = s.system.displacements().to_vec();
         let r = |name: &str, d: usize| -> f64 {
             m.supports
                 .iter()

@@ -76,7 +76,7 @@ impl Observer for Ends {
         for (i, &(b, p)) in sys.bar_gps.iter().enumerate() {
             bs[b][p] = sys.families.bars.out.committed[i].stress;
         }
-        self.u.push(sys.u.clone());
+        self.u.push(sys.displacements().to_vec());
         self.bar_stress.push(bs);
         self.tendon_force.push(
             sys.families

@@ -48,7 +48,7 @@ impl Observer for Rows {
         }
         self.0.push((
             s.factors[1],
-            s.system.u[2 * mid + 1],
+            s.system.displacements()[2 * mid + 1],
             stress,
             open,
             compressed,

@@ -50,7 +50,7 @@ impl Observer for Keep<'_> {
         self.recs.push(Rec {
             step: s.step,
             time: sys.time.t_to,
-            u: sys.u.clone(),
+            u: sys.displacements().to_vec(),
             stress: sys
                 .families
                 .continuum

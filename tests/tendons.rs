@@ -80,8 +80,8 @@ impl Observer for Keep {
             .iter()
             .map(|&n| {
                 [
-                    m.nodes[n][0] + s.system.u[2 * n],
-                    m.nodes[n][1] + s.system.u[2 * n + 1],
+                    m.nodes[n][0] + s.system.displacements()[2 * n],
+                    m.nodes[n][1] + s.system.displacements()[2 * n + 1],
                 ]
             })
             .collect();
@@ -90,7 +90,7 @@ impl Observer for Keep {
             .iter()
             .position(|p| (p[0] - 3.0).abs() < 1e-9 && p[1].abs() < 1e-9)
             .unwrap();
-        self.mid_uy = s.system.u[2 * mid + 1];
+        self.mid_uy = s.system.displacements()[2 * mid + 1];
         Ok(())
     }
 }
@@ -280,8 +280,8 @@ impl Observer for Push {
             .iter()
             .map(|&n| {
                 [
-                    m.nodes[n][0] + sys.u[2 * n],
-                    m.nodes[n][1] + sys.u[2 * n + 1],
+                    m.nodes[n][0] + sys.displacements()[2 * n],
+                    m.nodes[n][1] + sys.displacements()[2 * n + 1],
                 ]
             })
             .collect();
@@ -292,14 +292,15 @@ impl Observer for Push {
             let w = (3.0 - xs[0][0]) / (xs[1][0] - xs[0][0]);
             xs[0][1] + w * (xs[1][1] - xs[0][1])
         };
-        let ecc = 0.3 + sys.u[2 * centroid + 1] - yt;
+        let ecc = 0.3 + sys.displacements()[2 * centroid + 1] - yt;
         let stress = sys.families.tendons.states.committed[0]
             .as_ref()
             .unwrap()
             .stresses()
             .into_iter()
             .fold(0.0, f64::max);
-        self.0.push((-sys.u[2 * top + 1], -f, stress, ecc));
+        self.0
+            .push((-sys.displacements()[2 * top + 1], -f, stress, ecc));
         Ok(())
     }
 }
@@ -446,7 +447,7 @@ kind = "load"
             let sys = s.system;
             let m = sys.model;
             let n = &m.tendons[0].nodes;
-            let x = |k: usize| m.nodes[n[k]][0] + sys.u[2 * n[k]];
+            let x = |k: usize| m.nodes[n[k]][0] + sys.displacements()[2 * n[k]];
             self.0 = sys.families.tendons.states.committed[0]
                 .as_ref()
                 .unwrap()
@@ -566,8 +567,8 @@ impl Observer for PushZ {
             .iter()
             .map(|&n| {
                 [
-                    m.nodes[n][0] + sys.u[2 * n],
-                    m.nodes[n][1] + sys.u[2 * n + 1],
+                    m.nodes[n][0] + sys.displacements()[2 * n],
+                    m.nodes[n][1] + sys.displacements()[2 * n + 1],
                 ]
             })
             .collect();
@@ -576,10 +577,10 @@ impl Observer for PushZ {
             .unwrap();
         let w = (xj - xs[i][0]) / (xs[i + 1][0] - xs[i][0]);
         let yt = xs[i][1] + w * (xs[i + 1][1] - xs[i][1]);
-        let depth = 0.6 + sys.u[2 * top + 1] - yt;
+        let depth = 0.6 + sys.displacements()[2 * top + 1] - yt;
         let slope = -(xs[1][1] - xs[0][1]) / (xs[1][0] - xs[0][0]);
         let linear = (0.6 - x0[0][1]) + xj * slope;
-        self.1.push((depth, linear, sys.u[2 * top]));
+        self.1.push((depth, linear, sys.displacements()[2 * top]));
         self.0.increment(s)
     }
 }

@@ -28,7 +28,7 @@ struct Last {
 
 impl Observer for Last {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-        self.u = s.system.u.clone();
+        self.u = s.system.displacements().to_vec();
         self.f_int = s.f_int.to_vec();
         let g = &s.system.families.continuum.gauss.committed;
         self.stress = g.iter().map(|p| p.stress).collect();

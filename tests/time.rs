@@ -38,7 +38,7 @@ impl Observer for Keep {
             time: sys.time.t_to,
             strain: sys.families.continuum.gauss.committed[0].strain,
             stress: sys.families.continuum.gauss.committed[0].stress,
-            u: sys.u.clone(),
+            u: sys.displacements().to_vec(),
             forces: sys
                 .families
                 .tendons
@@ -1006,7 +1006,7 @@ impl Observer for Life {
         let mid = seed_midspan_node(sys.model);
         self.rows.push(LifeRow {
             time: sys.time.t_to,
-            uy_mid: sys.u[2 * mid + 1],
+            uy_mid: sys.displacements()[2 * mid + 1],
             step: s.step,
             q: s.factors[1],
             forces: sys.families.tendons.states.committed[0]

@@ -20,7 +20,7 @@ struct Last {
 
 impl Observer for Last {
     fn increment(&mut self, s: &Snapshot) -> std::io::Result<()> {
-        self.u = s.system.u.clone();
+        self.u = s.system.displacements().to_vec();
         self.f_int = s.f_int.to_vec();
         self.f_ext = s.f_ext.to_vec();
         self.stress = s

@@ -16,12 +16,12 @@ pub use super::families::BarOutput;
 impl System<'_> {
     /// Committed displacements (all dofs, x and y per node) [m].
     pub fn displacements(&self) -> &[f64] {
-        &self.u
+        &self.disp.committed
     }
 
     /// Displacements before the last committed increment (all dofs) [m].
     pub fn previous_displacements(&self) -> &[f64] {
-        &self.u_prev
+        &self.disp.previous
     }
 
     /// Time interval of the last increment on the analysis clock [d].

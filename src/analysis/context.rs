@@ -1,11 +1,12 @@
-//! The analysis state a step works on while it runs: the system, the solver, the load
-//! cases and factors, the displacements of the attempt, timings; and the round of the
-//! one-way supports after an attempt has converged ([`super::one_way`]). Shared by the
-//! increment controller (`increments.rs`) and the step drivers (`steps.rs`, `path.rs`);
-//! the methods that assemble, report and follow the path are in `path.rs`.
+//! The analysis state a step works on while it runs: the system (with the displacements of
+//! the attempt, `sys.disp.trial`), the solver, the load cases and factors, timings; and the
+//! round of the one-way supports after an attempt has converged ([`super::one_way`]). Shared
+//! by the increment controller (`increments.rs`) and the step drivers (`steps.rs`,
+//! `path.rs`); the methods that assemble, report and follow the path are in `path.rs`.
 
 use super::driver::Timings;
 use super::one_way::MAX_ROUNDS;
+use super::staged::StateBlock;
 use super::system::System;
 use crate::linalg::solver::SparseCholesky;
 
@@ -19,8 +20,6 @@ pub(super) struct PathContext<'a, 's> {
     pub cases: &'a [Vec<f64>],
     /// Current load-case factors (updated).
     pub factors: &'a mut Vec<f64>,
-    /// Current displacements (all dofs) [m].
-    pub u: &'a mut Vec<f64>,
     /// Timings and counters.
     pub timings: &'a mut Timings,
     /// Negative pivots at the last converged increment.
@@ -31,18 +30,18 @@ impl PathContext<'_, '_> {
     /// Throw the trial state of an attempt away: the displacements back to the committed
     /// ones and the iteration's crack holds released.
     pub(super) fn back_to_committed(&mut self) {
-        self.u.copy_from_slice(&self.sys.u);
+        self.sys.disp.revert();
         self.sys.unlatch();
         if let Some(st) = self.sys.stages.as_mut() {
             st.revert_contacts();
         }
     }
 
-    /// The one-way supports after an attempt converged at `self.u` with internal forces
-    /// `f_int` and external forces `f_ext` [N]: the trial statuses to solve it again with
-    /// (one round more in `rounds`), or None when its statuses hold (or have chattered for
-    /// [`MAX_ROUNDS`] rounds: then counted in `support_chatter` and kept). `rounds` is set
-    /// back to 0 when None is returned.
+    /// The one-way supports after an attempt converged at the trial displacements with
+    /// internal forces `f_int` and external forces `f_ext` [N]: the trial statuses to solve it
+    /// again with (one round more in `rounds`), or None when its statuses hold (or have
+    /// chattered for [`MAX_ROUNDS`] rounds: then counted in `support_chatter` and kept).
+    /// `rounds` is set back to 0 when None is returned.
     pub(super) fn one_way_check(
         &mut self,
         f_int: &[f64],
@@ -54,7 +53,9 @@ impl PathContext<'_, '_> {
             return None;
         }
         let size = crate::model::model_size(self.sys.model);
-        let which = st.one_way.switches(self.u, f_int, f_ext, size);
+        let which = st
+            .one_way
+            .switches(&self.sys.disp.trial, f_int, f_ext, size);
         if which.is_empty() || *rounds >= MAX_ROUNDS {
             if !which.is_empty() {
                 self.timings.support_chatter += 1;
@@ -90,6 +91,6 @@ impl PathContext<'_, '_> {
             p.touching.trial = t;
         }
         st.apply_contacts();
-        st.one_way.seat(self.u);
+        st.one_way.seat(&mut self.sys.disp.trial);
     }
 }

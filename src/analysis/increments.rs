@@ -490,8 +490,9 @@ impl Sizing for Controller {
 /// What a step kind supplies to [`run`]: how an attempt is solved and what a converged
 /// increment does. The sizing `S` is the step kind's ([`Controller`] or [`ArcSizing`]).
 pub(super) trait Stepper<S> {
-    /// Solve the next increment (its size from `ctl`), starting from `ctx.u`. Returns the
-    /// internal forces [N] and the Newton iterations.
+    /// Solve the next increment (its size from `ctl`), starting from the trial displacements
+    /// (`ctx.sys.disp.trial`, left at the attempt's end). Returns the internal forces [N] and
+    /// the Newton iterations.
     fn attempt(
         &mut self,
         ctx: &mut PathContext,
@@ -580,11 +581,12 @@ pub(super) fn run<S: Sizing>(
             continue;
         }
         let implex = stepper.implex_controlled();
-        let verdict = ctl.converged(iterations, ctx.u, &ctx.sys.u, |c| {
+        let disp = &ctx.sys.disp;
+        let verdict = ctl.converged(iterations, &disp.trial, &disp.committed, |c| {
             implex && {
                 let sizes = c.implex_sizes();
-                let energy = (&mut *ctx.solver, &ctx.u[..], &f_int[..]);
-                implex_retry(ctx.sys, energy, ctx.timings, sizes, c.implex_last())
+                let energy = (&mut *ctx.solver, &disp.trial[..], &f_int[..]);
+                implex_retry(&*ctx.sys, energy, ctx.timings, sizes, c.implex_last())
             }
         });
         match verdict {

@@ -62,7 +62,7 @@ fn lines_of(
     let inf: &Influence = &model.influence[table];
     // An instantaneous perturbation: no creep, shrinkage or relaxation over it.
     sys.begin_time_increment(TimeContext::at(clock));
-    let u0 = sys.u.clone();
+    let u0 = sys.disp.committed.clone();
     let base = sys
         .assemble(&u0, true)
         .map_err(|(e, err)| format!("element {} failed at the committed state: {err:?}", e + 1))?;

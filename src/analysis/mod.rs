@@ -4,6 +4,7 @@
 pub mod bonded_time;
 pub mod committed;
 mod context;
+pub mod displacements;
 mod driver;
 pub mod failure;
 pub mod families;

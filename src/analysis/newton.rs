@@ -72,11 +72,11 @@ pub(super) fn overshot(after: f64, before: f64) -> bool {
     after.is_nan() || after > BACKTRACK_GROWTH * before
 }
 
-/// Newton–Raphson for one increment: returns the converged internal forces and iterations.
+/// Newton–Raphson for one increment from the trial displacements (`sys.disp.trial`, moved
+/// in place to the converged ones): returns the converged internal forces and iterations.
 pub(super) fn newton(
     sys: &mut System,
     solver: &mut SparseCholesky,
-    u: &mut [f64],
     f_ext: &[f64],
     timings: &mut Timings,
     factored_linear: &mut bool,
@@ -95,7 +95,7 @@ pub(super) fn newton(
     let mut last: Option<(Vec<f64>, f64)> = None;
     for it in 0..=max_it {
         let need_k = !(sys.linear && *factored_linear);
-        let mut eval = residual_at(sys, u, f_ext, need_k, timings);
+        let mut eval = residual_at(sys, f_ext, need_k, timings);
         if let Some((du, rel0)) = last.take() {
             // An overshooting correction (residual grown more than 2×, or a material update
             // failing at its strains) is halved, up to three times ([`overshot`]).
@@ -104,10 +104,10 @@ pub(super) fn newton(
                 s *= 0.5;
                 for (d, &q) in sys.dofs.eq.iter().enumerate() {
                     if q != CONSTRAINED {
-                        u[d] -= s * du[q];
+                        sys.disp.trial[d] -= s * du[q];
                     }
                 }
-                eval = residual_at(sys, u, f_ext, need_k, timings);
+                eval = residual_at(sys, f_ext, need_k, timings);
                 if c.verbose {
                     let r = eval.as_ref().map_or(f64::NAN, |e| e.3);
                     eprintln!(
@@ -142,7 +142,7 @@ pub(super) fn newton(
             if sys.release_contacts() {
                 // Converged on held contact statuses: the state stands only if the free
                 // law (statuses by the sign of λ) is converged there too.
-                let (a, _, rf, free) = residual_at(sys, u, f_ext, false, timings)?;
+                let (a, _, rf, free) = residual_at(sys, f_ext, false, timings)?;
                 history.push(free);
                 if !hold_consistent(free, rel, tol, c.verbose) {
                     return Err(NewtonFailure::diverged(history, rf));
@@ -185,7 +185,7 @@ pub(super) fn newton(
         last_energy = Some(energy);
         for (d, &q) in sys.dofs.eq.iter().enumerate() {
             if q != CONSTRAINED {
-                u[d] += du[q];
+                sys.disp.trial[d] += du[q];
             }
         }
         if it > 0 && !sys.linear {
@@ -199,18 +199,19 @@ pub(super) fn newton(
 /// An assembly, the full and free residuals [N] and the relative residual norm [-].
 type Evaluated = (crate::analysis::system::Assembled, Vec<f64>, Vec<f64>, f64);
 
-/// Assembly at `u` (with the tangent if `need_k`), crack latching, and the residual; the
-/// relative norm is taken against the larger of the external force norm and the
-/// element-force scale (which stays finite under self-equilibrated prestress).
+/// Assembly at the trial displacements (with the tangent if `need_k`), crack latching, and
+/// the residual; the relative norm is taken against the larger of the external force norm
+/// and the element-force scale (which stays finite under self-equilibrated prestress).
 fn residual_at(
     sys: &mut System,
-    u: &[f64],
     f_ext: &[f64],
     need_k: bool,
     timings: &mut Timings,
 ) -> Result<Evaluated, NewtonFailure> {
     let t = Instant::now();
-    let a = sys.assemble(u, need_k).map_err(NewtonFailure::material)?;
+    let a = sys
+        .assemble_trial(need_k)
+        .map_err(NewtonFailure::material)?;
     sys.latch_cracks();
     timings.assembly_s += t.elapsed().as_secs_f64();
     let r: Vec<f64> = f_ext.iter().zip(&a.f_int).map(|(e, i)| e - i).collect();

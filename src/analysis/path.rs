@@ -10,37 +10,37 @@ use super::increments::{
     self, external_forces, external_forces_along, ArcSizing, Controller, Growth, PairNorm, Sizing,
 };
 use super::newton::{cycling, damping, hold_consistent, newton, norm, overshot};
-use super::system::{Assembled, System};
+use super::system::{Assembled, At, System};
 use crate::fem::dofs::CONSTRAINED;
 use crate::model::{ArcLengthControl, PathControl, Predictor, Step, StepKind};
 use std::time::Instant;
 
 impl PathContext<'_, '_> {
     /// Internal forces, tangent values and the element-force scale (the residual reference
-    /// that stays finite under self-equilibrated loading) at displacements `u`.
-    fn tangent(&mut self, u: &[f64]) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
-        self.tangent_reusing(u, None)
+    /// that stays finite under self-equilibrated loading) at the displacements `at`.
+    fn tangent(&mut self, at: At<'_>) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
+        self.tangent_reusing(at, None)
     }
 
     /// As [`PathContext::tangent`], taking the assembly the line search made at its last
     /// trial point (`kept`, with the tangent) instead of assembling again when that point
-    /// is `u` to the bit: the system's trial states are still that assembly's, and the same
-    /// displacements, committed and latched states give the same forces, tangent and trial
-    /// states, so only the repetition is saved.
+    /// is the displacements `at` to the bit: the system's trial states are still that
+    /// assembly's, and the same displacements, committed and latched states give the same
+    /// forces, tangent and trial states, so only the repetition is saved.
     fn tangent_reusing(
         &mut self,
-        u: &[f64],
+        at: At<'_>,
         kept: Option<Kept>,
     ) -> Result<(Vec<f64>, Vec<f64>, f64), NewtonFailure> {
         let t = Instant::now();
-        let a = match kept.filter(|k| same_bits(&k.u, u)) {
+        let a = match kept.filter(|k| same_bits(&k.u, at.of(&self.sys.disp))) {
             Some(k) => {
                 self.timings.line_searches.reused += 1;
                 k.assembled
             }
             None => self
                 .sys
-                .assemble(u, true)
+                .assemble_at(at, true)
                 .map_err(NewtonFailure::material)?,
         };
         self.sys.latch_cracks();
@@ -59,6 +59,12 @@ impl PathContext<'_, '_> {
                 u[d] += scale * du[q];
             }
         }
+    }
+
+    /// Add `scale` × a free-equation correction to the trial displacements (the same
+    /// arithmetic as [`PathContext::add_free`]).
+    fn add_to_trial(&mut self, du: &[f64], scale: f64) {
+        self.sys.disp.add_free(&self.sys.dofs.eq, du, scale);
     }
 
     /// Report a converged increment to the observer.
@@ -204,7 +210,7 @@ fn displacement_step(
         ctl.push(Controlled {
             c,
             q,
-            v0: ctx.sys.u[c],
+            v0: ctx.sys.disp.committed[c],
             row_pos: row_positions(ctx.sys, q),
         });
     }
@@ -229,7 +235,7 @@ fn displacement_step(
     // The last increment's move of the first controlled dof (whatever step it belonged to)
     // scales the first extrapolation; then the increments of this step.
     let c0 = ctl[0].c;
-    let last_move = (ctx.sys.u[c0] - ctx.sys.u_prev[c0]).abs();
+    let last_move = (ctx.sys.disp.committed[c0] - ctx.sys.disp.previous[c0]).abs();
     let full = (value - v0).abs();
     sizing.prev_size = (last_move > 0.0 && full > 0.0).then(|| last_move / full);
     let mut stepper = DisplacementStepper {
@@ -285,8 +291,7 @@ impl increments::Stepper<Controller> for DisplacementStepper {
     }
 
     fn commit_half(&mut self, ctx: &mut PathContext) {
-        let u = ctx.u.clone();
-        ctx.sys.commit(&u);
+        ctx.sys.commit();
     }
 
     fn accept(
@@ -297,8 +302,7 @@ impl increments::Stepper<Controller> for DisplacementStepper {
         f_int: Vec<f64>,
         iterations: usize,
     ) -> Result<bool, AnalysisError> {
-        let u = ctx.u.clone();
-        ctx.sys.commit(&u);
+        ctx.sys.commit();
         let force: f64 = self.ctl.iter().map(|k| f_int[k.c] - self.f_ext[k.c]).sum();
         ctx.report(
             obs,
@@ -349,7 +353,8 @@ struct Controlled {
 /// first iteration moves the other dofs by −K_fq Δ (tangent predictor), so the controlled
 /// nodes are not pushed alone. With `extrapolate = Some(r)` the iterations start from the
 /// last converged displacements plus r × the last increment (Δ is then what remains of the
-/// controlled move). Returns the converged internal forces and the iterations.
+/// controlled move). The iterate is the trial displacements (`ctx.sys.disp.trial`), left at
+/// the converged ones. Returns the converged internal forces and the iterations.
 fn newton_controlled(
     ctx: &mut PathContext,
     f_ext: &[f64],
@@ -360,9 +365,8 @@ fn newton_controlled(
     let controls = ctx.sys.model.controls.clone();
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
-    let mut u = ctx.u.clone();
     if let Some(r) = extrapolate {
-        ctx.sys.extrapolate(&mut u, r);
+        ctx.sys.extrapolate(r);
     }
     let mut last: Option<Correction> = None;
     // The line search's last assembly, when the iterations go on from its trial point.
@@ -373,17 +377,17 @@ fn newton_controlled(
             mut k,
             mut rf,
             mut rel,
-        } = controlled_residual(ctx, &u, f_ext, ctl, kept.take())?;
+        } = controlled_residual(ctx, f_ext, ctl, kept.take())?;
         if let Some(c) = last.take() {
             if overshot(rel, c.rel) {
                 // The correction overshot (a band of open cracks or yielded bars is nearly a
                 // mechanism: the linearised step closes cracks into compression at E): back
                 // along it to where the residual's work vanishes, or half-way.
-                let (s, at) = line_search(ctx, &c.u, &c.du, &c.rf, f_ext, ctl, true)?;
+                ctx.sys.disp.trial = c.u;
+                let (s, at) = line_search(ctx, &c.du, &c.rf, f_ext, ctl, true)?;
                 let s = s.unwrap_or(0.5);
-                u.copy_from_slice(&c.u);
-                ctx.add_free(&mut u, &c.du, s);
-                Residual { f_int, k, rf, rel } = controlled_residual(ctx, &u, f_ext, ctl, at)?;
+                ctx.add_to_trial(&c.du, s);
+                Residual { f_int, k, rf, rel } = controlled_residual(ctx, f_ext, ctl, at)?;
                 if controls.verbose {
                     eprintln!(
                         "    residual grew: back to {s:.3} of the last correction, relative residual {rel:.3e}"
@@ -413,15 +417,13 @@ fn newton_controlled(
             if rel <= tol || energy_ok {
                 if ctx.sys.release_contacts() {
                     // Converged on held contact statuses: checked under the free law.
-                    let free = controlled_residual(ctx, &u, f_ext, ctl, None)?;
+                    let free = controlled_residual(ctx, f_ext, ctl, None)?;
                     history.push(free.rel);
                     if !hold_consistent(free.rel, rel, tol, controls.verbose) {
                         return Err(NewtonFailure::diverged(history, free.rf));
                     }
-                    ctx.u.copy_from_slice(&u);
                     return Ok((free.f_int, it));
                 }
-                ctx.u.copy_from_slice(&u);
                 return Ok((f_int, it));
             }
         }
@@ -432,13 +434,13 @@ fn newton_controlled(
         if it == 0 {
             // rhs_i = r_i − Σ_q K_iq Δ_q for the free i; rhs_q = K_qq Δ_q.
             for k_ in ctl {
-                let delta = k_.v0 + shift - u[k_.c];
+                let delta = k_.v0 + shift - ctx.sys.disp.trial[k_.c];
                 for &(j, pos) in &k_.row_pos {
                     rf[j] -= k[pos] * delta;
                 }
             }
             for k_ in ctl {
-                let delta = k_.v0 + shift - u[k_.c];
+                let delta = k_.v0 + shift - ctx.sys.disp.trial[k_.c];
                 rf[k_.q] = k[p.col_ptr[k_.q]] * delta;
             }
         }
@@ -461,7 +463,7 @@ fn newton_controlled(
             // correction, g(s) = δu·r(u + s δu), which has a zero in (0, 1] when the
             // correction overshoots a kink of the material response; fall back to the
             // plain halving when g does not change sign.
-            let (s, at) = line_search(ctx, &u, &du, &rf, f_ext, ctl, false)?;
+            let (s, at) = line_search(ctx, &du, &rf, f_ext, ctl, false)?;
             kept = at;
             let s = s.unwrap_or(damp);
             du.iter_mut().for_each(|v| *v *= s);
@@ -473,13 +475,13 @@ fn newton_controlled(
             first_energy.get_or_insert(energy);
             last_energy = Some(energy);
             last = Some(Correction {
-                u: u.clone(),
+                u: ctx.sys.disp.trial.clone(),
                 du: du.clone(),
                 rf,
                 rel,
             });
         }
-        ctx.add_free(&mut u, &du, 1.0);
+        ctx.add_to_trial(&du, 1.0);
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
@@ -509,16 +511,15 @@ struct Residual {
     rel: f64,
 }
 
-/// Internal forces, tangent, free residual and relative residual norm at `u` (the line
-/// search's assembly `kept` taken when it was made at `u`).
+/// Internal forces, tangent, free residual and relative residual norm at the trial
+/// displacements (the line search's assembly `kept` taken when it was made there).
 fn controlled_residual(
     ctx: &mut PathContext,
-    u: &[f64],
     f_ext: &[f64],
     ctl: &[Controlled],
     kept: Option<Kept>,
 ) -> Result<Residual, NewtonFailure> {
-    let (f_int, k, scale) = ctx.tangent_reusing(u, kept)?;
+    let (f_int, k, scale) = ctx.tangent_reusing(At::Trial, kept)?;
     let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
     let mut rf = ctx.sys.to_free(&r);
     for k in ctl {
@@ -532,7 +533,8 @@ fn controlled_residual(
     Ok(Residual { f_int, k, rf, rel })
 }
 
-/// Step length s ∈ (0, 1] along the correction `du` (free equations) from `u` where the
+/// Step length s ∈ (0, 1] along the correction `du` (free equations) from the trial
+/// displacements (left as they are) where the
 /// work of the residual g(s) = du·r(u + s du) vanishes (regula falsi with the Illinois
 /// modification, at most 6 evaluations, |g| ≤ ½ |g(0)| accepted). None when g(1) keeps the
 /// sign of g(0) (no overshoot: the full step is as good as any shorter one).
@@ -544,7 +546,6 @@ fn controlled_residual(
 /// tangent assembly costs about 1.4 residual-only ones.
 fn line_search(
     ctx: &mut PathContext,
-    u: &[f64],
     du: &[f64],
     r0: &[f64],
     f_ext: &[f64],
@@ -560,7 +561,7 @@ fn line_search(
                 tangent: bool,
                 ctx: &mut PathContext|
      -> Result<(f64, Option<Kept>), NewtonFailure> {
-        let mut ut = u.to_vec();
+        let mut ut = ctx.sys.disp.trial.clone();
         ctx.add_free(&mut ut, du, s);
         let t = Instant::now();
         // The full step after an overshoot is the iterate just assembled (and latched):
@@ -664,7 +665,7 @@ fn arc_length_step(
     let mut sizing = ArcSizing::new(a.max_increments, ctx.sys.model.controls.max_cuts, tolerance);
     let start_disp = a
         .target_displacement
-        .map(|(n, d, _)| ctx.sys.u[2 * n + d.index()]);
+        .map(|(n, d, _)| ctx.sys.disp.committed[2 * n + d.index()]);
     let mut stepper = ArcStepper {
         si,
         a,
@@ -770,8 +771,7 @@ impl increments::Stepper<ArcSizing> for ArcStepper<'_> {
     }
 
     fn commit_half(&mut self, ctx: &mut PathContext) {
-        let u = ctx.u.clone();
-        ctx.sys.commit(&u);
+        ctx.sys.commit();
         let (d_lambda, du) = self.last.take().expect("a converged arc");
         self.lambda += d_lambda;
         *ctx.factors = self.factors_at(self.lambda);
@@ -804,13 +804,12 @@ impl increments::Stepper<ArcSizing> for ArcStepper<'_> {
                 }
             }
         }
-        let u = ctx.u.clone();
-        ctx.sys.commit(&u);
+        ctx.sys.commit();
         self.lambda = lam_new;
         self.reported_lambda = lam_new;
         *ctx.factors = self.factors_at(lam_new);
         if let (Some((n, d, v)), Some(u0)) = (a.target_displacement, self.start_disp) {
-            let x = ctx.sys.u[2 * n + d.index()];
+            let x = ctx.sys.disp.committed[2 * n + d.index()];
             if (x - v) * (v - u0).signum() >= 0.0 {
                 reached = true;
             }
@@ -854,34 +853,34 @@ impl increments::Stepper<ArcSizing> for ArcStepper<'_> {
     }
 }
 
-/// Load-controlled correction from the arc-length point in `ctx.u` onto the load factor
-/// `t` (forces `f_base + t q_full` [N]): Some((internal forces, iterations)) with `ctx.u`
-/// there, or None with the arc-length point's trial states restored if Newton fails.
+/// Load-controlled correction from the arc-length point in the trial displacements onto
+/// the load factor `t` (forces `f_base + t q_full` [N]), starting from the committed
+/// displacements: Some((internal forces, iterations)) with the trial there, or None with
+/// the arc-length point and its trial states restored if Newton fails.
 fn land_on_factor(
     ctx: &mut PathContext,
     f_base: &[f64],
     q_full: &[f64],
     t: f64,
 ) -> Result<Option<(Vec<f64>, usize)>, AnalysisError> {
-    let mut u_try = ctx.sys.u.clone();
+    let disp = &mut ctx.sys.disp;
+    let arc_point = std::mem::replace(&mut disp.trial, disp.committed.clone());
     let f_t = external_forces_along(f_base, q_full, t);
     let mut factored = false;
     if let Ok((fi, it)) = newton(
         ctx.sys,
         ctx.solver,
-        &mut u_try,
         &f_t,
         ctx.timings,
         &mut factored,
         StepKind::Load,
     ) {
-        ctx.u.copy_from_slice(&u_try);
         return Ok(Some((fi, it)));
     }
-    // Restore the trial states of the arc-length point.
-    let u = ctx.u.clone();
+    // Restore the arc-length point and its trial states.
+    ctx.sys.disp.trial = arc_point;
     ctx.sys
-        .assemble(&u, false)
+        .assemble_trial(false)
         .map_err(|(e, err)| AnalysisError::Mechanism(format!("element {}: {err}", e + 1)))?;
     Ok(None)
 }
@@ -902,9 +901,8 @@ fn arc_increment(
     du_prev: &Option<Vec<f64>>,
 ) -> Result<ArcIncrement, NewtonFailure> {
     let controls = ctx.sys.model.controls.clone();
-    let u_n = ctx.sys.u.clone();
     // Predictor: tangent at the committed state.
-    let (_, k, _) = ctx.tangent(&u_n)?;
+    let (_, k, _) = ctx.tangent(At::Committed)?;
     ctx.solver
         .factorize_indefinite(&ctx.sys.asm.pattern, &k)
         .map_err(NewtonFailure::Singular)?;
@@ -925,14 +923,16 @@ fn arc_increment(
     };
     let mut d_lambda = sign * l / nt;
     let mut du: Vec<f64> = dut.iter().map(|v| v * d_lambda).collect();
-    let mut u = u_n.clone();
-    ctx.add_free(&mut u, &du, 1.0);
+    // The iterate is the trial displacements, from the committed ones.
+    let disp = &mut ctx.sys.disp;
+    disp.trial.copy_from_slice(&disp.committed);
+    ctx.add_to_trial(&du, 1.0);
     let mut history = Vec::new();
     let (mut first_energy, mut last_energy): (Option<f64>, Option<f64>) = (None, None);
     // The last correction (iterate, Δu and Δλ it started from, δu, δλ, relative residual).
     let mut last: Option<ArcCorrection> = None;
     for it in 1..=controls.max_iterations + 1 {
-        let mut eval = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full);
+        let mut eval = arc_residual(ctx, lambda_n + d_lambda, f_base, q_full);
         if let Some(c) = last.take() {
             // An overshooting correction (the residual grows more than BACKTRACK_GROWTH×, or
             // a material update fails at its wild strains) is halved, up to three times; the
@@ -940,13 +940,13 @@ fn arc_increment(
             let mut s = 1.0;
             while s > 0.2 && eval.as_ref().map_or(true, |e| overshot(e.rel, c.rel)) {
                 s *= 0.5;
-                u.copy_from_slice(&c.u);
-                ctx.add_free(&mut u, &c.corr, s);
+                ctx.sys.disp.trial.copy_from_slice(&c.u);
+                ctx.add_to_trial(&c.corr, s);
                 du.iter_mut()
                     .zip(c.du.iter().zip(&c.corr))
                     .for_each(|(d, (d0, k))| *d = d0 + s * k);
                 d_lambda = c.d_lambda + s * c.dlam;
-                eval = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full);
+                eval = arc_residual(ctx, lambda_n + d_lambda, f_base, q_full);
                 if controls.verbose {
                     let r = eval.as_ref().map_or(f64::NAN, |e| e.rel);
                     eprintln!(
@@ -977,7 +977,7 @@ fn arc_increment(
         if rel <= tol || energy_ok {
             let f_int = if ctx.sys.release_contacts() {
                 // Converged on held contact statuses: checked under the free law.
-                let free = arc_residual(ctx, &u, lambda_n + d_lambda, f_base, q_full)?;
+                let free = arc_residual(ctx, lambda_n + d_lambda, f_base, q_full)?;
                 history.push(free.rel);
                 if !hold_consistent(free.rel, rel, tol, controls.verbose) {
                     return Err(NewtonFailure::diverged(history, free.rf));
@@ -986,7 +986,6 @@ fn arc_increment(
             } else {
                 f_int
             };
-            ctx.u.copy_from_slice(&u);
             return Ok(ArcIncrement {
                 f_int,
                 d_lambda,
@@ -1012,7 +1011,7 @@ fn arc_increment(
         first_energy.get_or_insert(energy);
         last_energy = Some(energy);
         last = Some(ArcCorrection {
-            u: u.clone(),
+            u: ctx.sys.disp.trial.clone(),
             du: du.clone(),
             d_lambda,
             corr: corr.clone(),
@@ -1023,7 +1022,7 @@ fn arc_increment(
             *d += c;
         }
         d_lambda += dlam;
-        ctx.add_free(&mut u, &corr, 1.0);
+        ctx.add_to_trial(&corr, 1.0);
     }
     // The loop returns at its last iteration; this is for max_iterations = usize::MAX only.
     Err(NewtonFailure::diverged(history, Vec::new()))
@@ -1106,16 +1105,15 @@ struct ArcCorrection {
     rel: f64,
 }
 
-/// Internal forces, tangent, free residual and relative residual norm at `u` under the
-/// loads `f_base + lam q_full` (all dofs) [N].
+/// Internal forces, tangent, free residual and relative residual norm at the trial
+/// displacements under the loads `f_base + lam q_full` (all dofs) [N].
 fn arc_residual(
     ctx: &mut PathContext,
-    u: &[f64],
     lam: f64,
     f_base: &[f64],
     q_full: &[f64],
 ) -> Result<Residual, NewtonFailure> {
-    let (f_int, k, scale) = ctx.tangent(u)?;
+    let (f_int, k, scale) = ctx.tangent(At::Trial)?;
     let f_ext = external_forces_along(f_base, q_full, lam);
     let r: Vec<f64> = f_ext.iter().zip(&f_int).map(|(e, i)| e - i).collect();
     let rf = ctx.sys.to_free(&r);

@@ -7,8 +7,9 @@
 //! states equal the committed ones, no crack is latched, and every factorisation is
 //! recomputed from the same matrix.
 
+use super::displacements::Displacements;
 use super::families::Families;
-use super::staged::{same_count, StateBlock};
+use super::staged::StateBlock;
 use super::stages::{StageShape, StageState};
 use super::system::System;
 use crate::materials::point::TimeContext;
@@ -65,8 +66,8 @@ impl System<'_> {
     /// The committed state, borrowed (call between increments).
     pub fn state(&self) -> SystemStateRef<'_> {
         SavedState {
-            u: Cow::Borrowed(&self.u),
-            u_prev: Cow::Borrowed(&self.u_prev),
+            u: Cow::Borrowed(&self.disp.committed),
+            u_prev: Cow::Borrowed(&self.disp.previous),
             time: self.time,
             families: Cow::Borrowed(&self.families),
             stages: self.stages.as_ref().map(Cow::Borrowed),
@@ -88,17 +89,19 @@ impl System<'_> {
 
     /// Replace the committed (and trial) states by a saved state of the same model. Errors
     /// name what does not match (the model changed since the state was saved): each block
-    /// checks its own sizes ([`StateBlock::check_shape`]).
+    /// checks its own sizes ([`StateBlock::check_shape`]). The trial displacements equal the
+    /// committed ones after it.
     pub fn restore(&mut self, s: SystemState) -> Result<(), String> {
-        same_count("dofs", s.u.len(), self.u.len())?;
-        same_count("dofs (previous)", s.u_prev.len(), self.u_prev.len())?;
+        let n_dofs = self.disp.committed.len();
+        let disp = Displacements::saved(s.u.into_owned(), s.u_prev.into_owned());
+        self.disp.check_shape(&disp, n_dofs)?;
         self.families.check_shape(&s.families, self.model)?;
         match (&s.stages, &self.stages) {
             (Some(saved), Some(now)) => {
                 let shape = StageShape {
                     model: self.model,
                     n_eq: self.dofs.n_eq,
-                    n_dofs: self.u.len(),
+                    n_dofs,
                 };
                 now.check_shape(saved, shape)?;
             }
@@ -118,8 +121,7 @@ impl System<'_> {
             self.tendons[t] =
                 (tb.states.committed[t].as_ref()).map(|_| self.build_tendon(t, &tb.u0[t]));
         }
-        self.u = s.u.into_owned();
-        self.u_prev = s.u_prev.into_owned();
+        self.disp = disp;
         self.time = s.time;
         self.families = s.families.into_owned();
         if let Some(st) = s.stages {

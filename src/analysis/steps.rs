@@ -55,9 +55,8 @@ pub fn run_with(
     let mut neg_pivots = driver.neg_pivots;
     let mut clock = driver.clock;
     // Prescribed displacements apply from the first increment on.
-    let mut u = sys.u.clone();
     for &(d, v) in &sys.dofs.prescribed {
-        u[d] = v;
+        sys.disp.trial[d] = v;
     }
     let mut factored_linear = false;
     // Load cases given their loads by influence lines (`[[influence.place]]`).
@@ -86,7 +85,6 @@ pub fn run_with(
             solver: &mut solver,
             cases: &cases,
             factors: &mut factors,
-            u: &mut u,
             timings: &mut timings,
             neg_pivots: &mut neg_pivots,
         };
@@ -392,7 +390,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
             ctl.increment > 0,
             ctl.prev_size,
         ) {
-            ctx.sys.extrapolate(ctx.u, (target - ctl.level) / p);
+            ctx.sys.extrapolate((target - ctl.level) / p);
         }
         if let Some(work) = obs.idle_work() {
             ctx.solver.beside_next_factorisation(work);
@@ -400,7 +398,6 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
         newton(
             ctx.sys,
             ctx.solver,
-            ctx.u,
             &self.f_ext,
             ctx.timings,
             &mut self.factored_linear,
@@ -429,7 +426,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
     }
 
     fn commit_half(&mut self, ctx: &mut super::context::PathContext) {
-        ctx.sys.commit(ctx.u);
+        ctx.sys.commit();
         self.reached_clock = ctx.sys.time.t_to;
     }
 
@@ -442,7 +439,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
         iterations: usize,
     ) -> Result<bool, AnalysisError> {
         let si = self.si;
-        ctx.sys.commit(ctx.u);
+        ctx.sys.commit();
         *ctx.factors = std::mem::take(&mut self.lam);
         self.reached_clock = ctx.sys.time.t_to;
         let end_of_step = ctl.finished();
@@ -518,7 +515,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
 fn discard_trial(ctx: &mut super::context::PathContext) {
     ctx.back_to_committed();
     for &(d, v) in &ctx.sys.dofs.prescribed {
-        ctx.u[d] = v;
+        ctx.sys.disp.trial[d] = v;
     }
 }
 

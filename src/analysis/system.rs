@@ -1,5 +1,6 @@
 //! The discrete system: dof map, sparse pattern, displacements, material-point states
 //! (committed and trial), and the assembly of internal forces and tangent.
+// long: System's build, assembly, commit and stage entry share its private buffers and assembly record (elem_buf, blocks, geometry, last); its methods on public fields only are in state.rs, time.rs, bonded_time.rs and committed.rs
 
 use crate::elements::bar::{bar_green_strain, bar_strain_row};
 use crate::elements::continuum::{self, GaussOutput};
@@ -12,6 +13,8 @@ use crate::materials::point::{crack_base, plastic_base, PointState, TimeContext,
 use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
+pub use super::displacements::At;
+use super::displacements::Displacements;
 use super::families::{BarBlock, ContinuumBlock, Families, JointBlock, TendonBlock};
 pub use super::families::{BarOutput, BarPhase};
 use super::responses;
@@ -41,11 +44,10 @@ pub struct System<'m> {
     pub gp_offset: Vec<usize>,
     /// Assembler numbers of the elements, one block per family.
     pub numbers: ElementNumbers,
-    /// Committed displacements (all dofs) [m].
-    pub u: Vec<f64>,
-    /// Displacements before the last committed increment [m] (its size sets the history
-    /// extrapolation of the next increment).
-    pub u_prev: Vec<f64>,
+    /// The displacements: the Newton iterate of the increment under way, the committed
+    /// ones and those before the last committed increment (their difference sets the path
+    /// extrapolation of the next increment) [m].
+    pub disp: Displacements,
     /// Time interval of the current increment on the analysis clock [d].
     pub time: TimeContext,
     /// The state of every element family (committed and trial).
@@ -338,8 +340,7 @@ impl<'m> System<'m> {
             ordering_s,
             gp_offset,
             numbers,
-            u: vec![0.0; model.n_dofs()],
-            u_prev: vec![0.0; model.n_dofs()],
+            disp: Displacements::zero(model.n_dofs()),
             time: TimeContext::default(),
             families,
             linear,
@@ -494,12 +495,33 @@ impl<'m> System<'m> {
     /// buffers; the scatter is sequential in element order (continuum elements, joints,
     /// tendons), so results are bit-identical whatever the thread count. The error names
     /// the continuum element whose material point failed.
-    // long: one pass per element family in the scatter order (continuum with its bars, joints, tendons) that keeps results thread-independent; the passes share the scatter and buffers
     pub fn assemble(
         &mut self,
         u: &[f64],
         tangent: bool,
     ) -> Result<Assembled, (usize, UpdateError)> {
+        self.assemble_at(At::Given(u), tangent)
+    }
+
+    /// As [`System::assemble`], at the trial displacements (`disp.trial`, the Newton
+    /// iterate), read in place: no copy of the iterate per iteration.
+    pub fn assemble_trial(&mut self, tangent: bool) -> Result<Assembled, (usize, UpdateError)> {
+        self.assemble_at(At::Trial, tangent)
+    }
+
+    /// As [`System::assemble`], at the displacements `at`. The trial and committed
+    /// displacements are read where they are, in [`System::disp`]: the assembly borrows that
+    /// field for reading and the state blocks it writes (families, buffers) for writing,
+    /// disjoint fields of `self`, so the borrow checker sees that the assembly cannot move
+    /// the displacements it is made at (the drivers used to keep the iterate outside the
+    /// system for that; now it is the system's own block, [`Displacements`]).
+    // long: one pass per element family in the scatter order (continuum with its bars, joints, tendons) that keeps results thread-independent; the passes share the scatter and buffers
+    pub fn assemble_at(
+        &mut self,
+        at: At<'_>,
+        tangent: bool,
+    ) -> Result<Assembled, (usize, UpdateError)> {
+        let u = at.of(&self.disp);
         let model = self.model;
         self.last.valid = false;
         let keep = self.last.kept;
@@ -811,7 +833,7 @@ impl<'m> System<'m> {
                     &self.bar_gps,
                     &self.bar_offset,
                     &thermal,
-                    &self.u,
+                    &self.disp.committed,
                     &time,
                     false,
                     (start, end),
@@ -864,8 +886,9 @@ impl<'m> System<'m> {
             if data.stressed_in_step != step || self.tendons[t].is_some() {
                 continue;
             }
+            let u = &self.disp.committed;
             let u0: Vec<[f64; 2]> = (0..data.nodes.len())
-                .map(|p| data.at_point(p, |n| [self.u[2 * n], self.u[2 * n + 1]]))
+                .map(|p| data.at_point(p, |n| [u[2 * n], u[2 * n + 1]]))
                 .collect();
             let el = self.build_tendon(t, &u0);
             let tb = &mut self.families.tendons;
@@ -903,7 +926,7 @@ impl<'m> System<'m> {
                     let mut ue: Vec<f64> = el
                         .nodes
                         .iter()
-                        .flat_map(|&n| [self.u[2 * n], self.u[2 * n + 1]])
+                        .flat_map(|&n| [self.disp.committed[2 * n], self.disp.committed[2 * n + 1]])
                         .collect();
                     if let Some(r) = self
                         .stages
@@ -1081,27 +1104,29 @@ impl<'m> System<'m> {
         Some(self.to_free(&r))
     }
 
-    /// Accept the trial states of the last assembly and the displacements `u`.
-    pub fn commit(&mut self, u: &[f64]) {
+    /// Accept the trial states of the last assembly and the trial displacements (the
+    /// committed ones become the previous).
+    pub fn commit(&mut self) {
         self.last.valid = false;
         self.commit_time_dependent();
-        std::mem::swap(&mut self.u, &mut self.u_prev);
-        self.u.copy_from_slice(u);
+        self.disp.commit();
         self.families.commit();
         if let Some(st) = self.stages.as_mut() {
             st.commit();
         }
     }
 
-    /// Add `ratio` × the last converged increment (u − u_prev) to the free dofs of `u` [m]:
-    /// the extrapolated start of the next increment ([`crate::model::Predictor`]).
-    pub fn extrapolate(&self, u: &mut [f64], ratio: f64) {
+    /// Add `ratio` × the last converged increment (committed − previous) to the free dofs
+    /// of the trial displacements [m]: the extrapolated start of the next increment
+    /// ([`crate::model::Predictor`]).
+    pub fn extrapolate(&mut self, ratio: f64) {
         // Held equations stay where they are (a one-way support touching down in this
         // increment moved in the last one).
         let held = |q: usize| self.stages.as_ref().is_some_and(|st| st.held[q]);
+        let d_ = &mut self.disp;
         for (d, &q) in self.dofs.eq.iter().enumerate() {
             if q != CONSTRAINED && !held(q) {
-                u[d] += ratio * (self.u[d] - self.u_prev[d]);
+                d_.trial[d] += ratio * (d_.committed[d] - d_.previous[d]);
             }
         }
     }
@@ -1130,9 +1155,8 @@ impl<'m> System<'m> {
             return Ok(());
         };
         let reaction = if entered && StageState::removes_support(self.model, step) {
-            let u = self.u.clone();
             // The committed state at the committed displacements: internal forces only.
-            let a = self.assemble(&u, false);
+            let a = self.assemble_at(At::Committed, false);
             self.families.revert();
             Some(
                 a?.f_int
@@ -1144,7 +1168,7 @@ impl<'m> System<'m> {
         } else {
             None
         };
-        let (model, u, eq) = (self.model, &self.u, &self.dofs.eq);
+        let (model, u, eq) = (self.model, &self.disp.committed, &self.dofs.eq);
         self.stage_jump.clear();
         if let Some(st) = self.stages.as_mut() {
             let before = st.element_active.clone();
@@ -1176,8 +1200,7 @@ impl<'m> System<'m> {
             return Ok(());
         }
         self.last.valid = false;
-        let u = self.u.clone();
-        let a = self.assemble(&u, false);
+        let a = self.assemble_at(At::Committed, false);
         self.families.revert();
         let f_int = a?.f_int;
         let st = self.stages.as_ref().expect("placing needs stages");
@@ -1202,6 +1225,102 @@ mod tests {
     use super::*;
     use crate::materials::concrete::ConcreteState;
     use crate::materials::point::Material;
+
+    /// The displacement block inside the system, on one elastic Q4 (1 × 1 m) held in x on
+    /// its left edge and in y at node 1: an assembly at `At::Trial` / `At::Committed` is the
+    /// assembly at a copy of that vector (forces bit for bit; trial and committed differ, so
+    /// a mix-up shows), `commit` shifts committed to previous and takes the trial, the path
+    /// extrapolation adds r (committed − previous) to the free dofs of the trial only, and a
+    /// restore of a snapshot sets the trial back to the committed displacements.
+    #[test]
+    fn displacements_are_assembled_committed_and_restored_in_place() {
+        let text = r#"
+[[materials]]
+name = "e"
+kind = "elastic"
+E = 30e9
+nu = 0.2
+
+[[regions]]
+name = "r"
+material = "e"
+thickness = 0.1
+
+[mesh]
+type = "explicit"
+nodes = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+blocks = [{ region = "r", element = "Q4", elements = [[1, 2, 3, 4]] }]
+
+[[supports]]
+name = "left"
+line = [[0.0, 0.0], [0.0, 1.0]]
+ux = 0.0
+
+[[supports]]
+name = "pin"
+node = 1
+uy = 0.0
+
+[[load_cases]]
+name = "pull"
+line_loads = [{ line = [[1.0, 0.0], [1.0, 1.0]], q = [1e5, 0.0] }]
+
+[[steps]]
+name = "s"
+kind = "load"
+loads = { pull = 1.0 }
+increments = 1
+"#;
+        let model = crate::input::parse(text, "test.toml").unwrap().model;
+        let mut sys = System::new(&model);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        // Node 2 (dofs 2, 3) and node 3 (dofs 4, 5) pulled right, the top lifted.
+        let u1 = vec![0.0, 0.0, 1e-4, 0.0, 1e-4, 2e-5, 0.0, 2e-5];
+        sys.disp.trial.copy_from_slice(&u1);
+        let f1 = sys.assemble(&u1, false).unwrap().f_int;
+        assert_eq!(bits(&sys.assemble_trial(false).unwrap().f_int), bits(&f1));
+        sys.commit();
+        assert_eq!(sys.displacements(), &u1[..]);
+        assert_eq!(sys.previous_displacements(), &[0.0; 8][..]);
+        let u2: Vec<f64> = u1.iter().map(|x| 3.0 * x).collect();
+        sys.disp.trial.copy_from_slice(&u2);
+        let f2 = sys.assemble(&u2, false).unwrap().f_int;
+        assert_ne!(
+            bits(&f1),
+            bits(&f2),
+            "the two states must differ for the test to see"
+        );
+        assert_eq!(bits(&sys.assemble_trial(false).unwrap().f_int), bits(&f2));
+        assert_eq!(
+            bits(&sys.assemble_at(At::Committed, false).unwrap().f_int),
+            bits(&f1)
+        );
+        sys.commit();
+        assert_eq!(
+            (sys.displacements(), sys.previous_displacements()),
+            (&u2[..], &u1[..])
+        );
+        // Extrapolation by ½ of the last increment u2 − u1, on the free dofs; the held ones
+        // (0, 1: node 1; 6: node 4's x) keep their trial values.
+        sys.disp.trial[6] = 7.0;
+        sys.extrapolate(0.5);
+        let expected: Vec<f64> = (0..8)
+            .map(|d| match d {
+                0 | 1 => 0.0,
+                6 => 7.0,
+                _ => u2[d] + 0.5 * (u2[d] - u1[d]),
+            })
+            .collect();
+        assert_eq!(sys.disp.trial, expected);
+        // A snapshot restored: committed and previous as saved, the trial back on them.
+        let saved = sys.snapshot();
+        sys.disp.trial.fill(1.0);
+        sys.disp.commit();
+        sys.restore(saved).unwrap();
+        assert_eq!(sys.disp.committed, u2);
+        assert_eq!(sys.disp.previous, u1);
+        assert_eq!(sys.disp.trial, u2);
+    }
 
     /// The global IMPL-EX error (`System::implex_force_error`, docs/theory-concrete.md §5.2)
     /// against a hand value: one Q4 concrete element a × b = 0.2 × 0.1 m, thickness 0.15 m,

@@ -59,7 +59,7 @@ impl Plausibility {
             );
             let size = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt();
             let (node, u) = sys
-                .u
+                .displacements()
                 .chunks(2)
                 .map(|d| d[0].hypot(d[1]))
                 .enumerate()

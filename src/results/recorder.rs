@@ -811,7 +811,7 @@ fn continuum_vtu(model: &Model, snap: &Snapshot, buffer: Vec<u8>) -> (Vec<u8>, V
         .collect();
     let disp: Vec<f64> = snap
         .system
-        .u
+        .displacements()
         .chunks(2)
         .flat_map(|d| [d[0], d[1], 0.0])
         .collect();
