@@ -363,7 +363,13 @@ impl Lu4 {
         let mut piv = [0; 4];
         let mut f = [[0.0; 4]; 4];
         for c in 0..4 {
-            let p = (c..4).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+            // The last of the largest |a[i][c]| (total order), as `Iterator::max_by` picks.
+            let mut p = c;
+            for i in c + 1..4 {
+                if a[p][c].abs().total_cmp(&a[i][c].abs()) != std::cmp::Ordering::Greater {
+                    p = i;
+                }
+            }
             if a[p][c].abs() < 1e-300 || !a[p][c].is_finite() {
                 return None;
             }
