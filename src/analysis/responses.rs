@@ -5,13 +5,13 @@
 use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
 use super::tendon_time::BarPointTime;
-use crate::elements::bar::{bar_point_response, BarKinematics, BarStage};
+use crate::elements::bar::{bar_point_response, bar_strain_row, BarKinematics, BarStage};
 use crate::elements::continuum::{
     gauss_geometry, rule_points, ContinuumElement, Formulation, GaussGeometry, GaussOutput,
-    Integration, NodeBlocks,
+    Integration, NodeBlocks, TangentMemo,
 };
 use crate::elements::{ElementResponse, Response};
-use crate::materials::point::{PointState, TimeContext, UpdateError};
+use crate::materials::point::{Material, PointState, TimeContext, UpdateError};
 use crate::materials::steel::SteelState;
 use crate::model::{Geometry, Model};
 
@@ -67,6 +67,139 @@ impl GeometryCache {
         let d = &self.data[self.offset[e]..self.offset[e + 1]];
         (!d.is_empty()).then(|| GaussGeometry::unpack(d, n, n_pts))
     }
+}
+
+/// What the assembly keeps between calls besides the Gauss geometry: for a nonlinear run
+/// in small strain the elements' tangent memos and the bar points' strain rows, for any
+/// nonlinear run the elements' local materials (each a cache of values the element loop
+/// computed at every assembly, with the same operations, so the same bits).
+pub struct Kept {
+    geometry: Option<GeometryCache>,
+    memos: Option<TangentMemos>,
+    bar_rows: Vec<[f64; ND]>,
+    locals: Option<LocalMaterials>,
+}
+
+impl Kept {
+    /// The caches of `model` with its Gauss `geometry` (none for a linear run: nothing
+    /// kept); `blocks` are the node blocks each element forms, `bar_gps` the bar points in
+    /// assembly order.
+    pub fn new(
+        model: &Model,
+        geometry: Option<GeometryCache>,
+        blocks: &[NodeBlocks],
+        bar_gps: &[(usize, usize)],
+    ) -> Self {
+        let small_strain = geometry.is_some() && model.geometry != Geometry::Nonlinear;
+        let locals = geometry.as_ref().map(|g| LocalMaterials::new(model, g));
+        Self {
+            geometry,
+            memos: small_strain.then(|| TangentMemos::new(model, blocks)),
+            bar_rows: if small_strain {
+                bar_strain_rows(model, bar_gps)
+            } else {
+                Vec::new()
+            },
+            locals,
+        }
+    }
+
+    /// The Gauss-point geometry, if kept.
+    pub fn geometry(&self) -> Option<&GeometryCache> {
+        self.geometry.as_ref()
+    }
+}
+
+/// The tangent memos of the small-strain continuum elements ([`TangentMemo`]), for a
+/// nonlinear run in small strain: one per element with a Gauss-geometry cache (none for
+/// incompatible modes), each 1 + 9 n_pts + 4 × (wanted node blocks) values (a Q8 of 9
+/// points assembled by its lower triangle: 226 values, 1.8 kB; a Q4 of 4 points: 77).
+pub struct TangentMemos {
+    /// Start of each element's memo in `data` (elements + 1).
+    offset: Vec<usize>,
+    data: Vec<f64>,
+}
+
+impl TangentMemos {
+    /// Empty memos for every small-strain element of `model` with the wanted `blocks`.
+    pub fn new(model: &Model, blocks: &[NodeBlocks]) -> Self {
+        let mut offset = Vec::with_capacity(model.elements.len() + 1);
+        offset.push(0);
+        let mut len = 0;
+        for (el, b) in model.elements.iter().zip(blocks) {
+            if el.integration != Integration::Incompatible {
+                let n_pts = rule_points(el.kind, el.integration).len();
+                len += TangentMemo::len(el.nodes.len(), n_pts, *b);
+            }
+            offset.push(len);
+        }
+        Self {
+            offset,
+            data: vec![0.0; len],
+        }
+    }
+}
+
+/// The continuum elements' materials with their size-dependent constants
+/// ([`crate::materials::point::for_element`] at the element's crack band width: the crush
+/// band of a concrete), made once for a nonlinear run instead of at every element
+/// response (a copy of the concrete's parameters each time): one per distinct (material,
+/// h), each element's index into them.
+pub struct LocalMaterials {
+    materials: Vec<Material>,
+    /// Element e's entry in `materials` (`u32::MAX`: none, the model's material as it is).
+    of: Vec<u32>,
+}
+
+impl LocalMaterials {
+    /// The local materials of every element of `model` whose Gauss geometry `cache`
+    /// holds (an element without, or whose material refuses its h, has none: its
+    /// response makes or refuses it as before).
+    pub fn new(model: &Model, cache: &GeometryCache) -> Self {
+        let mut seen = std::collections::HashMap::new();
+        let mut materials = Vec::new();
+        let of = (0..model.elements.len())
+            .map(|e| {
+                let m = model.regions[model.elements[e].region].material;
+                let Some(h) = cache.h(e) else {
+                    return u32::MAX;
+                };
+                *seen.entry((m, h.to_bits())).or_insert_with(|| {
+                    match crate::materials::point::for_element(&model.materials[m].law, h) {
+                        Ok(Some(local)) => {
+                            materials.push(local);
+                            (materials.len() - 1) as u32
+                        }
+                        _ => u32::MAX,
+                    }
+                })
+            })
+            .collect();
+        Self { materials, of }
+    }
+
+    /// The local material of element `e`, if made.
+    fn get(&self, e: usize) -> Option<&Material> {
+        self.materials.get(self.of[e] as usize)
+    }
+}
+
+/// The strain rows g of the embedded bar points `bar_gps` ([`bar_strain_row`]), in their
+/// order, for a small-strain run (they depend on the undeformed geometry only; the
+/// assembly recomputed them at every bar point).
+pub fn bar_strain_rows(model: &Model, bar_gps: &[(usize, usize)]) -> Vec<[f64; ND]> {
+    let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
+    bar_gps
+        .iter()
+        .map(|&(b, p)| {
+            let bp = &model.bars[b].points[p];
+            let el = &model.elements[bp.element];
+            for (a, &node) in el.nodes.iter().enumerate() {
+                coords[a] = model.nodes[node];
+            }
+            bar_strain_row(el.kind, &coords[..el.nodes.len()], &bp.point)
+        })
+        .collect()
 }
 
 /// The crack band width h [m] of continuum element `e` as its material update takes it
@@ -133,6 +266,8 @@ pub(super) struct HostChunk<'a> {
     bar_offset: &'a [usize],
     /// First bar point of the chunk.
     b0: usize,
+    /// The strain rows of the chunk's bar points, if cached (small strain; empty: none).
+    bar_rows: &'a [[f64; ND]],
     bar_committed: &'a [SteelState],
     bar_phase: &'a [BarPhase],
     bar_eps_ref: &'a [f64],
@@ -146,15 +281,18 @@ pub(super) struct HostChunk<'a> {
     blocks: &'a [NodeBlocks],
     /// The elements' Gauss-point geometry, if cached.
     geometry: Option<&'a GeometryCache>,
+    /// The elements' local materials, if made.
+    locals: Option<&'a LocalMaterials>,
 }
 
 /// One element's own trial slices: element index, point states, Gauss outputs, bar steel
-/// states and bar outputs.
+/// states and bar outputs, and its tangent memo (empty: none).
 pub(super) type HostPiece<'a> = (
     usize,
     &'a mut [PointState],
     &'a mut [GaussOutput],
     (&'a mut [SteelState], &'a mut [BarOutput]),
+    &'a mut [f64],
 );
 
 /// Split the state of elements `start..end` so that each element's trial slices can be
@@ -173,8 +311,16 @@ pub(super) fn split_chunk<'a>(
     (start, end): (usize, usize),
     stages: Option<&'a StageState>,
     blocks: &'a [NodeBlocks],
-    geometry: Option<&'a GeometryCache>,
+    (kept, memos): (&'a mut Kept, bool),
 ) -> (HostChunk<'a>, Vec<HostPiece<'a>>) {
+    let Kept {
+        geometry,
+        memos: all_memos,
+        bar_rows,
+        locals,
+    } = kept;
+    let memos = all_memos.as_mut().filter(|_| memos);
+    let (geometry, locals) = (geometry.as_ref(), locals.as_ref());
     let g0 = gp_offset[start];
     let g1 = gp_offset[end];
     let (cont, bars) = (&mut families.continuum, &mut families.bars);
@@ -192,6 +338,7 @@ pub(super) fn split_chunk<'a>(
         bar_gps,
         bar_offset,
         b0,
+        bar_rows: bar_rows.get(b0..b1).unwrap_or(&[]),
         bar_committed: &bars.steel.committed[b0..b1],
         bar_phase: &bars.phase,
         bar_eps_ref: &bars.eps_ref[b0..b1],
@@ -201,6 +348,7 @@ pub(super) fn split_chunk<'a>(
         stages,
         blocks,
         geometry,
+        locals,
     };
     let (mut bt_rest, mut bo_rest) = (&mut bars.steel.trial[b0..b1], &mut bars.out.trial[b0..b1]);
     // Per-element slices.
@@ -209,7 +357,14 @@ pub(super) fn split_chunk<'a>(
         &mut cont.points.trial[g0..g1],
         &mut cont.gauss.trial[g0..g1],
     );
+    let (m_offset, mut m_rest): (&[usize], &mut [f64]) = match memos {
+        Some(TangentMemos { offset, data }) => (offset, &mut data[offset[start]..offset[end]]),
+        None => (&[], &mut []),
+    };
+    let m_len = |e: usize| m_offset.get(e + 1).map_or(0, |o| o - m_offset[e]);
     for e in start..end {
+        let (m, mr) = std::mem::take(&mut m_rest).split_at_mut(m_len(e));
+        m_rest = mr;
         let ngp = gp_offset[e + 1] - gp_offset[e];
         let (t, tr) = t_rest.split_at_mut(ngp);
         let (o, or) = o_rest.split_at_mut(ngp);
@@ -220,7 +375,7 @@ pub(super) fn split_chunk<'a>(
         let (bo, bor) = bo_rest.split_at_mut(nb);
         bt_rest = btr;
         bo_rest = bor;
-        pieces.push((e, t, o, (bt, bo)));
+        pieces.push((e, t, o, (bt, bo), m));
     }
     (chunk, pieces)
 }
@@ -231,7 +386,7 @@ impl HostChunk<'_> {
     /// entries.
     pub(super) fn element(
         &self,
-        (e, t, o, (bt, bo)): HostPiece,
+        (e, t, o, (bt, bo), memo): HostPiece,
         fe: &mut [f64],
         ke: &mut [f64],
     ) -> Result<(), UpdateError> {
@@ -248,6 +403,7 @@ impl HostChunk<'_> {
             bar_gps,
             bar_offset,
             b0,
+            bar_rows,
             bar_committed,
             bar_phase,
             bar_eps_ref,
@@ -257,10 +413,12 @@ impl HostChunk<'_> {
             stages,
             blocks,
             geometry,
+            locals,
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
-        let mat = &model.materials[region.material].law;
+        let local = locals.and_then(|l| l.get(e));
+        let mat = local.unwrap_or(&model.materials[region.material].law);
         let nn = el.nodes.len();
         let nd = 2 * nn;
         let mut coords = [[0.0; 2]; crate::fem::shape::MAX_NODES];
@@ -301,10 +459,12 @@ impl HostChunk<'_> {
             coords,
             thickness: region.thickness,
             material: mat,
+            localised: local.is_some(),
             time,
             imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
             blocks: blocks[e],
             geometry: cached.as_ref(),
+            memo: std::cell::Cell::from_mut(memo).as_slice_of_cells(),
         };
         element.response(
             ue,
@@ -349,6 +509,7 @@ impl HostChunk<'_> {
                 el.kind,
                 coords,
                 &bar.points[p].point,
+                bar_rows.get(bc0 + i),
                 &bar.steel,
                 bar.area,
                 stage,

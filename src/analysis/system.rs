@@ -91,9 +91,10 @@ pub struct System<'m> {
     elem_buf2: (Vec<f64>, Vec<f64>),
     /// The tangent blocks each continuum element forms (those the scatter adds).
     blocks: Vec<crate::elements::continuum::NodeBlocks>,
-    /// The continuum elements' Gauss-point geometry, computed once for a nonlinear run
-    /// (None for a linear one, which assembles twice: not worth the memory).
-    geometry: Option<responses::GeometryCache>,
+    /// What the element loop keeps between assemblies of a nonlinear run (none for a
+    /// linear one, which assembles twice: not worth the memory): the Gauss-point
+    /// geometry, tangent memos, bar strain rows, local materials ([`responses::Kept`]).
+    kept: responses::Kept,
     /// The last assembly's element forces, for [`System::reassemble_after_latch`].
     last: LastAssembly,
 }
@@ -331,9 +332,10 @@ impl<'m> System<'m> {
                 let n = model.elements[e].nodes.len();
                 crate::elements::continuum::NodeBlocks(asm.node_blocks(number, n))
             })
-            .collect();
+            .collect::<Vec<_>>();
         Self {
             model,
+            kept: responses::Kept::new(model, geometry, &blocks, &bar_gps),
             dofs,
             asm,
             ordering,
@@ -365,7 +367,6 @@ impl<'m> System<'m> {
                 ..Default::default()
             },
             blocks,
-            geometry,
         }
     }
 
@@ -567,7 +568,7 @@ impl<'m> System<'m> {
                 (start, end),
                 stages,
                 &self.blocks,
-                self.geometry.as_ref(),
+                (&mut self.kept, tangent),
             );
             // `buf` takes this chunk; `other` holds the pending chunk's responses.
             std::mem::swap(&mut buf, &mut other);
@@ -758,7 +759,7 @@ impl<'m> System<'m> {
                 (e, e + 1),
                 None,
                 &self.blocks,
-                self.geometry.as_ref(),
+                (&mut self.kept, false),
             );
             let piece = pieces.pop().expect("one element");
             let fe = &mut forces[e * responses::ND..(e + 1) * responses::ND];
@@ -839,7 +840,7 @@ impl<'m> System<'m> {
                     (start, end),
                     self.stages.as_ref(),
                     &self.blocks,
-                    self.geometry.as_ref(),
+                    (&mut self.kept, false),
                 );
                 let results = compute_chunk(pieces, responses::ND, &mut buf, |p, fe, ke| {
                     if !which[p.0] {
@@ -1003,7 +1004,7 @@ impl<'m> System<'m> {
                 if !params.implex {
                     return 0.0;
                 }
-                let h = responses::crack_band_width(model, self.geometry.as_ref(), e);
+                let h = responses::crack_band_width(model, self.kept.geometry(), e);
                 (gp_offset[e]..gp_offset[e + 1])
                     .map(|g| match (&c.points.committed[g], &c.points.trial[g]) {
                         (PointState::Concrete(cs), PointState::Concrete(ts)) => {
@@ -1060,7 +1061,7 @@ impl<'m> System<'m> {
                 if !params.implex || stages.is_some_and(|s| !s.element_acts(e)) {
                     return None;
                 }
-                let geo = responses::element_geometry(model, self.geometry.as_ref(), e);
+                let geo = responses::element_geometry(model, self.kept.geometry(), e);
                 let thickness = model.regions[el.region].thickness;
                 let n = el.nodes.len();
                 let mut f = vec![0.0; 2 * n];

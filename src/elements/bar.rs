@@ -184,13 +184,15 @@ pub struct BarPointResult {
 /// `u_e` [m] into a force: uniaxial steel `steel` at the point's stage, f += g σ A w into
 /// `f` [N] and, if given, K += g E_t A w gᵀ (+ σ A w (d dᵀ ⊗ I₂) under the total Lagrangian
 /// kinematics) into `k` [N/m]; `area` A [m²]. With a host of `kind` and node coordinates
-/// `coords` [m].
+/// `coords` [m]; `row` is the point's strain row g ([`bar_strain_row`]) if already known
+/// (small strain: it depends on the undeformed geometry only).
 #[allow(clippy::too_many_arguments)]
 pub fn bar_point_response(
     kinematics: BarKinematics,
     kind: ElementKind,
     coords: &[[f64; 2]],
     p: &BarPoint,
+    row: Option<&[f64; 2 * MAX_NODES]>,
     steel: &SteelParams,
     area: f64,
     stage: BarStage,
@@ -202,7 +204,10 @@ pub fn bar_point_response(
     let nd = u_e.len();
     let (eps_b, g, d) = match kinematics {
         BarKinematics::SmallStrain => {
-            let g = bar_strain_row(kind, coords, p);
+            let g = match row {
+                Some(g) => *g,
+                None => bar_strain_row(kind, coords, p),
+            };
             let e = g.iter().zip(u_e).map(|(a, b)| a * b).sum::<f64>();
             (e, g, None)
         }

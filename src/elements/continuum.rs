@@ -6,6 +6,7 @@ use crate::fem::shape::{cartesian_derivatives, jacobian, line_shape, MAX_NODES};
 use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
 use crate::model::ElementKind;
 use serde::{Deserialize, Serialize};
+use std::cell::Cell;
 
 /// Integration rule (plain model data, defined in [`crate::model`]).
 pub use crate::model::element_data::Integration;
@@ -61,23 +62,6 @@ impl Formulation {
     }
 }
 
-/// The signature of [`response_at`] and the total Lagrangian response.
-type ResponseFn = fn(
-    ElementKind,
-    &GaussGeometry,
-    f64,
-    &Material,
-    &[PointState],
-    &[f64],
-    &mut [f64],
-    Option<&mut [f64]>,
-    &mut [PointState],
-    &mut [GaussOutput],
-    &TimeContext,
-    &[f64],
-    NodeBlocks,
-) -> Result<(), UpdateError>;
-
 /// A continuum element ready to answer: formulation, node coordinates [m], thickness [m],
 /// material and the time increment of the analysis clock.
 pub struct ContinuumElement<'a> {
@@ -89,6 +73,9 @@ pub struct ContinuumElement<'a> {
     pub thickness: f64,
     /// Material of every point.
     pub material: &'a Material,
+    /// `material` already carries the element's size-dependent constants
+    /// ([`crate::materials::point::for_element`] at its h), made once by the caller.
+    pub localised: bool,
     /// Time increment (creep, shrinkage) [d].
     pub time: &'a TimeContext,
     /// Imposed (stress-free) normal strain θ [-] of each Gauss point, ε_th = θ (1, 1, 0)
@@ -98,6 +85,8 @@ pub struct ContinuumElement<'a> {
     pub blocks: NodeBlocks,
     /// The Gauss-point geometry if already known (a cache; None: computed from `coords`).
     pub geometry: Option<&'a GaussGeometry>,
+    /// The element's tangent memo ([`TangentMemo`]; empty: none), small strain only.
+    pub memo: &'a [Cell<f64>],
 }
 
 impl super::ElementResponse for ContinuumElement<'_> {
@@ -115,11 +104,9 @@ impl super::ElementResponse for ContinuumElement<'_> {
         let (c, t, m) = (self.coords, self.thickness, self.material);
         let (f, k) = (into.f, into.k);
         // The small-strain and total Lagrangian responses take the same arguments.
-        let (kind, integration, respond): (_, _, ResponseFn) = match self.formulation {
-            Formulation::SmallStrain { kind, integration } => (kind, integration, response_at),
-            Formulation::TotalLagrangian { kind, integration } => {
-                (kind, integration, super::total_lagrangian::response_tl)
-            }
+        let (kind, integration, tl) = match self.formulation {
+            Formulation::SmallStrain { kind, integration } => (kind, integration, false),
+            Formulation::TotalLagrangian { kind, integration } => (kind, integration, true),
             Formulation::IncompatibleModes => {
                 super::incompatible::response_at(
                     c,
@@ -145,21 +132,40 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 &computed
             }
         };
-        respond(
-            kind,
-            geometry,
-            t,
-            m,
-            committed,
-            u,
-            f,
-            k,
-            trial,
-            out,
-            self.time,
-            self.imposed,
-            self.blocks,
-        )?;
+        if tl {
+            super::total_lagrangian::response_tl(
+                kind,
+                geometry,
+                t,
+                m,
+                committed,
+                u,
+                f,
+                k,
+                trial,
+                out,
+                self.time,
+                self.imposed,
+                self.blocks,
+            )?;
+        } else {
+            small_strain(
+                kind,
+                geometry,
+                t,
+                m,
+                committed,
+                u,
+                f,
+                k,
+                trial,
+                out,
+                self.time,
+                self.imposed,
+                self.blocks,
+                (self.memo, self.localised),
+            )?;
+        }
         Ok(true)
     }
 }
@@ -407,12 +413,50 @@ pub fn response_at(
     committed: &[PointState],
     u: &[f64],
     f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+    blocks: NodeBlocks,
+) -> Result<(), UpdateError> {
+    small_strain(
+        kind,
+        geometry,
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        time,
+        imposed,
+        blocks,
+        (&[], false),
+    )
+}
+
+/// [`response_at`] with the element's tangent memo `memo` ([`TangentMemo`]; empty: none):
+/// when every point's tangent D has the bits of the memo's, the tangent is the memo's
+/// (the same function of the same values), else it is formed and kept there.
+#[allow(clippy::too_many_arguments)]
+fn small_strain(
+    kind: ElementKind,
+    geometry: &GaussGeometry,
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
     mut k: Option<&mut [f64]>,
     trial: &mut [PointState],
     out: &mut [GaussOutput],
     time: &TimeContext,
     imposed: &[f64],
     blocks: NodeBlocks,
+    (memo, localised): (&[Cell<f64>], bool),
 ) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
     let nd = 2 * n;
@@ -422,7 +466,11 @@ pub fn response_at(
     }
     let (n_pts, geo, h) = (geometry.n_pts, &geometry.points, geometry.h);
     // Size-dependent material constants once per element (same values as per point).
-    let local = crate::materials::point::for_element(mat, h)?;
+    let local = if localised {
+        None
+    } else {
+        crate::materials::point::for_element(mat, h)?
+    };
     let mat = local.as_ref().unwrap_or(mat);
     // Tangents and weights of the points, for the stiffness after all updates.
     let mut tangents = [[[0.0; 3]; 3]; 9];
@@ -456,6 +504,13 @@ pub fn response_at(
     let Some(k) = k else {
         return Ok(());
     };
+    let memo = TangentMemo::of(memo, n, n_pts, blocks);
+    if let Some(m) = memo {
+        if m.holds(&tangents[..n_pts]) {
+            m.copy_into(k, n, blocks);
+            return Ok(());
+        }
+    }
     // Rows of B_aᵀ D (2×3) of every point and node; then K_ab = Σ_g w B_aᵀ D B_b block
     // by block, summed over the points in their order in registers (the operations of
     // adding point by point into K).
@@ -493,7 +548,88 @@ pub fn response_at(
             k[row1 + 2 * b + 1] = acc[3];
         }
     }
+    if let Some(m) = memo {
+        m.keep(&tangents[..n_pts], k, n, blocks);
+    }
     Ok(())
+}
+
+/// One small-strain element's tangent memo: its points' tangents D when its tangent was
+/// last formed, and the wanted node blocks of that tangent ([`NodeBlocks`]). In small
+/// strain the tangent is a function of the points' D alone (the geometry, weights and
+/// blocks do not change), so where every D has the memo's bits the tangent has the memo's
+/// bits too, and its B_aᵀ D B_b sums are skipped: the elastic elements of a cracking
+/// model, and IMPL-EX cracked points, whose tangent comes from the committed state, repeat
+/// theirs at every iteration of an increment. Layout (f64 values, [`TangentMemo::len`]): a
+/// flag (1: filled), the n_pts × 9 entries of the D's, then 4 entries per wanted block
+/// (a, b) in the order a, then b.
+#[derive(Clone, Copy)]
+pub struct TangentMemo<'a> {
+    cells: &'a [Cell<f64>],
+    n_pts: usize,
+}
+
+impl<'a> TangentMemo<'a> {
+    /// Values of the memo of an element of `n` nodes, `n_pts` points and wanted `blocks`.
+    pub fn len(n: usize, n_pts: usize, blocks: NodeBlocks) -> usize {
+        let mut wanted = 0;
+        blocks.each(n, |_, _| wanted += 1);
+        1 + 9 * n_pts + 4 * wanted
+    }
+
+    /// The memo in `cells` if it has the length of one for this element (else none).
+    fn of(cells: &'a [Cell<f64>], n: usize, n_pts: usize, blocks: NodeBlocks) -> Option<Self> {
+        (!cells.is_empty() && cells.len() == Self::len(n, n_pts, blocks))
+            .then_some(Self { cells, n_pts })
+    }
+
+    /// Whether the memo is filled and its D's have the bits of `tangents`.
+    fn holds(&self, tangents: &[[[f64; 3]; 3]]) -> bool {
+        self.cells[0].get() == 1.0
+            && tangents
+                .iter()
+                .flatten()
+                .flatten()
+                .zip(&self.cells[1..])
+                .all(|(d, c)| d.to_bits() == c.get().to_bits())
+    }
+
+    /// Write the kept blocks into the (zeroed) element matrix `k` of `n` nodes.
+    fn copy_into(&self, k: &mut [f64], n: usize, blocks: NodeBlocks) {
+        let nd = 2 * n;
+        let kept = &self.cells[1 + 9 * self.n_pts..];
+        let mut i = 0;
+        blocks.each(n, |a, b| {
+            let (r0, r1) = (2 * a * nd + 2 * b, (2 * a + 1) * nd + 2 * b);
+            k[r0] = kept[i].get();
+            k[r0 + 1] = kept[i + 1].get();
+            k[r1] = kept[i + 2].get();
+            k[r1 + 1] = kept[i + 3].get();
+            i += 4;
+        });
+    }
+
+    /// Keep `tangents` and the wanted blocks of the element matrix `k` formed from them.
+    fn keep(&self, tangents: &[[[f64; 3]; 3]], k: &[f64], n: usize, blocks: NodeBlocks) {
+        let nd = 2 * n;
+        for (c, d) in self.cells[1..]
+            .iter()
+            .zip(tangents.iter().flatten().flatten())
+        {
+            c.set(*d);
+        }
+        let kept = &self.cells[1 + 9 * self.n_pts..];
+        let mut i = 0;
+        blocks.each(n, |a, b| {
+            let (r0, r1) = (2 * a * nd + 2 * b, (2 * a + 1) * nd + 2 * b);
+            kept[i].set(k[r0]);
+            kept[i + 1].set(k[r0 + 1]);
+            kept[i + 2].set(k[r1]);
+            kept[i + 3].set(k[r1 + 1]);
+            i += 4;
+        });
+        self.cells[0].set(1.0);
+    }
 }
 
 /// The node blocks (a, b) of an element matrix that are wanted: bit 9a + b (a, b < 9). The
@@ -512,6 +648,19 @@ impl NodeBlocks {
     #[inline]
     pub fn has(self, a: usize, b: usize) -> bool {
         self.0 >> (9 * a + b) & 1 == 1
+    }
+
+    /// Call `f(a, b)` for every wanted block of an element of `n` nodes, a then b
+    /// ascending (the order of testing [`NodeBlocks::has`] over a, then b).
+    #[inline]
+    pub fn each(self, n: usize, mut f: impl FnMut(usize, usize)) {
+        for a in 0..n {
+            let mut row = (self.0 >> (9 * a)) as u64 & ((1 << n) - 1);
+            while row != 0 {
+                f(a, row.trailing_zeros() as usize);
+                row &= row - 1;
+            }
+        }
     }
 }
 
@@ -615,4 +764,84 @@ pub fn extrapolation_weights(
         .position(|k| *k == kind)
         .expect("every kind is in ALL");
     &tables[2 * k + usize::from(integration == Integration::Reduced)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::materials::concrete::ConcreteParams;
+
+    /// The element matrix of a distorted Q8 of MC90 concrete under the uniform strain
+    /// εx = `ex` (nodal displacements ux = ex x), formed with the memo `memo` (empty: none).
+    fn q8_matrix(ex: f64, memo: &[Cell<f64>], blocks: NodeBlocks) -> Vec<f64> {
+        let kind = ElementKind::Q8;
+        let coords: Vec<[f64; 2]> = kind
+            .info()
+            .node_xi
+            .iter()
+            .map(|[x, e]| [0.4 + 0.2 * x + 0.03 * x * e, 0.15 * e + 0.01 * x])
+            .collect();
+        let mat = Material::Concrete {
+            params: Box::new(ConcreteParams::from_mc90(38e6, 0.2)),
+            density: 0.0,
+        };
+        let geo = gauss_geometry(kind, Integration::Full, &coords);
+        let committed = vec![mat.initial_state(); geo.n_pts];
+        let mut trial = committed.clone();
+        let mut out = vec![GaussOutput::default(); geo.n_pts];
+        let u: Vec<f64> = coords.iter().flat_map(|c| [ex * c[0], 0.0]).collect();
+        let (mut f, mut k) = (vec![0.0; 16], vec![f64::NAN; 256]);
+        small_strain(
+            kind,
+            &geo,
+            0.25,
+            &mat,
+            &committed,
+            &u,
+            &mut f,
+            Some(&mut k),
+            &mut trial,
+            &mut out,
+            &TimeContext::default(),
+            &[],
+            blocks,
+            (memo, false),
+        )
+        .unwrap();
+        k
+    }
+
+    /// The memo gives the tangent formed without it, bit for bit: filled on an elastic
+    /// strain, taken at a second elastic strain (the same D), and not taken once the
+    /// points crack (their D changes: the tangent formed anew, not the elastic one kept).
+    #[test]
+    fn tangent_memo_gives_the_formed_tangent() {
+        // The lower triangle of node blocks, as the assembly wants of a symmetric matrix.
+        let mut bits = 0u128;
+        for a in 0..8 {
+            for b in 0..=a {
+                bits |= 1 << (9 * a + b);
+            }
+        }
+        let blocks = NodeBlocks(bits);
+        // 1 + 9 points × 9 entries of D + 36 blocks × 4.
+        let len = TangentMemo::len(8, 9, blocks);
+        assert_eq!(len, 1 + 81 + 144);
+        let mut store = vec![0.0; len];
+        let memo = Cell::from_mut(store.as_mut_slice()).as_slice_of_cells();
+        let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        // Elastic (εx = 2e-5, a fifth of the cracking strain of C30-ish concrete).
+        let fresh = q8_matrix(2e-5, &[], blocks);
+        assert!(same(&q8_matrix(2e-5, memo, blocks), &fresh));
+        assert_eq!(memo[0].get(), 1.0, "filled");
+        // Another elastic strain: same D, the memo's tangent.
+        assert!(same(
+            &q8_matrix(-4e-5, memo, blocks),
+            &q8_matrix(-4e-5, &[], blocks)
+        ));
+        // Cracked (εx = 1e-3, ten times the cracking strain): a new D and a new tangent.
+        let cracked = q8_matrix(1e-3, &[], blocks);
+        assert!(!same(&cracked, &fresh), "cracking changes the tangent");
+        assert!(same(&q8_matrix(1e-3, memo, blocks), &cracked));
+    }
 }

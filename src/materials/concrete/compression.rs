@@ -363,7 +363,13 @@ impl Lu4 {
         let mut piv = [0; 4];
         let mut f = [[0.0; 4]; 4];
         for c in 0..4 {
-            let p = (c..4).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+            // The last of the largest |a[i][c]| (total order), as `Iterator::max_by` picks.
+            let mut p = c;
+            for i in c + 1..4 {
+                if a[p][c].abs().total_cmp(&a[i][c].abs()) != std::cmp::Ordering::Greater {
+                    p = i;
+                }
+            }
             if a[p][c].abs() < 1e-300 || !a[p][c].is_finite() {
                 return None;
             }
@@ -417,17 +423,24 @@ fn step(
     let s_tr: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| d[i][j] * ee[j]).sum());
     let h_n = law.at(ebar_n);
     let q = p.q_norm();
+    let limit = h_n.sigma_c * (1.0 + 1e-13);
+    let elastic = PlasticUpdate {
+        stress: s_tr,
+        plastic_strain: *ep_n,
+        ebar: ebar_n,
+        tangent: d,
+        plastic: false,
+    };
+    // A trial well inside the loading surface is elastic by a bound on σ_e (no arccos or
+    // power; the same decision as σ_e itself, ottosen::below_by_bound).
+    if ottosen::below_by_bound(&p.ottosen, &s_tr, q, limit) {
+        return Ok(elastic);
+    }
     // σ_e of the trial with its invariants and arccos kept for the first iterate.
     let (se_tr, kept_tr) = ottosen::equivalent_stress_kept(&p.ottosen, &s_tr);
     let se_tr = se_tr / q;
-    if se_tr <= h_n.sigma_c * (1.0 + 1e-13) {
-        return Ok(PlasticUpdate {
-            stress: s_tr,
-            plastic_strain: *ep_n,
-            ebar: ebar_n,
-            tangent: d,
-            plastic: false,
-        });
+    if se_tr <= limit {
+        return Ok(elastic);
     }
     let (e, nu, f) = (p.ec, p.nu, p.fcm);
     // Compliance C = D⁻¹.

@@ -388,7 +388,6 @@ fn direction(
 }
 
 /// Stress update of a cracked point (`committed.n_cracks` ≥ 1).
-// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit, shear cap) read as one table of cases against docs/theory-concrete.md
 pub fn update_cracked(
     p: &ConcreteParams,
     committed: &ConcreteState,
@@ -396,6 +395,22 @@ pub fn update_cracked(
     char_length: f64,
     ratio: f64,
 ) -> UpdateResult {
+    let mut st = committed.clone();
+    let (s, d) = update_cracked_into(p, committed, strain, char_length, ratio, &mut st)?;
+    Ok((st, s, d))
+}
+
+/// [`update_cracked`] with the new state written into `out` (left as it was on an error):
+/// the element loop's trial slot, without a state built and moved twice.
+// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit, shear cap) read as one table of cases against docs/theory-concrete.md
+pub fn update_cracked_into(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    ratio: f64,
+    out: &mut ConcreteState,
+) -> Result<([f64; 3], [[f64; 3]; 3]), MaterialError> {
     if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
         && !(char_length > 0.0 && char_length.is_finite())
     {
@@ -446,7 +461,8 @@ pub fn update_cracked(
         }
     }
     let g = 0.5 * p.ec / (1.0 + p.nu);
-    let mut st = committed.clone();
+    let st = out;
+    super::assign(st, committed);
     st.strain = *strain;
     st.n_cracks = n_cracks;
     st.crack_max = [r0.emax, if n_cracks >= 2 { r1.emax } else { 0.0 }];
@@ -462,7 +478,7 @@ pub fn update_cracked(
         st.crushed = true;
         st.stress = [0.0; 3];
         let d = super::d_matrix(p.ec, p.nu).map(|r| r.map(|v| v * p.residual_stiffness));
-        return Ok((st, [0.0; 3], d));
+        return Ok(([0.0; 3], d));
     }
     let mut sl = [0.0; 3];
     let mut dl = [[0.0; 3]; 3];
@@ -565,7 +581,7 @@ pub fn update_cracked(
     }
     let (s, d) = to_global(&t, &sl, &dl);
     st.stress = s;
-    Ok((st, s, d))
+    Ok((s, d))
 }
 
 /// Stress and tangent from the local (crack or principal) axes back to x, y: σ = Tᵀ σ',

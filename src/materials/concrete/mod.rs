@@ -734,10 +734,7 @@ pub fn update_full_into(
         );
     }
     if committed.n_cracks > 0 {
-        return moved(
-            out,
-            cracking::update_cracked(p, committed, strain, char_length, ratio),
-        );
+        return cracking::update_cracked_into(p, committed, strain, char_length, ratio, out);
     }
     let d = d_matrix(p.ec, p.nu);
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);

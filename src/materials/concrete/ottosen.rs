@@ -284,6 +284,55 @@ pub fn equivalent_stress_kept(p: &OttosenParams, s: &[f64; 3]) -> (f64, Kept) {
     (0.5 * (pp + root), kept)
 }
 
+/// An upper bound of h(x) = cos(⅓ arccos x) [-] on [−1, 1] without arccos or cosine: h is
+/// the largest root of 4h³ − 3h = x, increasing and concave (h′ = 1/(12h² − 3) falls as h
+/// rises from ½ to 1), so each tangent h₀ + (x − x₀)/(12h₀² − 3) at x₀ = 4h₀³ − 3h₀ lies
+/// above it (up to the round-off of evaluating them, a few 1e-16); the least of the
+/// tangents at h₀ = 0.52, 0.55, 0.6, 0.7, 0.8, 0.9, 1.
+fn cos_third_acos_above(x: f64) -> f64 {
+    [0.52, 0.55, 0.6, 0.7, 0.8, 0.9, 1.0]
+        .iter()
+        .map(|&h0: &f64| h0 + (x - (4.0 * h0 * h0 * h0 - 3.0 * h0)) / (12.0 * h0 * h0 - 3.0))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Whether σ_e(s)/q as [`equivalent_stress_kept`] computes it is at most `limit`, proven
+/// without its arccos, cosine and power from an upper bound. σ_e = ½(p + √(p² + 4αJ2))
+/// increases with p = λ√J2 + βI1, and λ = c1 h(c2 cos 3θ) with h(x) = cos(⅓ arccos x)
+/// increasing; the bound takes cos 3θ with J2·√J2 for J2^1.5 and 1e-9 added, h from its
+/// tangents ([`cos_third_acos_above`]) and λ raised by 1e-12 of itself, I1, J2 and 4αJ2 in
+/// the operations of [`invariants`] and [`equivalent_stress_kept`], and keeps a slack of
+/// 1e-12 × (2(λ√J2 + |βI1|) + √(p² + 4αJ2)) for the round-off of both evaluations (a few
+/// 1e-16 of the same scale; libm's arccos and cosine are within an ulp). Floating-point
+/// rounding is monotone, so `true` means the exact evaluation is at most `limit` too
+/// (`q` > 0). `false`: not proven (the point may still be inside); the caller evaluates
+/// σ_e. In uniaxial compression the bound is 5 % above σ_e.
+pub fn below_by_bound(p: &OttosenParams, s: &[f64; 3], q: f64, limit: f64) -> bool {
+    if !(p.c1 >= 0.0 && p.alpha >= 0.0 && q > 0.0) {
+        return false;
+    }
+    let i1 = s[0] + s[1];
+    let m = i1 / 3.0;
+    let (sx, sy, sz, t) = (s[0] - m, s[1] - m, -m, s[2]);
+    let j2 = 0.5 * (sx * sx + sy * sy + sz * sz) + t * t;
+    if j2.is_nan() || j2 <= 0.0 {
+        return false;
+    }
+    let sj2 = j2.sqrt();
+    let j3 = sx * sy * sz - sz * t * t;
+    let c = (1.5 * 3f64.sqrt() * j3 / (j2 * sj2)).clamp(-1.0, 1.0);
+    let x = (p.c2.min(C2_MAX) * c + 1e-9).clamp(-1.0, 1.0);
+    let lam = p.c1 * cos_third_acos_above(x) * (1.0 + 1e-12);
+    if !lam.is_finite() {
+        return false;
+    }
+    let (dev, hyd) = (lam * sj2, p.beta * i1);
+    let pu = dev + hyd;
+    let root = (pu * pu + 4.0 * p.alpha * j2).sqrt();
+    let slack = 1e-12 * (2.0 * (dev + hyd.abs()) + root);
+    (0.5 * (pu + root) + slack) / q <= limit
+}
+
 /// [`equivalent_stress_derivatives`] at `s` from its [`Kept`] values (same bits).
 pub fn derivatives_kept(
     p: &OttosenParams,
@@ -606,6 +655,60 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The bound never proves a state inside a limit its exact σ_e/q passes: at the exact
+    /// value less 1e-9 of it (far beyond the round-off of either evaluation, far below the
+    /// slack) it says "not proven", over a grid of plane-stress states (compression,
+    /// tension, near-hydrostatic, pure shear; the tensile meridian, where λ reaches c1 and
+    /// the bound is tight, included); and it does prove the states well inside (uniaxial
+    /// compression against 1.06 × its σ_e; every state of the grid against twice its σ_e).
+    #[test]
+    fn bound_on_equivalent_stress_never_passes_the_exact_value() {
+        let p = params();
+        let q = q_c(&p);
+        let vals = [-60e6, -45e6, -20e6, -3e6, -1e3, 0.0, 1e3, 1e6, 3.8e6, 1e7];
+        let mut proved = 0;
+        for &a in &vals {
+            for &b in &vals {
+                for &t in &[0.0, 1e3, 2e6, -7e6] {
+                    let s = [a, b, t];
+                    let exact = equivalent_stress_kept(&p, &s).0 / q;
+                    if exact > 0.0 {
+                        assert!(!below_by_bound(&p, &s, q, exact * (1.0 - 1e-9)), "{s:?}");
+                    }
+                    if below_by_bound(&p, &s, q, 2.0 * exact.abs()) {
+                        proved += 1;
+                    }
+                }
+            }
+        }
+        // Near-hydrostatic biaxial compression: σ_e small against |I1| (cancellation).
+        let s = [-30e6, -30e6 + 1.0, 0.5];
+        let exact = equivalent_stress_kept(&p, &s).0 / q;
+        assert!(!below_by_bound(&p, &s, q, exact - 1e-9 * 30e6));
+        // Uniaxial compression (σ_e/q = f by the normalisation): the bound within 6 %.
+        assert!(below_by_bound(&p, &[-20e6, 0.0, 0.0], q, 1.06 * 20e6));
+        assert!(!below_by_bound(&p, &[-20e6, 0.0, 0.0], q, 20e6));
+        let states = vals.len() * vals.len() * 4;
+        assert_eq!(proved, states - 1, "all but σ = 0 proved within 2×");
+    }
+
+    /// The tangents lie above cos(⅓ arccos x) on [−1, 1] (2001 points) up to round-off
+    /// (at a tangent's touching point the two evaluations differ in the last bits; the
+    /// bound's 1e-12 covers that) and within 2.5 % of it (the first tangent, next to
+    /// x = −1 where the slope is infinite, is the loosest).
+    #[test]
+    fn tangents_bound_cos_third_acos_from_above() {
+        for i in 0..=2000 {
+            let x = -1.0 + i as f64 / 1000.0;
+            let h = (x.acos() / 3.0).cos();
+            let b = cos_third_acos_above(x);
+            assert!(
+                b * (1.0 + 1e-12) >= h && b <= 1.025 * h,
+                "x = {x}: {b} against {h}"
+            );
         }
     }
 }
