@@ -503,6 +503,11 @@ def bench(name, runners, rounds, answers):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", default="panel,beam")
+    ap.add_argument(
+        "--modes", default="one,all",
+        help="one: every program pinned to one core with one thread (OpenBLAS too); all: every core; "
+             "a table block per mode (peers.py --modes)",
+    )
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--panel-n", type=int, default=1, help="panel mesh n x n Q4 (OpenSees' RCPS stops at first cracking on n > 1: a uniform panel cracks everywhere at once)")
     ap.add_argument("--panel-crack", default="rotating",
@@ -532,6 +537,10 @@ def main():
     only = args.only.split(",")
     progs = args.programs.split(",")
     tol_n = None if args.tolerance == "own" else float(args.tolerance)
+    modes = args.modes.split(",")
+    if any(m not in ("one", "all") for m in modes):
+        sys.exit(f"--modes {args.modes}: each mode is one or all")
+    load0 = peers.os.getloadavg()[0]
     tol_text = "each program's own test" if tol_n is None else f"both at ||unbalance||_2 <= {tol_n:g} N, no energy test"
     if "panel" in only:
         files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack, tol_n)
@@ -543,10 +552,13 @@ def main():
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs, {tol_text}"
-        lines, res = bench(name, runners, args.rounds, panel_answers)
-        table += lines
-        dump["panel"] = res
-        print("\n".join(lines), flush=True)
+        for mode in modes:
+            peers.MODE = mode
+            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, panel_answers)
+            table += lines
+            dump[f"panel {mode}"] = res
+            print("\n".join(lines), flush=True)
+        peers.MODE = None
     if "beam" in only:
         files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm, tol_n=tol_n)
         nodes, _, _, _ = beam_mesh(args.refine)
@@ -561,11 +573,16 @@ def main():
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm, {tol_text}"
-        lines, res = bench(name, runners, args.rounds, beam_answers)
-        table += lines
-        dump["beam"] = res
-        print("\n".join(lines), flush=True)
-    print("\n" + "\n".join(table))
+        for mode in modes:
+            peers.MODE = mode
+            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, beam_answers)
+            table += lines
+            dump[f"beam {mode}"] = res
+            print("\n".join(lines), flush=True)
+        peers.MODE = None
+    print(f"\n{peers.time.strftime('%Y-%m-%d %H:%M UTC', peers.time.gmtime())}, {peers.processor()}, "
+          f"load average at the start: {load0:.2f}, at the end: {peers.os.getloadavg()[0]:.2f}")
+    print("\n".join(table))
     if args.json:
         Path(args.json).write_text(json.dumps(dump))
 
