@@ -29,8 +29,9 @@ const MAGIC: &str = "segfem checkpoint";
 /// keep the softening cut-off's history (`cutoff_max`, `cutoff_max_old`); 9: the
 /// construction stage reached (staged models restart) and the recorder's joint openings; 10:
 /// the one-way supports' contact points and statuses, and the recorder's lifted points per
-/// row.
-const VERSION: u32 = 10;
+/// row; 11: the concrete points' plastic strain before the committed one (IMPL-EX in
+/// compression).
+const VERSION: u32 = 11;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -48,6 +49,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (8, 13_423_329_791_089_162_975),
     (9, 7_976_921_271_131_270_574),
     (10, 5_454_227_443_183_593_876),
+    (11, 3_136_055_901_800_596_340),
 ];
 
 #[derive(Serialize, Deserialize)]

@@ -211,6 +211,15 @@ pub struct ConcreteParams {
     /// price of a first-order error in the increment size. Default false (implicit).
     #[serde(default)]
     pub implex: bool,
+    /// IMPL-EX integration of the uncracked compression plasticity as well (needs
+    /// [`ConcreteParams::implex`]): within an increment a point that flowed in the last one
+    /// takes the stress of its plastic strain extrapolated from that increment, with the
+    /// elastic tangent; its state (plastic strain, hardening variable, crushing) is the
+    /// implicit return mapping's at the same strain. Load increments only (the
+    /// viscoplastic option keeps its own update). Default false (docs/theory-concrete.md
+    /// §4, "IMPL-EX in compression").
+    #[serde(default)]
+    pub compression_implex: bool,
     /// Owen–Hinton elasto-viscoplastic compression plasticity (None: rate-independent
     /// return mapping, the default; see [`compression::viscoplastic_update`]).
     #[serde(default)]
@@ -276,6 +285,7 @@ impl ConcreteParams {
             secant_crack_tangent: false,
             zero_double_crack: false,
             implex: false,
+            compression_implex: false,
             viscoplastic: None,
             compression_softening: CompressionSoftening::Mc90,
             crush_eu: None,
@@ -482,6 +492,10 @@ pub struct ConcreteState {
     pub(crate) strain: [f64; 3],
     pub(crate) stress: [f64; 3],
     pub(crate) plastic_strain: [f64; 3],
+    /// Plastic strain of the state before the committed one [-] (IMPL-EX compression:
+    /// the last increment's plastic flow is `plastic_strain` minus this).
+    #[serde(default)]
+    pub(crate) plastic_strain_old: [f64; 3],
     pub(crate) ebar: f64,
     pub(crate) kappa: f64,
     pub(crate) n_cracks: u8,
@@ -533,6 +547,7 @@ impl ConcreteState {
             strain: [0.0; 3],
             stress: [0.0; 3],
             plastic_strain: [0.0; 3],
+            plastic_strain_old: [0.0; 3],
             ebar: 0.0,
             kappa: 0.0,
             n_cracks: 0,
@@ -786,6 +801,7 @@ pub fn update_full_into(
             assign(out, committed);
             out.strain = *strain;
             out.plastic_strain = u.plastic_strain;
+            out.plastic_strain_old = committed.plastic_strain;
             out.ebar = u.ebar;
             let h = law.at(u.ebar);
             out.kappa = h.kappa.max(0.0);
@@ -796,6 +812,9 @@ pub fn update_full_into(
                 out.crushed = true;
                 let r = crushed(p, out, strain);
                 return moved(out, Ok(r));
+            }
+            if p.compression_implex && dt == 0.0 {
+                return Ok(implex_compression(p, committed, strain, ratio, out));
             }
             out.stress = u.stress;
             return Ok((u.stress, u.tangent));
@@ -820,6 +839,11 @@ pub fn update_full_into(
             st.crack_max_old = st.crack_max;
             st.crack_strain = [e_n, 0.0];
             st.strain = *strain;
+            st.plastic_strain_old = committed.plastic_strain;
+            if p.compression_implex && dt == 0.0 {
+                // The stress of the uncracked routes (no jump where the crack forms).
+                return Ok(implex_compression(p, committed, strain, ratio, st));
+            }
             st.stress = s_tr;
             return Ok((s_tr, d));
         }
@@ -828,8 +852,37 @@ pub fn update_full_into(
     }
     assign(out, committed);
     out.strain = *strain;
+    out.plastic_strain_old = committed.plastic_strain;
+    if p.compression_implex && dt == 0.0 {
+        // The same extrapolated stress whichever route the implicit state takes: no jump
+        // where a point that flowed last increment leaves the plastic route.
+        return Ok(implex_compression(p, committed, strain, ratio, out));
+    }
     out.stress = s_tr;
     Ok((s_tr, d))
+}
+
+/// IMPL-EX stress of an uncracked point (`compression_integration = "implex"`; Oliver,
+/// Huespe & Cante 2008): the elastic stress of the plastic strain extrapolated from the
+/// last increment's flow, ε̃ᵖ = εᵖ_n + r (εᵖ_n − εᵖ_n−1) (`ratio` r = this increment's
+/// size over the last's), with the elastic tangent: linear in the strain within the
+/// increment. `out` already holds the implicit state at `strain` (what the next
+/// extrapolation starts from); its stress is set to the IMPL-EX one.
+fn implex_compression(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    ratio: f64,
+    out: &mut ConcreteState,
+) -> ([f64; 3], [[f64; 3]; 3]) {
+    let ee: [f64; 3] = std::array::from_fn(|i| {
+        let c = committed.plastic_strain[i];
+        strain[i] - (c + ratio * (c - committed.plastic_strain_old[i]))
+    });
+    let d = d_matrix(p.ec, p.nu);
+    let s = matvec(&d, &ee);
+    out.stress = s;
+    (s, d)
 }
 
 /// `*out = c.clone()` field by field (a creep box is reused; no whole-state temporary).
@@ -838,6 +891,7 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
         strain,
         stress,
         plastic_strain,
+        plastic_strain_old,
         ebar,
         kappa,
         n_cracks,
@@ -857,6 +911,7 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
     out.strain = *strain;
     out.stress = *stress;
     out.plastic_strain = *plastic_strain;
+    out.plastic_strain_old = *plastic_strain_old;
     out.ebar = *ebar;
     out.kappa = *kappa;
     out.n_cracks = *n_cracks;

@@ -153,6 +153,11 @@ pub(super) const SCHEMA: Schema = Schema {
             "implex",
             "crack laws: implex or implicit",
         ),
+        text(
+            "compression_integration",
+            "implicit",
+            "compression plasticity: implicit or implex (needs crack_integration = implex)",
+        ),
         Key::typed(
             "normalize_equivalent_stress",
             KeyType::Flag,
@@ -360,6 +365,25 @@ fn build(t: &Table, warnings: &mut Vec<String>) -> R<Law> {
         // MC90 creep is linear up to 0.4 f_cm and its compliance holds the whole strain
         // there: the compression plasticity starts at that stress (docs/theory-time.md §9).
         p.initial_yield_ratio = 0.4;
+    }
+    if p.compression_implex {
+        // The extrapolated stress is built on the load-increment route of fixed-crack
+        // concrete alone (docs/theory-concrete.md §4, "IMPL-EX in compression").
+        for (with, on) in [
+            ("creep", p.creep.is_some()),
+            ("viscoplastic", p.viscoplastic.is_some()),
+            (
+                "crack_model = \"rotating\"",
+                p.crack_model == crate::materials::concrete::CrackModel::Rotating,
+            ),
+        ] {
+            if on {
+                return Err(t.err(
+                    "compression_integration",
+                    format!("\"implex\" is not available with {with} (fixed cracks, load increments only)"),
+                ));
+            }
+        }
     }
     p.validate().map_err(|e| t.table_err(e.to_string()))?;
     // Cracking and crushing are the law's own: no strength check.
@@ -579,6 +603,24 @@ fn concrete_overrides(
             _ => {
                 return Err(t.err(
                     "crack_integration",
+                    format!("must be \"implicit\" or \"implex\", got \"{v}\""),
+                ))
+            }
+        };
+    }
+    if let Some(v) = t.text("compression_integration") {
+        p.compression_implex = match v {
+            "implicit" => false,
+            "implex" if p.implex => true,
+            "implex" => {
+                return Err(t.err(
+                    "compression_integration",
+                    "\"implex\" needs crack_integration = \"implex\" (the increment's extrapolation ratio comes with it)".to_string(),
+                ))
+            }
+            _ => {
+                return Err(t.err(
+                    "compression_integration",
                     format!("must be \"implicit\" or \"implex\", got \"{v}\""),
                 ))
             }
