@@ -31,6 +31,12 @@ Problems (docs/performance.md, "Nonlinear side by side", lists every difference 
          as Steel01 truss elements sharing the mesh nodes (OpenSees has no embedded bars in
          2D continua), the stirrups between the nodes at y = 0.05 and 0.45 m (segfem's run
          from 0.03 to 0.47 m inside the elements).
+  wall   a cantilever shear wall (2.0 m high, 1.0 m long, 0.15 m thick; boundary, web and
+         horizontal bars) pushed sideways to 20 mm (about 1 % drift) through an elastic
+         loading beam, on a uniform Q8 mesh of 0.05 / refine m: the RC beam's laws in both
+         programs (segfem's embedded bars, OpenSees' trusses on the mesh lines), so the
+         comparison is the beam's on a problem with cracking all over the web that is not
+         start-up bound (issue 43 item 2). Not in the default --only.
 """
 
 import argparse
@@ -435,6 +441,237 @@ def beam_rows_segfem(out):
 
 
 # ---------------------------------------------------------------------------------------
+# Cantilever shear wall (issue 43 item 2: a panel problem that is not start-up bound)
+# ---------------------------------------------------------------------------------------
+
+# Wall 2.0 m high, 1.0 m long, 0.15 m thick, on a fixed base, pushed sideways through a
+# 0.2 m elastic loading beam (0.3 m thick) on top. Modelled lying down: x along the height
+# (base at x = 0, beam from x = 2.0 to 2.2), y along the wall's length. Boundary bars
+# 4 Ø16 (8.04 cm²) at 50 mm from each edge, web verticals 2 Ø10 (1.57 cm²) at the quarter
+# points, horizontals 2 Ø8 (1.0 cm²) every 0.2 m; concrete and steel as the RC beam's.
+# Section analysis: cracking near 35 kN, yield of the boundary bars near 200 kN at 7–8 mm
+# (1 % drift is 21 mm): flexure with diagonal web cracking.
+WALL = dict(H=2.0, top=0.2, lw=1.0, t=0.15, t_top=0.3, edge=8.04e-4, web=1.57e-4, horiz=1.0e-4)
+WALL_VERTICAL_Y = (0.05, 0.25, 0.5, 0.75, 0.95)
+WALL_HORIZONTAL_X = tuple(0.1 + 0.2 * k for k in range(10))
+WALL_CONTROL = (2.1, 0.5)
+
+
+def wall_mesh(r):
+    """The wall's uniform Q8 mesh (0.05 / r elements): nodes, (elements, region), index."""
+    nx, ny = 44 * r, 20 * r
+    L, D = WALL["H"] + WALL["top"], WALL["lw"]
+    xs = [L * i / (2 * nx) for i in range(2 * nx + 1)]
+    ys = [D * j / (2 * ny) for j in range(2 * ny + 1)]
+    idx, nodes = {}, []
+    for j in range(2 * ny + 1):
+        for i in range(2 * nx + 1):
+            if i % 2 and j % 2:
+                continue
+            idx[(i, j)] = len(nodes)
+            nodes.append((xs[i], ys[j]))
+    elems = []
+    for j in range(0, 2 * ny, 2):
+        for i in range(0, 2 * nx, 2):
+            c = [(i, j), (i + 2, j), (i + 2, j + 2), (i, j + 2)]
+            m = [(i + 1, j), (i + 2, j + 1), (i + 1, j + 2), (i, j + 1)]
+            reg = "top" if (xs[i] + xs[i + 2]) / 2 > WALL["H"] else "concrete"
+            elems.append(([idx[p] for p in c + m], reg))
+    return nodes, elems, idx, (nx, ny)
+
+
+def write_wall(r, d, tol_n=None, stop_mm=20.0):
+    """The wall in both programs, pushed to `stop_mm` at the loading beam's axis: 0.5 mm in
+    25 increments, then the rest in 120. `tol_n` [N] as for the beam (None: each program's
+    own, segfem's relative 1e-4, OpenSees 10 N)."""
+    d.mkdir(parents=True, exist_ok=True)
+    H, lw, t = WALL["H"], WALL["lw"], WALL["t"]
+    h = 0.05 / r
+    bars = []
+    for k, y in enumerate(WALL_VERTICAL_Y):
+        a = WALL["edge"] if k in (0, len(WALL_VERTICAL_Y) - 1) else WALL["web"]
+        bars.append((f"v{k}", [[0.0, y], [H, y]], a))
+    for k, x in enumerate(WALL_HORIZONTAL_X):
+        bars.append((f"h{k}", [[round(x, 6), 0.05], [round(x, 6), lw - 0.05]], WALL["horiz"]))
+    bar_text = "".join(
+        f'\n[[bars]]\nname = "{n}"\npath = {p!r}\narea = {a!r}\nmaterial = "B500"\n' for n, p, a in bars
+    )
+    solver = ("force_tolerance = 1e-4\n" if tol_n is None
+              else f"absolute_force_tolerance = {tol_n!r}\nenergy_tolerance = 1e-30\n")
+    (d / "segfem.toml").write_text(
+        f"""title = "Cantilever shear wall 2.0 x 1.0 x 0.15 m, refine {r}"
+[[materials]]
+name = "C30"
+kind = "concrete"
+fcm = {BEAM['fcm']!r}
+nu = {BEAM['nu']!r}
+tension_softening = "crack_band"
+initial_yield_ratio = 0.3
+compression_softening = "crush_band"
+crack_integration = "implex"
+[[materials]]
+name = "B500"
+kind = "rebar"
+E = {BEAM['es']!r}
+fy = {BEAM['fy']!r}
+Et = {BEAM['et']!r}
+[[materials]]
+name = "C30_elastic"
+kind = "elastic"
+E = {BEAM['E']!r}
+nu = {BEAM['nu']!r}
+[[regions]]
+name = "wall"
+material = "C30"
+thickness = {t!r}
+[[regions]]
+name = "top"
+material = "C30_elastic"
+thickness = {WALL['t_top']!r}
+boxes = [[[{H!r}, 0.0], [{H + WALL['top']!r}, {lw!r}]]]
+[mesh]
+type = "banded"
+length = {H + WALL['top']!r}
+nx = {44 * r}
+element = "Q8"
+bands = [{{ region = "wall", depth = {lw!r}, rows = {20 * r} }}]
+{bar_text}
+[[supports]]
+name = "base"
+line = [[0.0, 0.0], [0.0, {lw!r}]]
+ux = 0.0
+uy = 0.0
+[[monitors]]
+name = "control_uy"
+kind = "displacement"
+point = {list(WALL_CONTROL)!r}
+component = "y"
+[[monitors]]
+name = "steel_max"
+kind = "bar_stress"
+bar = "v0"
+[[steps]]
+name = "cracking"
+kind = "displacement"
+control = {{ point = {list(WALL_CONTROL)!r}, component = "y", value = 0.0005 }}
+increments = 25
+[[steps]]
+name = "to_failure"
+kind = "displacement"
+control = {{ point = {list(WALL_CONTROL)!r}, component = "y", value = {stop_mm / 1e3!r} }}
+increments = 120
+[solver]
+{solver}max_iterations = 30
+max_cuts = 8
+"""
+    )
+    nodes, elems, idx, (nx, ny) = wall_mesh(r)
+    L = H + WALL["top"]
+    te, ts, td, ce, cs = asd_laws(h)
+    ix = lambda x: round(x * 2 * nx / L)  # noqa: E731
+    jy = lambda y: round(y * 2 * ny / lw)  # noqa: E731
+    trusses = []  # (node list along the bar, area)
+    for _, path, a in bars:
+        (x0, y0), (x1, y1) = path
+        if y0 == y1:
+            line = [idx[(i, jy(y0))] for i in range(ix(x0), ix(x1) + 1)]
+        else:
+            line = [idx[(ix(x0), j)] for j in range(jy(y0), jy(y1) + 1)]
+        trusses.append((line, a))
+    base = [idx[(0, j)] for j in range(2 * ny + 1)]
+    ctrl = idx[(ix(WALL_CONTROL[0]), jy(WALL_CONTROL[1]))]
+    E, nu = BEAM["E"], BEAM["nu"]
+    (d / "opensees.py").write_text(
+        f"""import openseespy.opensees as ops, json, time
+t0 = time.perf_counter()
+ops.wipe(); ops.model('basic', '-ndm', 2, '-ndf', 2)
+nodes = {nodes!r}
+elems = {elems!r}
+for k, (x, y) in enumerate(nodes):
+    ops.node(k + 1, x, y)
+ops.nDMaterial('ASDConcrete3D', 1, {E!r}, {nu!r}, '-Te', *{te!r}, '-Ts', *{ts!r}, '-Td', *{td!r},
+               '-Ce', *{ce!r}, '-Cs', *{cs!r}, '-implex', '-autoRegularization', {h!r})
+ops.nDMaterial('ElasticIsotropic', 2, {E!r}, {nu!r})
+mats = {{'concrete': (1, {t!r}), 'top': (2, {WALL['t_top']!r})}}
+for k, (e, reg) in enumerate(elems):
+    m, th = mats[reg]
+    ops.element('quad8n', k + 1, *[v + 1 for v in e], th, 'PlaneStress', m)
+ops.uniaxialMaterial('Steel01', 10, {BEAM['fy']!r}, {BEAM['es']!r}, {BEAM['et'] / BEAM['es']!r})
+ne = len(elems)
+edge = []
+for n, (line, a) in enumerate({trusses!r}):
+    for p, q in zip(line[:-1], line[1:]):
+        ne += 1
+        ops.element('truss', ne, p + 1, q + 1, a, 10)
+        if n == 0:
+            edge.append((ne, a))
+for k in {base!r}:
+    ops.fix(k + 1, 1, 1)
+ops.timeSeries('Linear', 1); ops.pattern('Plain', 1, 1); ops.sp({ctrl} + 1, 2, 1.0)
+ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Transformation')
+ops.test('NormUnbalance', {10.0 if tol_n is None else tol_n!r}, 30)
+ops.algorithm('Newton')
+ops.analysis('Static')
+t1 = time.perf_counter()
+rows, iters, fails = [], 0, 0
+def run(total, n):
+    # As the beam's: a failed increment is halved (up to 8 times), the size regrows after
+    # each success.
+    global iters, fails
+    du0 = total / n
+    done, du = 0.0, du0
+    while done < total - 1e-12:
+        du = min(du, total - done)
+        ops.integrator('LoadControl', du)  # pseudo-time = the beam's sideways displacement [m]
+        ok = ops.analyze(1)
+        iters += ops.testIter()
+        if ok != 0:
+            fails += 1
+            du /= 2
+            if du < du0 / 256:
+                return False
+            continue
+        done += du
+        s = max(ops.eleResponse(e, 'axialForce')[0] / a for e, a in edge)
+        ops.reactions()
+        rows.append((ops.nodeDisp({ctrl} + 1, 2), ops.nodeReaction({ctrl} + 1, 2), s))
+        if du < du0:
+            du *= 2
+    return True
+okk = run(0.0005, 25) and run({stop_mm / 1e3 - 0.0005!r}, 120)
+t2 = time.perf_counter()
+json.dump({{'rows': rows, 'iterations': iters, 'failed_attempts': fails, 'completed': okk,
+           'increments': len(rows), 'setup_s': t1 - t0, 'analysis_s': t2 - t1}}, open('opensees_result.json', 'w'))
+print('RESULT', max(r[1] for r in rows))
+"""
+    )
+    return {"segfem": d / "segfem.toml", "OpenSees": d / "opensees.py"}
+
+
+def wall_answers(rows):
+    """rows: (control uy [m] > 0, P [N] > 0, edge bar stress max [Pa])."""
+    xy = [(u, p) for u, p, _ in rows]
+    ipk = max(range(len(rows)), key=lambda i: rows[i][1])
+    y = next((p for _, p, s in rows if s >= 0.999 * BEAM["fy"]), float("nan"))
+    return {
+        "cracking P [kN] (secant < 0.9 initial)": secant_drop(xy) / 1e3,
+        "yield P [kN] (edge bar at f_y)": y / 1e3,
+        "peak P [kN]": rows[ipk][1] / 1e3,
+        "P at the end [kN]": rows[-1][1] / 1e3,
+        "end: displacement [mm]": rows[-1][0] * 1e3,
+    }
+
+
+def wall_rows_segfem(out):
+    rows = list(csv.DictReader(open(out / "history.csv")))
+    data = [
+        (float(r["control_uy [m]"]), abs(float(r["control_force [N]"])), float(r["steel_max [Pa]"]))
+        for r in rows
+    ]
+    return data, sum(int(r["iterations"]) for r in rows)
+
+
+# ---------------------------------------------------------------------------------------
 # Running
 # ---------------------------------------------------------------------------------------
 
@@ -512,7 +749,7 @@ def main():
     ap.add_argument("--panel-n", type=int, default=1, help="panel mesh n x n Q4 (OpenSees' RCPS stops at first cracking on n > 1: a uniform panel cracks everywhere at once)")
     ap.add_argument("--panel-crack", default="rotating",
                     help="segfem's panel concrete: rotating (+ VC93 compression softening, the panel series' best) or fixed (seed beta, OOFEM's ConcreteFCM counterpart)")
-    ap.add_argument("--refine", type=int, default=1, help="beam mesh refinement (1 = the example)")
+    ap.add_argument("--refine", type=int, default=1, help="beam and wall mesh refinement (1 = the example; the wall's 0.05 m elements)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
     ap.add_argument(
         "--tolerance", default="10",
@@ -578,6 +815,22 @@ def main():
             lines, res = bench(f"{name} [{mode}]", runners, args.rounds, beam_answers)
             table += lines
             dump[f"beam {mode}"] = res
+            print("\n".join(lines), flush=True)
+        peers.MODE = None
+    if "wall" in only:
+        files = write_wall(args.refine, peers.WORK / f"nl_wall_{args.refine}", tol_n=tol_n)
+        nodes, _, _, _ = wall_mesh(args.refine)
+        runners = {
+            "segfem": lambda: run_segfem(files["segfem"], wall_rows_segfem),
+            "OpenSees": lambda: run_opensees(files["OpenSees"]),
+        }
+        runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
+        name = f"shear wall refine {args.refine}, Q8, {2 * len(nodes)} dofs, to 20 mm, {tol_text}"
+        for mode in modes:
+            peers.MODE = mode
+            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, wall_answers)
+            table += lines
+            dump[f"wall {mode}"] = res
             print("\n".join(lines), flush=True)
         peers.MODE = None
     print(f"\n{peers.time.strftime('%Y-%m-%d %H:%M UTC', peers.time.gmtime())}, {peers.processor()}, "
