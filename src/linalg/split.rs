@@ -614,6 +614,7 @@ impl SplitCholesky {
     }
 
     /// Which blocks of the last factorisation went by LDLᵀ: half 1, half 2, the separator.
+    #[cfg(test)]
     pub fn ldlt_blocks(&self) -> [bool; 3] {
         [self.halves[0].ldlt, self.halves[1].ldlt, self.s_ldlt]
     }
