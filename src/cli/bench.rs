@@ -683,13 +683,15 @@ pub struct BareRow {
     /// negative pivots (by halves and whole, the same) and medians of [`BARE_ROUNDS`]
     /// factorisations [s] as `factorize_indefinite` runs them: the whole matrix's LLᵀ
     /// attempt then LDLᵀ (after a definite tangent), its LLᵀ and LDLᵀ at once on two cores
-    /// (after an indefinite one), and by halves (LLᵀ per half, LDLᵀ where it fails); the
+    /// (after an indefinite one), by halves after a definite tangent (LLᵀ per half, LDLᵀ
+    /// where it fails) and after an indefinite one (LDLᵀ at once where it was needed); the
     /// largest difference of the whole and split solutions relative to the largest entry.
     /// Zero when the system does not go by halves.
     pub ldlt_negative_pivots: usize,
     pub ldlt_whole_sequential_s: f64,
     pub ldlt_whole_concurrent_s: f64,
     pub ldlt_split_s: f64,
+    pub ldlt_split_next_s: f64,
     pub ldlt_rel_diff: f64,
 }
 
@@ -771,7 +773,7 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
     };
     let split_rel_diff = rel_diff(&xw, &xs);
     // The indefinite matrix K − σ diag(K), factorised the three ways, alternated.
-    let (mut lw1, mut lw2, mut ls) = (vec![0.0], vec![0.0], vec![0.0]);
+    let (mut lw1, mut lw2, mut ls, mut ls2) = (vec![0.0], vec![0.0], vec![0.0], vec![0.0]);
     let (mut ldlt_negative_pivots, mut ldlt_rel_diff) = (0, 0.0);
     if own_split {
         let mut kd = k.clone();
@@ -781,7 +783,7 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
             }
         }
         let err = |e: segfem::linalg::solver::SolverError| e.to_string();
-        (lw1, lw2, ls) = (vec![], vec![], vec![]);
+        (lw1, lw2, ls, ls2) = (vec![], vec![], vec![], vec![]);
         for _ in 0..BARE_ROUNDS {
             // After a definite tangent: the LLᵀ attempt, then the LDLᵀ.
             whole.factorize_indefinite(pattern, &k).map_err(err)?;
@@ -792,9 +794,15 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
             let t = Instant::now();
             whole.factorize_indefinite(pattern, &kd).map_err(err)?;
             lw2.push(t.elapsed().as_secs_f64());
+            // By halves after a definite tangent (LLᵀ attempts), then after an indefinite
+            // one (LDLᵀ at once in the halves that were indefinite).
+            split.factorize_indefinite(pattern, &k).map_err(err)?;
             let t = Instant::now();
             let ns = split.factorize_indefinite(pattern, &kd).map_err(err)?;
             ls.push(t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            split.factorize_indefinite(pattern, &kd).map_err(err)?;
+            ls2.push(t.elapsed().as_secs_f64());
             if nw != ns {
                 return Err(format!("negative pivots: {nw} whole, {ns} by halves"));
             }
@@ -825,6 +833,7 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         ldlt_whole_sequential_s: median(&mut lw1),
         ldlt_whole_concurrent_s: median(&mut lw2),
         ldlt_split_s: median(&mut ls),
+        ldlt_split_next_s: median(&mut ls2),
         ldlt_rel_diff,
     })
 }

@@ -1580,7 +1580,8 @@ mod tests {
     /// separator's Schur complement (halves by LLᵀ) or in the halves as well (LDLᵀ
     /// throughout), the negative pivots are the matrix's negative eigenvalues (faer's dense
     /// symmetric eigenvalues, an independent computation) and the solution is the dense LU
-    /// solve's to round-off; a positive-definite one is factorised by LLᵀ throughout.
+    /// solve's to round-off; a positive-definite one is factorised by LLᵀ throughout, or by
+    /// LDLᵀ with no negative pivot right after an indefinite one.
     #[test]
     fn ldlt_by_halves_inertia_and_solution() {
         use faer::linalg::solvers::Solve;
@@ -1602,11 +1603,16 @@ mod tests {
         assert!(b_min > lam[0], "{b_min} against {}", lam[0]);
         let only_separator = 0.5 * (lam[0] + b_min.min(lam[1]));
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        // After an indefinite border matrix its half goes to LDLᵀ at once (and so does S),
+        // also for the definite matrix that follows; the one after that is LLᵀ again.
+        let definite = lam[0] - 0.5;
         for (sigma, blocks) in [
-            (lam[0] - 0.5, [false, false, false]),
+            (definite, [false, false, false]),
             (only_separator, [false, false, true]),
             (0.37, [true, true, true]),
             (3.0, [true, true, true]),
+            (definite, [true, true, true]),
+            (definite, [false, false, false]),
         ] {
             let mut vals = base.clone();
             for j in 0..n {
@@ -1645,9 +1651,9 @@ mod tests {
             );
         }
         assert_eq!(split.stats.split_ldlt_to_whole, 0);
-        // Three factorisations ended in LDLᵀ, each counted as the LLᵀ attempt and the LDLᵀ.
-        assert_eq!(split.stats.ldlt_factorisations, 3);
-        assert_eq!(split.stats.factorisations, 7);
+        // Four factorisations ended in LDLᵀ, each counted as the LLᵀ attempt and the LDLᵀ.
+        assert_eq!(split.stats.ldlt_factorisations, 4);
+        assert_eq!(split.stats.factorisations, 10);
     }
 
     /// LDLᵀ by halves of a singular matrix (a zero row and column) in half 1, half 2 or

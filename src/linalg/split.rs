@@ -184,6 +184,9 @@ struct Half {
     /// Whether the factor in `l_values` is an LDLᵀ (D on the supernodes' diagonals, L
     /// unit) rather than an LLᵀ.
     ldlt: bool,
+    /// Whether the last factorisation was an LDLᵀ of an indefinite Bᵢ (a negative pivot of
+    /// its own or trailing block): the next indefinite factorisation goes to LDLᵀ at once.
+    indefinite: bool,
     /// After an LDLᵀ: the trailing block's pivots Dᵢ (s) and Mᵢ Dᵢ (s × s, allocated at the
     /// first LDLᵀ).
     d33: Vec<f64>,
@@ -431,6 +434,7 @@ impl SplitCholesky {
                 m33: vec![0.0; s * s],
                 schur: vec![0.0; s * s],
                 ldlt: false,
+                indefinite: false,
                 d33: vec![0.0; s],
                 md: Vec::new(),
                 x: vec![0.0; nb],
@@ -520,14 +524,22 @@ impl SplitCholesky {
     }
 
     /// Numeric factorisation of a symmetric matrix that may be indefinite, by halves: each
-    /// half's border matrix by LLᵀ, or by LDLᵀ (no pivoting) where its LLᵀ fails; the
+    /// half's border matrix by LLᵀ, or by LDLᵀ (no pivoting) where its LLᵀ fails or where
+    /// the border matrix was indefinite at the last factorisation; the
     /// separator's S by dense LLᵀ when both halves went by LLᵀ and it is positive definite,
     /// else by dense LDLᵀ (no pivoting). `tiny`: as in [`SplitCholesky::factorize`].
     pub fn factorize_indefinite(&mut self, values: &[f64], tiny: f64) -> IndefiniteOutcome {
         let [h1, h2] = &mut self.halves;
-        let run = |h: &mut Half| match h.factorize(values, tiny, false) {
-            Err(HalfFail::NotPositive(_)) => h.factorize(values, tiny, true),
-            r => r,
+        // A half whose border matrix was indefinite at the last factorisation goes to LDLᵀ at
+        // once (its LLᵀ attempt would most likely fail again, after part of the work).
+        let run = |h: &mut Half| {
+            if h.indefinite {
+                return h.factorize(values, tiny, true);
+            }
+            match h.factorize(values, tiny, false) {
+                Err(HalfFail::NotPositive(_)) => h.factorize(values, tiny, true),
+                r => r,
+            }
         };
         let (r1, r2) = rayon::join(|| run(h1), || run(h2));
         let pivots = match (r1, r2) {
@@ -685,6 +697,7 @@ impl Half {
         let (m, nb) = (self.m, self.pattern.nrows());
         let s = nb - m;
         self.ldlt = ldlt;
+        self.indefinite = false;
         let a = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
         let stack = MemStack::new(&mut self.mem);
         if ldlt {
@@ -783,6 +796,7 @@ impl Half {
             if !(growth <= TRAILING_GROWTH * a33.max(t33)) {
                 return Err(HalfFail::Trailing);
             }
+            self.indefinite = own.negative > 0 || self.d33.iter().any(|&d| d < 0.0);
             MatRef::from_column_major_slice(&self.md, s, s)
         } else {
             mm
