@@ -793,7 +793,9 @@ impl Half {
                     .sum();
                 a.max(t.abs())
             });
-            if !(growth <= TRAILING_GROWTH * a33.max(t33)) {
+            // (A NaN growth fails too.)
+            let bound = TRAILING_GROWTH * a33.max(t33);
+            if growth.is_nan() || growth > bound {
                 return Err(HalfFail::Trailing);
             }
             self.indefinite = own.negative > 0 || self.d33.iter().any(|&d| d < 0.0);
