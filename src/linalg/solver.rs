@@ -1,8 +1,8 @@
 //! The one linear-solver interface of segfem: a symmetric sparse matrix in compressed-column
 //! form (lower triangle), symbolic analysis (AMD ordering) once per pattern, numeric
 //! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work;
-//! the LLᵀ of a large system ordered by nested dissection goes by halves on two cores
-//! ([`super::split`]).
+//! the LLᵀ of a large system ordered by nested dissection, and the LDLᵀ of an indefinite
+//! one, go by halves on two cores ([`super::split`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -414,7 +414,9 @@ pub struct SparseCholesky {
     /// Smallest factor [values] for that ([`CONCURRENT_LDLT_VALUES`]; lowered by tests).
     concurrent_min: usize,
     /// The LLᵀ factorised as two halves at once and the separator (large systems ordered by
-    /// nested dissection); LDLᵀ and a failed split LLᵀ go the whole-matrix way.
+    /// nested dissection), and the LDLᵀ of an indefinite tangent; a failed split LLᵀ of
+    /// [`SparseCholesky::factorize`] and an LDLᵀ whose trailing block is unusable go the
+    /// whole-matrix way.
     split: Option<SplitCholesky>,
     /// Negative pivots of the last successful factorisation (0 after LLᵀ).
     pub negative_pivots: usize,
@@ -973,7 +975,8 @@ impl SparseCholesky {
     /// non-positive pivot, LDLᵀ (no pivoting, same symbolic analysis and ordering). Returns
     /// the number of negative pivots of D (the inertia index: 0 for a positive-definite
     /// matrix; ≥ 1 past a limit point or bifurcation). A zero or non-finite pivot is
-    /// [`SolverError::Singular`].
+    /// [`SolverError::Singular`]. A solver by halves does this by halves
+    /// ([`SplitCholesky::factorize_indefinite`]: LLᵀ or LDLᵀ per block, the same inertia).
     pub fn factorize_indefinite(
         &mut self,
         pattern: &LowerPattern,

@@ -17,6 +17,14 @@
 //! factor. The solves run forward through both halves at once (each adding −L₃ᵢ yᵢ to the
 //! separator's right-hand side), through L33 and L33ᵀ, and back through both halves at once.
 //!
+//! An indefinite matrix (a nonlinear tangent past a limit point) goes by halves too
+//! ([`SplitCholesky::factorize_indefinite`]): a half whose LLᵀ fails is factorised by faer's
+//! LDLᵀ without pivoting, which gives Lᵢᵢ, Dᵢ, L₃ᵢ and a trailing block with
+//! Mᵢ D̃ᵢ Mᵢᵀ = A33 − L₃ᵢ Dᵢ L₃ᵢᵀ; S = M₁D̃₁M₁ᵀ + M₂D̃₂M₂ᵀ − A33 gets a dense LDLᵀ. By
+//! Sylvester's law of inertia on P A Pᵀ = L D Lᵀ, D = diag(D1, D2, D3), the negative pivots
+//! of A are those of D1, D2 (the halves' own columns) and D3 (docs/theory.md, "LDLᵀ by
+//! halves").
+//!
 //! The price is the separator's dense work three times on the critical path (in Bᵢ, in
 //! MᵢMᵢᵀ, in S) instead of once: small for the plane meshes' separators (a cross-section of
 //! the mesh), against half of everything below them.
