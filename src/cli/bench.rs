@@ -679,7 +679,26 @@ pub struct BareRow {
     pub own_solve_split_s: f64,
     /// Largest difference of the two solutions of K x = K·1 relative to the largest entry.
     pub split_rel_diff: f64,
+    /// An indefinite matrix of the same pattern, K − σ diag(K) with σ = [`LDLT_SHIFT`]: its
+    /// negative pivots (by halves and whole, the same) and medians of [`BARE_ROUNDS`]
+    /// factorisations [s] as `factorize_indefinite` runs them: the whole matrix's LLᵀ
+    /// attempt then LDLᵀ (after a definite tangent), its LLᵀ and LDLᵀ at once on two cores
+    /// (after an indefinite one), by halves after a definite tangent (LLᵀ per half, LDLᵀ
+    /// where it fails) and after an indefinite one (LDLᵀ at once where it was needed); the
+    /// largest difference of the whole and split solutions relative to the largest entry.
+    /// Zero when the system does not go by halves.
+    pub ldlt_negative_pivots: usize,
+    pub ldlt_whole_sequential_s: f64,
+    pub ldlt_whole_concurrent_s: f64,
+    pub ldlt_split_s: f64,
+    pub ldlt_split_next_s: f64,
+    pub ldlt_rel_diff: f64,
 }
+
+/// Shift σ of the indefinite matrix K − σ diag(K) of [`BareRow`]: a few negative
+/// eigenvalues of K φ = λ diag(K) φ for the beams and squares measured (its smallest ones
+/// are 1e-6–1e-4).
+pub const LDLT_SHIFT: f64 = 1e-3;
 
 /// Rounds of [`BareRow::own_numeric_whole_s`] and [`BareRow::own_numeric_split_s`].
 const BARE_ROUNDS: usize = 5;
@@ -745,12 +764,55 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    let scale = xw.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let split_rel_diff = xw
-        .iter()
-        .zip(&xs)
-        .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()))
-        / scale;
+    let rel_diff = |xw: &[f64], xs: &[f64]| {
+        let scale = xw.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        xw.iter()
+            .zip(xs)
+            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()))
+            / scale
+    };
+    let split_rel_diff = rel_diff(&xw, &xs);
+    // The indefinite matrix K − σ diag(K), factorised the three ways, alternated.
+    let (mut lw1, mut lw2, mut ls, mut ls2) = (vec![0.0], vec![0.0], vec![0.0], vec![0.0]);
+    let (mut ldlt_negative_pivots, mut ldlt_rel_diff) = (0, 0.0);
+    if own_split {
+        let mut kd = k.clone();
+        for i in 0..pattern.n {
+            if let Some(q) = pattern.position(i, i) {
+                kd[q] -= LDLT_SHIFT * k[q];
+            }
+        }
+        let err = |e: segfem::linalg::solver::SolverError| e.to_string();
+        (lw1, lw2, ls, ls2) = (vec![], vec![], vec![], vec![]);
+        for _ in 0..BARE_ROUNDS {
+            // After a definite tangent: the LLᵀ attempt, then the LDLᵀ.
+            whole.factorize_indefinite(pattern, &k).map_err(err)?;
+            let t = Instant::now();
+            let nw = whole.factorize_indefinite(pattern, &kd).map_err(err)?;
+            lw1.push(t.elapsed().as_secs_f64());
+            // After an indefinite one: both at once.
+            let t = Instant::now();
+            whole.factorize_indefinite(pattern, &kd).map_err(err)?;
+            lw2.push(t.elapsed().as_secs_f64());
+            // By halves after a definite tangent (LLᵀ attempts), then after an indefinite
+            // one (LDLᵀ at once in the halves that were indefinite).
+            split.factorize_indefinite(pattern, &k).map_err(err)?;
+            let t = Instant::now();
+            let ns = split.factorize_indefinite(pattern, &kd).map_err(err)?;
+            ls.push(t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            split.factorize_indefinite(pattern, &kd).map_err(err)?;
+            ls2.push(t.elapsed().as_secs_f64());
+            if nw != ns {
+                return Err(format!("negative pivots: {nw} whole, {ns} by halves"));
+            }
+            ldlt_negative_pivots = ns;
+        }
+        let (mut xw, mut xs) = (b.clone(), b.clone());
+        whole.solve_in_place(&mut xw);
+        split.solve_in_place(&mut xs);
+        ldlt_rel_diff = rel_diff(&xw, &xs);
+    }
     Ok(BareRow {
         equations: pattern.n,
         amd_symbolic_s,
@@ -767,6 +829,12 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         own_solve_whole_s: median(&mut sw),
         own_solve_split_s: median(&mut ss),
         split_rel_diff,
+        ldlt_negative_pivots,
+        ldlt_whole_sequential_s: median(&mut lw1),
+        ldlt_whole_concurrent_s: median(&mut lw2),
+        ldlt_split_s: median(&mut ls),
+        ldlt_split_next_s: median(&mut ls2),
+        ldlt_rel_diff,
     })
 }
 

@@ -102,11 +102,13 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                 );
                 let (t, s) = (&x.timings, &x.timings.solver);
                 outln!(
-                    "{:>28} assembly {:.3} s, {} factorisations ({} LDLT) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
+                    "{:>28} assembly {:.3} s, {} factorisations ({} LDLT, {:.3} s; {} by halves to whole) {:.3} s ({:.2} ms each, factor {} values), solves {:.3} s",
                     "",
                     t.assembly_s,
                     s.factorisations,
                     s.ldlt_factorisations,
+                    s.indefinite_s,
+                    s.split_ldlt_to_whole,
                     s.numeric_s,
                     1e3 * s.numeric_s / s.factorisations.max(1) as f64,
                     s.factor_nnz,
@@ -170,13 +172,15 @@ pub(crate) fn bench_rc(refine: Vec<usize>) -> ExitCode {
                 );
                 let (t, s) = (&x.timings, &x.timings.solver);
                 outln!(
-                    "{:>18} assembly {:.2} s, line searches {:.2} s, ordering + symbolic {:.3} s, {} factorisations ({} LDLT) {:.2} s ({:.1} ms each, factor {} values), solves {:.2} s",
+                    "{:>18} assembly {:.2} s, line searches {:.2} s, ordering + symbolic {:.3} s, {} factorisations ({} LDLT, {:.2} s; {} by halves to whole) {:.2} s ({:.1} ms each, factor {} values), solves {:.2} s",
                     "",
                     t.assembly_s,
                     t.line_search_s,
                     s.symbolic_s,
                     s.factorisations,
                     s.ldlt_factorisations,
+                    s.indefinite_s,
+                    s.split_ldlt_to_whole,
                     s.numeric_s,
                     1e3 * s.numeric_s / s.factorisations.max(1) as f64,
                     s.factor_nnz,

@@ -1,8 +1,8 @@
 //! The one linear-solver interface of segfem: a symmetric sparse matrix in compressed-column
 //! form (lower triangle), symbolic analysis (AMD ordering) once per pattern, numeric
 //! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work;
-//! the LLᵀ of a large system ordered by nested dissection goes by halves on two cores
-//! ([`super::split`]).
+//! the LLᵀ of a large system ordered by nested dissection, and the LDLᵀ of an indefinite
+//! one, go by halves on two cores ([`super::split`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -15,7 +15,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::split::{SplitCholesky, SplitOutcome};
+use super::split::{IndefiniteOutcome, SplitCholesky, SplitOutcome};
 
 pub use super::pattern::LowerPattern;
 
@@ -79,6 +79,13 @@ pub struct SolverStats {
     /// unnecessary are in neither count above.
     #[serde(skip_serializing_if = "is_zero")]
     pub concurrent_ldlt: usize,
+    /// Seconds of the numeric factorisations that ended in an LDLᵀ (their failed LLᵀ
+    /// attempt included; part of `numeric_s`).
+    pub indefinite_s: f64,
+    /// Indefinite factorisations by halves that went to the whole matrix's LDLᵀ (a half's
+    /// trailing block unusable, [`super::split::IndefiniteOutcome::Whole`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub split_ldlt_to_whole: usize,
 }
 
 fn is_zero(v: &usize) -> bool {
@@ -104,6 +111,10 @@ const FACTOR_KIND: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
 /// smallest ratios of the bundled examples are 1e-5–2e-2, 8e-9 for the seed beam next to
 /// its limit point (where LDLᵀ takes over anyway).
 const TINY_PIVOT: f64 = 1e-11;
+
+/// Relative size of an LDLᵀ pivot at or below which the tangent counts as singular:
+/// |D_j| ≤ SINGULAR_PIVOT max_k |D_k| ([`SolverError::Singular`]), by halves as whole.
+pub(crate) const SINGULAR_PIVOT: f64 = 1e-14;
 
 /// Systems from this many equations on have the pivots of an LLᵀ factor checked in parallel
 /// ([`SparseCholesky::tiny_pivot`]).
@@ -403,7 +414,9 @@ pub struct SparseCholesky {
     /// Smallest factor [values] for that ([`CONCURRENT_LDLT_VALUES`]; lowered by tests).
     concurrent_min: usize,
     /// The LLᵀ factorised as two halves at once and the separator (large systems ordered by
-    /// nested dissection); LDLᵀ and a failed split LLᵀ go the whole-matrix way.
+    /// nested dissection), and the LDLᵀ of an indefinite tangent; a failed split LLᵀ of
+    /// [`SparseCholesky::factorize`] and an LDLᵀ whose trailing block is unusable go the
+    /// whole-matrix way.
     split: Option<SplitCholesky>,
     /// Negative pivots of the last successful factorisation (0 after LLᵀ).
     pub negative_pivots: usize,
@@ -780,6 +793,38 @@ impl SparseCholesky {
         }))
     }
 
+    /// The indefinite factorisation by halves ([`SplitCholesky::factorize_indefinite`]),
+    /// if this analysis has one (None if not; the analysis already taken in). Counted as
+    /// the sequential path counts: one factorisation, two when it ended in an LDLᵀ (the
+    /// LLᵀ attempt and the LDLᵀ), one of them LDLᵀ.
+    fn factorize_split_indefinite(&mut self, values: &[f64]) -> Option<IndefiniteOutcome> {
+        let split = self.split.as_mut()?;
+        let t = std::time::Instant::now();
+        self.factor = Factor::None;
+        if let Some(work) = self.beside.take() {
+            std::thread::spawn(work);
+        }
+        let out = split.factorize_indefinite(values, TINY_PIVOT);
+        self.stats.numeric_s += t.elapsed().as_secs_f64();
+        self.stats.factorisations += 1;
+        if !matches!(out, IndefiniteOutcome::Llt) {
+            self.stats.factorisations += 1;
+            self.stats.ldlt_factorisations += 1;
+        }
+        match out {
+            IndefiniteOutcome::Llt => {
+                self.factor = Factor::Split;
+                self.negative_pivots = 0;
+            }
+            IndefiniteOutcome::Ldlt(negative) => {
+                self.factor = Factor::Split;
+                self.negative_pivots = negative;
+            }
+            _ => {}
+        }
+        Some(out)
+    }
+
     /// The whole matrix's LLᵀ by faer on one core.
     fn factorize_whole(
         &mut self,
@@ -930,24 +975,29 @@ impl SparseCholesky {
     /// non-positive pivot, LDLᵀ (no pivoting, same symbolic analysis and ordering). Returns
     /// the number of negative pivots of D (the inertia index: 0 for a positive-definite
     /// matrix; ≥ 1 past a limit point or bifurcation). A zero or non-finite pivot is
-    /// [`SolverError::Singular`].
+    /// [`SolverError::Singular`]. A solver by halves does this by halves
+    /// ([`SplitCholesky::factorize_indefinite`]: LLᵀ or LDLᵀ per block, the same inertia).
     pub fn factorize_indefinite(
         &mut self,
         pattern: &LowerPattern,
         values: &[f64],
     ) -> Result<usize, SolverError> {
         self.take_analysis()?;
+        let (numeric0, ldlt0) = (self.stats.numeric_s, self.stats.ldlt_factorisations);
         if self.last_ldlt {
             self.whole(pattern)?;
         }
         let out = if self.last_ldlt && self.symbolic.len_val() >= self.concurrent_min {
             self.factorize_both(pattern, values)
-        } else if let Some(split) = self.factorize_split(values)? {
-            // A failed split LLᵀ: straight to the whole matrix's LDLᵀ (the matrix is
-            // filled there).
+        } else if let Some(split) = self.factorize_split_indefinite(values) {
             match split {
-                Ok(()) => Ok(0),
-                Err(_) => {
+                IndefiniteOutcome::Llt => Ok(0),
+                IndefiniteOutcome::Ldlt(negative) => Ok(negative),
+                IndefiniteOutcome::Singular => Err(SolverError::Singular),
+                // A half's trailing block unusable: the whole matrix's LDLᵀ (the matrix is
+                // filled there).
+                IndefiniteOutcome::Whole => {
+                    self.stats.split_ldlt_to_whole += 1;
                     self.prepare(pattern, values)?;
                     self.factorize_ldlt(pattern, values)
                 }
@@ -962,7 +1012,11 @@ impl SparseCholesky {
                 Err(e) => Err(e),
             }
         };
-        self.last_ldlt = self.factor == Factor::Ldlt;
+        // (A solver by halves stays by halves after a whole-matrix LDLᵀ.)
+        self.last_ldlt = self.factor == Factor::Ldlt && self.split.is_none();
+        if self.stats.ldlt_factorisations > ldlt0 {
+            self.stats.indefinite_s += self.stats.numeric_s - numeric0;
+        }
         out
     }
 
@@ -1080,7 +1134,9 @@ impl SparseCholesky {
         let d = self.ldlt_diagonal();
         // Pivots below this relative size are treated as zero (singular tangent).
         let scale = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        if d.iter().any(|v| !v.is_finite() || v.abs() <= 1e-14 * scale) {
+        if d.iter()
+            .any(|v| !v.is_finite() || v.abs() <= SINGULAR_PIVOT * scale)
+        {
             return Err(SolverError::Singular);
         }
         self.factor = Factor::Ldlt;
@@ -1423,8 +1479,8 @@ mod tests {
     }
 
     /// The LLᵀ by halves of a positive-definite matrix solves as the whole-matrix one does,
-    /// to round-off; an indefinite one falls back to LDLᵀ with the same inertia; a
-    /// mechanism is reported.
+    /// to round-off; an indefinite one goes by LDLᵀ by halves with the whole matrix's
+    /// inertia; a mechanism is reported.
     #[test]
     fn split_factorisation_matches_the_whole_one() {
         let m = 41;
@@ -1454,16 +1510,21 @@ mod tests {
                 assert!((a - c).abs() <= 1e-12 * norm, "{a} against {c}");
             }
         }
-        // Indefinite: LDLᵀ, the whole matrix's, the same negative pivots as without the split.
+        // Indefinite: LDLᵀ by halves, the same negative pivots as the whole matrix's LDLᵀ,
+        // the same solution to round-off (condition ~1e3–1e4 near σ: 1e-11 of the solution).
         let a = split.factorize_indefinite(&p, &indefinite).unwrap();
         let c = whole.factorize_indefinite(&p, &indefinite).unwrap();
         assert!(a > 5);
         assert_eq!(a, c);
-        assert_eq!(split.factor, Factor::Ldlt);
+        assert_eq!(split.factor, Factor::Split);
+        assert_eq!(whole.factor, Factor::Ldlt);
         let (mut x, mut y) = (b.clone(), b.clone());
         split.solve_in_place(&mut x);
         whole.solve_in_place(&mut y);
-        assert_eq!(x, y);
+        let norm = y.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for (a, c) in x.iter().zip(&y) {
+            assert!((a - c).abs() <= 1e-11 * norm, "{a} against {c}");
+        }
         // And back to a definite matrix: by halves again (after the concurrent LDLᵀ/LLᵀ
         // pair, which needs the last factorisation indefinite).
         assert_eq!(split.factorize_indefinite(&p, &definite).unwrap(), 0);
@@ -1485,6 +1546,155 @@ mod tests {
             let e2 = whole.factorize(&p, &v).unwrap_err();
             assert_eq!(e1, e2);
             assert_eq!(e1, SolverError::NotPositiveDefinite { equation: eq });
+        }
+    }
+
+    /// The 9-point matrix of [`shifted_laplacian`] (σ = 0) with every stored entry moved by
+    /// a pseudo-random amount in [−0.3, 0.3) (no symmetry of the grid left to make the
+    /// spectrum special), and the same matrix dense.
+    fn perturbed_laplacian(m: usize) -> (LowerPattern, Vec<f64>, faer::Mat<f64>) {
+        let (p, mut vals) = shifted_laplacian(m, 0.0);
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        for v in vals.iter_mut() {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            *v += 0.6 * ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+        }
+        let n = p.n;
+        let mut a = faer::Mat::<f64>::zeros(n, n);
+        for j in 0..n {
+            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[q];
+                a[(i, j)] = vals[q];
+                a[(j, i)] = vals[q];
+            }
+        }
+        (p, vals, a)
+    }
+
+    /// Smallest eigenvalue of the principal submatrix of `a` on `rows`.
+    fn smallest_eigenvalue(a: &faer::Mat<f64>, rows: &[usize]) -> f64 {
+        let b = faer::Mat::<f64>::from_fn(rows.len(), rows.len(), |i, j| a[(rows[i], rows[j])]);
+        b.self_adjoint_eigenvalues(Side::Lower).unwrap()[0]
+    }
+
+    /// LDLᵀ by halves: on indefinite matrices whose negative eigenvalues lie only in the
+    /// separator's Schur complement (halves by LLᵀ) or in the halves as well (LDLᵀ
+    /// throughout), the negative pivots are the matrix's negative eigenvalues (faer's dense
+    /// symmetric eigenvalues, an independent computation) and the solution is the dense LU
+    /// solve's to round-off; a positive-definite one is factorised by LLᵀ throughout, or by
+    /// LDLᵀ with no negative pivot right after an indefinite one.
+    #[test]
+    fn ldlt_by_halves_inertia_and_solution() {
+        use faer::linalg::solvers::Solve;
+        let m = 21;
+        let n = m * m;
+        let order = grid_dissection(m);
+        let (p, base, a0) = perturbed_laplacian(m);
+        let mut split = SparseCholesky::build(&p, FACTOR_KIND, Some(&order), 0).unwrap();
+        let sp = split.split.as_ref().unwrap().split;
+        let sep: Vec<usize> = order[sp.n1 + sp.n2..].to_vec();
+        let border = |r: std::ops::Range<usize>| -> Vec<usize> {
+            order[r].iter().chain(&sep).copied().collect()
+        };
+        let lam = a0.self_adjoint_eigenvalues(Side::Lower).unwrap();
+        // The border matrices' smallest eigenvalues lie above the whole matrix's
+        // (interlacing); a shift between them makes A indefinite with B1 and B2 definite.
+        let b_min = smallest_eigenvalue(&a0, &border(0..sp.n1))
+            .min(smallest_eigenvalue(&a0, &border(sp.n1..sp.n1 + sp.n2)));
+        assert!(b_min > lam[0], "{b_min} against {}", lam[0]);
+        let only_separator = 0.5 * (lam[0] + b_min.min(lam[1]));
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        // After an indefinite border matrix its half goes to LDLᵀ at once (and so does S),
+        // also for the definite matrix that follows; the one after that is LLᵀ again.
+        let definite = lam[0] - 0.5;
+        for (sigma, blocks) in [
+            (definite, [false, false, false]),
+            (only_separator, [false, false, true]),
+            (0.37, [true, true, true]),
+            (3.0, [true, true, true]),
+            (definite, [true, true, true]),
+            (definite, [false, false, false]),
+        ] {
+            let mut vals = base.clone();
+            for j in 0..n {
+                vals[p.position(j, j).unwrap()] -= sigma;
+            }
+            let a = faer::Mat::<f64>::from_fn(n, n, |i, j| {
+                a0[(i, j)] - if i == j { sigma } else { 0.0 }
+            });
+            let ev = a.self_adjoint_eigenvalues(Side::Lower).unwrap();
+            let expected = ev.iter().filter(|&&v| v < 0.0).count();
+            // The count is not a matter of round-off: no eigenvalue near 0.
+            let gap = ev.iter().fold(f64::INFINITY, |g, v| g.min(v.abs()));
+            assert!(gap > 1e-3, "σ = {sigma}: eigenvalue {gap} near 0");
+            let negative = split.factorize_indefinite(&p, &vals).unwrap();
+            assert_eq!(negative, expected, "σ = {sigma}");
+            assert_eq!(split.negative_pivots, expected);
+            assert_eq!(split.factor, Factor::Split);
+            assert_eq!(
+                split.split.as_ref().unwrap().ldlt_blocks(),
+                blocks,
+                "σ = {sigma}"
+            );
+            let mut x = b.clone();
+            split.solve_in_place(&mut x);
+            let rhs = faer::Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+            let y = a.partial_piv_lu().solve(&rhs);
+            let norm = (0..n).fold(0.0_f64, |s, i| s.max(y[(i, 0)].abs()));
+            let diff = (0..n).fold(0.0_f64, |s, i| s.max((x[i] - y[(i, 0)]).abs()));
+            // Two solves of a matrix of condition κ = max|λ| / min|λ| (25–240 here) agree to
+            // ~κ·1e-16 of the solution (measured 1.4e-15–4.9e-14, at most 2.4e-16·κ);
+            // 1e-15·κ leaves a factor 4 for the growth of the unpivoted LDLᵀ.
+            let kappa = ev.iter().fold(0.0_f64, |s, v| s.max(v.abs())) / gap;
+            assert!(
+                diff <= 1e-15 * kappa * norm,
+                "σ = {sigma}: {diff} of {norm}, κ {kappa}"
+            );
+        }
+        assert_eq!(split.stats.split_ldlt_to_whole, 0);
+        // Four factorisations ended in LDLᵀ, each counted as the LLᵀ attempt and the LDLᵀ.
+        assert_eq!(split.stats.ldlt_factorisations, 4);
+        assert_eq!(split.stats.factorisations, 10);
+    }
+
+    /// LDLᵀ by halves of a singular matrix (a zero row and column) in half 1, half 2 or
+    /// the separator: [`SolverError::Singular`], as the whole matrix's LDLᵀ says; the
+    /// separator's zero row makes both halves' trailing blocks singular, which goes to the
+    /// whole matrix's LDLᵀ.
+    #[test]
+    fn ldlt_by_halves_reports_singular() {
+        let m = 21;
+        let n = m * m;
+        let order = grid_dissection(m);
+        let (p, vals) = shifted_laplacian(m, 0.37);
+        let mut split = SparseCholesky::build(&p, FACTOR_KIND, Some(&order), 0).unwrap();
+        let mut whole = SparseCholesky::with_ordering(&p, Some(&order)).unwrap();
+        assert!(split.is_split() && !whole.is_split());
+        let sp = split.split.as_ref().unwrap().split;
+        for (k, eq) in [order[5], order[sp.n1 + 3], order[n - 2]]
+            .into_iter()
+            .enumerate()
+        {
+            let mut v = vals.clone();
+            for j in 0..n {
+                for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                    if j == eq || p.row_idx[q] == eq {
+                        v[q] = 0.0;
+                    }
+                }
+            }
+            assert_eq!(
+                split.factorize_indefinite(&p, &v),
+                Err(SolverError::Singular)
+            );
+            assert_eq!(
+                whole.factorize_indefinite(&p, &v),
+                Err(SolverError::Singular)
+            );
+            assert!(!split.has_factor());
+            assert_eq!(split.stats.split_ldlt_to_whole, usize::from(k == 2));
         }
     }
 

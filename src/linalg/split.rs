@@ -17,18 +17,29 @@
 //! factor. The solves run forward through both halves at once (each adding −L₃ᵢ yᵢ to the
 //! separator's right-hand side), through L33 and L33ᵀ, and back through both halves at once.
 //!
+//! An indefinite matrix (a nonlinear tangent past a limit point) goes by halves too
+//! ([`SplitCholesky::factorize_indefinite`]): a half whose LLᵀ fails is factorised by faer's
+//! LDLᵀ without pivoting, which gives Lᵢᵢ, Dᵢ, L₃ᵢ and a trailing block with
+//! Mᵢ D̃ᵢ Mᵢᵀ = A33 − L₃ᵢ Dᵢ L₃ᵢᵀ; S = M₁D̃₁M₁ᵀ + M₂D̃₂M₂ᵀ − A33 gets a dense LDLᵀ. By
+//! Sylvester's law of inertia on P A Pᵀ = L D Lᵀ, D = diag(D1, D2, D3), the negative pivots
+//! of A are those of D1, D2 (the halves' own columns) and D3 (docs/theory.md, "LDLᵀ by
+//! halves").
+//!
 //! The price is the separator's dense work three times on the critical path (in Bᵢ, in
 //! MᵢMᵢᵀ, in S) instead of once: small for the plane meshes' separators (a cross-section of
 //! the mesh), against half of everything below them.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, MatMut, MatRef, Par, Side};
 
-use super::solver::{fault_in, supernodal_in_order, LowerPattern, TOUCH_AHEAD_VALUES};
+use super::solver::{
+    fault_in, supernodal_in_order, LowerPattern, SINGULAR_PIVOT, TOUCH_AHEAD_VALUES,
+};
 
 /// One supernode of a half's factor: its first column `b`, its `ncols` columns, the rows
 /// below them (`pat`) and its values `blk`, column-major with `ncols + pat.len()` rows.
@@ -174,9 +185,20 @@ struct Half {
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     mem: MemBuffer,
-    /// Mᵢ (dense s × s, column-major, lower) and then Mᵢ Mᵢᵀ (lower).
+    /// Mᵢ (dense s × s, column-major, lower; unit diagonal after an LDLᵀ) and then
+    /// Mᵢ Mᵢᵀ or Mᵢ Dᵢ Mᵢᵀ (lower).
     m33: Vec<f64>,
     schur: Vec<f64>,
+    /// Whether the factor in `l_values` is an LDLᵀ (D on the supernodes' diagonals, L
+    /// unit) rather than an LLᵀ.
+    ldlt: bool,
+    /// Whether the last factorisation was an LDLᵀ of an indefinite Bᵢ (a negative pivot of
+    /// its own or trailing block): the next indefinite factorisation goes to LDLᵀ at once.
+    indefinite: bool,
+    /// After an LDLᵀ: the trailing block's pivots Dᵢ (s) and Mᵢ Dᵢ (s × s, allocated at the
+    /// first LDLᵀ).
+    d33: Vec<f64>,
+    md: Vec<f64>,
     /// Solve scratch: the half's right-hand side (its `m` unknowns and the separator's `s`)
     /// and the gathered rows of one supernode.
     x: Vec<f64>,
@@ -192,6 +214,76 @@ pub enum SplitOutcome {
     NotPositiveDefinite(usize),
 }
 
+/// How an indefinite factorisation by halves ([`SplitCholesky::factorize_indefinite`]) ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IndefiniteOutcome {
+    /// Positive definite: LLᵀ in both halves and the separator, the factor
+    /// [`SplitCholesky::factorize`] gives.
+    Llt,
+    /// LDLᵀ in at least one block (the others LLᵀ); the number of negative pivots of the
+    /// whole matrix (Sylvester: the halves' own ones and the separator's).
+    Ldlt(usize),
+    /// A pivot of D zero, not finite, or at most [`SINGULAR_PIVOT`] of the largest.
+    Singular,
+    /// A half's trailing block could not be used (its LDLᵀ met a zero pivot there, or grew
+    /// past [`TRAILING_GROWTH`]): the caller factorises the whole matrix.
+    Whole,
+}
+
+/// Largest growth of a half's trailing LDLᵀ, max_j Σ_k M_jk² |D_k| against the larger of
+/// the largest diagonal entries of A33 and of Mᵢ Dᵢ Mᵢᵀ (1 or less when Bᵢ is positive
+/// definite), for its product Mᵢ Dᵢ Mᵢᵀ to stand in for A33 − L₃ᵢ Dᵢ L₃ᵢᵀ: the product's
+/// round-off is ~1e-16 of that growth, so at most ~1e-10 of the separator's entries.
+pub const TRAILING_GROWTH: f64 = 1e6;
+
+/// Why a half's factorisation failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum HalfFail {
+    /// An LLᵀ pivot (position in Bᵢ) not positive, or round-off of its diagonal entry.
+    NotPositive(usize),
+    /// An LDLᵀ pivot of the half's own columns zero or not finite.
+    Singular,
+    /// The LDLᵀ's trailing block unusable (a zero pivot there, or growth).
+    Trailing,
+}
+
+/// Pivots of the half's own columns (l_jj² of an LLᵀ, D_j of an LDLᵀ): the largest and
+/// smallest magnitudes, the negative ones, and whether all are finite.
+#[derive(Debug, Clone, Copy)]
+struct Pivots {
+    max: f64,
+    min: f64,
+    negative: usize,
+    finite: bool,
+}
+
+impl Pivots {
+    fn new() -> Self {
+        Self {
+            max: 0.0,
+            min: f64::INFINITY,
+            negative: 0,
+            finite: true,
+        }
+    }
+
+    fn add(&mut self, d: f64) {
+        self.max = self.max.max(d.abs());
+        self.min = self.min.min(d.abs());
+        self.negative += usize::from(d < 0.0);
+        self.finite &= d.is_finite();
+    }
+
+    fn join(self, o: Self) -> Self {
+        Self {
+            max: self.max.max(o.max),
+            min: self.min.min(o.min),
+            negative: self.negative + o.negative,
+            finite: self.finite && o.finite,
+        }
+    }
+}
+
 /// The split factorisation: both halves and the separator's dense factor.
 pub struct SplitCholesky {
     pub split: TopSplit,
@@ -199,8 +291,10 @@ pub struct SplitCholesky {
     /// The separator block A33: (dense position in the s × s column-major lower block,
     /// position in the caller's value array).
     a33: Vec<(usize, usize)>,
-    /// S and then its Cholesky factor L33 (dense s × s column-major, lower).
+    /// S and then its Cholesky factor L33, or its LDLᵀ factor (unit L33 below the
+    /// diagonal, D33 on it) when `s_ldlt` (dense s × s column-major, lower).
     l33: Vec<f64>,
+    s_ldlt: bool,
     mem33: MemBuffer,
     /// `order[k]`: the original equation eliminated k-th.
     order: Vec<usize>,
@@ -326,7 +420,9 @@ impl SplitCholesky {
             let pattern = SymbolicSparseColMat::new_checked(nb, nb, col_ptr, None, row_idx);
             let upper = SymbolicSparseColMatRef::new_checked(nb, nb, &up_ptr, None, &up_idx);
             let symbolic = supernodal_in_order(upper)?;
-            let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+            let req = symbolic
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+                .or(symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
             let mut l_values = vec![0.0; symbolic.len_val()];
             let mut mem = MemBuffer::try_new(req).map_err(|e| format!("{e:?}"))?;
             if l_values.len() >= TOUCH_AHEAD_VALUES / 2 {
@@ -345,6 +441,10 @@ impl SplitCholesky {
                 symbolic,
                 m33: vec![0.0; s * s],
                 schur: vec![0.0; s * s],
+                ldlt: false,
+                indefinite: false,
+                d33: vec![0.0; s],
+                md: Vec::new(),
                 x: vec![0.0; nb],
                 work: Vec::new(),
             })
@@ -364,12 +464,20 @@ impl SplitCholesky {
             s,
             Par::Seq,
             Default::default(),
+        )
+        .or(
+            faer::linalg::cholesky::ldlt::factor::cholesky_in_place_scratch::<f64>(
+                s,
+                Par::Seq,
+                Default::default(),
+            ),
         );
         Ok(Some(Self {
             split,
             halves: [h1?, h2?],
             a33,
             l33: vec![0.0; s * s],
+            s_ldlt: false,
             mem33: MemBuffer::try_new(req).map_err(|e| format!("{e:?}"))?,
             order: order.to_vec(),
         }))
@@ -400,25 +508,90 @@ impl SplitCholesky {
     /// Numeric LLᵀ of the matrix with these values (the caller's pattern). `tiny`: the
     /// relative pivot size l_jj² ≤ tiny a_jj counted as zero.
     pub fn factorize(&mut self, values: &[f64], tiny: f64) -> SplitOutcome {
-        let TopSplit { n1, n2, s } = self.split;
+        let TopSplit { n1, n2, .. } = self.split;
         let [h1, h2] = &mut self.halves;
-        let (r1, r2) = rayon::join(|| h1.factorize(values, tiny), || h2.factorize(values, tiny));
+        let (r1, r2) = rayon::join(
+            || h1.factorize(values, tiny, false),
+            || h2.factorize(values, tiny, false),
+        );
         // Positions in the elimination order of a failed pivot (local to the half).
-        let global = |k: usize, m: usize, off: usize| {
-            if k < m {
-                off + k
-            } else {
-                n1 + n2 + (k - m)
-            }
+        let global = |r: Result<Pivots, HalfFail>, m: usize, off: usize| match r {
+            Err(HalfFail::NotPositive(k)) if k < m => Some(off + k),
+            Err(HalfFail::NotPositive(k)) => Some(n1 + n2 + (k - m)),
+            Err(_) => unreachable!("an LLᵀ fails by a pivot"),
+            Ok(_) => None,
         };
-        let bad = [
-            r1.err().map(|k| global(k, n1, 0)),
-            r2.err().map(|k| global(k, n2, n1)),
-        ];
+        let bad = [global(r1, n1, 0), global(r2, n2, n1)];
         if let Some(k) = bad.into_iter().flatten().min() {
             return SplitOutcome::NotPositiveDefinite(k);
         }
-        // S = M1 M1ᵀ + M2 M2ᵀ − A33 (lower), then its Cholesky factor.
+        match self.separator_llt(values, tiny) {
+            Ok(()) => SplitOutcome::Ok,
+            Err(j) => SplitOutcome::NotPositiveDefinite(n1 + n2 + j),
+        }
+    }
+
+    /// Numeric factorisation of a symmetric matrix that may be indefinite, by halves: each
+    /// half's border matrix by LLᵀ, or by LDLᵀ (no pivoting) where its LLᵀ fails or where
+    /// the border matrix was indefinite at the last factorisation; the
+    /// separator's S by dense LLᵀ when both halves went by LLᵀ and it is positive definite,
+    /// else by dense LDLᵀ (no pivoting). `tiny`: as in [`SplitCholesky::factorize`].
+    pub fn factorize_indefinite(&mut self, values: &[f64], tiny: f64) -> IndefiniteOutcome {
+        let [h1, h2] = &mut self.halves;
+        // A half whose border matrix was indefinite at the last factorisation goes to LDLᵀ at
+        // once (its LLᵀ attempt would most likely fail again, after part of the work).
+        let run = |h: &mut Half| {
+            if h.indefinite {
+                return h.factorize(values, tiny, true);
+            }
+            match h.factorize(values, tiny, false) {
+                Err(HalfFail::NotPositive(_)) => h.factorize(values, tiny, true),
+                r => r,
+            }
+        };
+        let (r1, r2) = rayon::join(|| run(h1), || run(h2));
+        let pivots = match (r1, r2) {
+            (Ok(a), Ok(b)) => a.join(b),
+            (Err(HalfFail::Singular), _) | (_, Err(HalfFail::Singular)) => {
+                return IndefiniteOutcome::Singular
+            }
+            _ => return IndefiniteOutcome::Whole,
+        };
+        if !h1.ldlt && !h2.ldlt && self.separator_llt(values, tiny).is_ok() {
+            return IndefiniteOutcome::Llt;
+        }
+        // S = A33 − L31 D1 L31ᵀ − L32 D2 L32ᵀ, its LDLᵀ without pivoting.
+        self.s_ldlt = true;
+        self.schur(values);
+        let s = self.split.s;
+        let a = MatMut::from_column_major_slice_mut(&mut self.l33, s, s);
+        if faer::linalg::cholesky::ldlt::factor::cholesky_in_place(
+            a,
+            LdltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut self.mem33),
+            Default::default(),
+        )
+        .is_err()
+        {
+            return IndefiniteOutcome::Singular;
+        }
+        let mut sep = Pivots::new();
+        for j in 0..s {
+            sep.add(self.l33[j + j * s]);
+        }
+        let all = pivots.join(sep);
+        if !all.finite || all.min <= SINGULAR_PIVOT * all.max {
+            return IndefiniteOutcome::Singular;
+        }
+        IndefiniteOutcome::Ldlt(all.negative)
+    }
+
+    /// S = (A33 − L31 D1 L31ᵀ) + (A33 − L32 D2 L32ᵀ) − A33 into `l33` (lower), D = I after
+    /// an LLᵀ.
+    fn schur(&mut self, values: &[f64]) {
+        let s = self.split.s;
+        let [h1, h2] = &self.halves;
         let l = &mut self.l33;
         for j in 0..s {
             for i in j..s {
@@ -429,7 +602,15 @@ impl SplitCholesky {
         for &(q, p) in &self.a33 {
             l[q] -= values[p];
         }
-        let a = MatMut::from_column_major_slice_mut(l, s, s);
+    }
+
+    /// S and its dense Cholesky factor L33. Err: the separator's position of a pivot not
+    /// positive or round-off of its diagonal entry.
+    fn separator_llt(&mut self, values: &[f64], tiny: f64) -> Result<(), usize> {
+        let s = self.split.s;
+        self.s_ldlt = false;
+        self.schur(values);
+        let a = MatMut::from_column_major_slice_mut(&mut self.l33, s, s);
         let res = faer::linalg::cholesky::llt::factor::cholesky_in_place(
             a,
             LltRegularization::default(),
@@ -439,17 +620,23 @@ impl SplitCholesky {
         );
         if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = res
         {
-            return SplitOutcome::NotPositiveDefinite(n1 + n2 + index.min(s - 1));
+            return Err(index.min(s - 1));
         }
         // A separator pivot at round-off of its diagonal entry a_jj of A33 (the diagonal
         // entries come in `a33` in the order of j; a pivot without one is not zero here).
         for &(q, p) in &self.a33 {
             let j = q % s;
             if q / s == j && self.l33[q] * self.l33[q] <= tiny * values[p].abs() {
-                return SplitOutcome::NotPositiveDefinite(n1 + n2 + j);
+                return Err(j);
             }
         }
-        SplitOutcome::Ok
+        Ok(())
+    }
+
+    /// Which blocks of the last factorisation went by LDLᵀ: half 1, half 2, the separator.
+    #[cfg(test)]
+    pub fn ldlt_blocks(&self) -> [bool; 3] {
+        [self.halves[0].ldlt, self.halves[1].ldlt, self.s_ldlt]
     }
 
     /// Solve A x = b in place with the last successful factorisation.
@@ -471,17 +658,22 @@ impl SplitCholesky {
             .map(|j| b[order[sep0 + j]] + h1.x[n1 + j] + h2.x[n2 + j])
             .collect();
         {
+            use faer::linalg::triangular_solve as ts;
             let l = MatRef::from_column_major_slice(&self.l33, s, s);
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                l,
-                MatMut::from_column_major_slice_mut(&mut y3, s, 1),
-                Par::Seq,
-            );
-            faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-                l.transpose(),
-                MatMut::from_column_major_slice_mut(&mut y3, s, 1),
-                Par::Seq,
-            );
+            fn y(y3: &mut [f64]) -> MatMut<'_, f64> {
+                let s = y3.len();
+                MatMut::from_column_major_slice_mut(y3, s, 1)
+            }
+            if self.s_ldlt {
+                ts::solve_unit_lower_triangular_in_place(l, y(&mut y3), Par::Seq);
+                for (j, v) in y3.iter_mut().enumerate() {
+                    *v /= self.l33[j + j * s];
+                }
+                ts::solve_unit_upper_triangular_in_place(l.transpose(), y(&mut y3), Par::Seq);
+            } else {
+                ts::solve_lower_triangular_in_place(l, y(&mut y3), Par::Seq);
+                ts::solve_upper_triangular_in_place(l.transpose(), y(&mut y3), Par::Seq);
+            }
         }
         let back = |h: &mut Half| {
             h.x[h.m..].copy_from_slice(&y3);
@@ -501,32 +693,61 @@ impl SplitCholesky {
 }
 
 impl Half {
-    /// Fill Bᵢ, factorise it, check the half's own pivots, and form Mᵢ Mᵢᵀ. Err: the
-    /// position (in Bᵢ) of a pivot that is not positive or is round-off of its diagonal entry.
-    fn factorize(&mut self, values: &[f64], tiny: f64) -> Result<(), usize> {
+    /// Fill Bᵢ, factorise it (LLᵀ, or LDLᵀ without pivoting if `ldlt`), check the half's
+    /// own pivots, and form Mᵢ Mᵢᵀ (Mᵢ Dᵢ Mᵢᵀ). Ok: the own pivots (l_jj² or D_j).
+    fn factorize(&mut self, values: &[f64], tiny: f64, ldlt: bool) -> Result<Pivots, HalfFail> {
         for (v, &p) in self.values.iter_mut().zip(&self.source) {
             *v = values[p];
         }
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
         }
+        let (m, nb) = (self.m, self.pattern.nrows());
+        let s = nb - m;
+        self.ldlt = ldlt;
+        self.indefinite = false;
         let a = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
-        if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) =
-            self.symbolic.factorize_numeric_llt(
+        let stack = MemStack::new(&mut self.mem);
+        if ldlt {
+            let res = self.symbolic.factorize_numeric_ldlt(
                 &mut self.l_values,
                 a,
                 Side::Lower,
-                LltRegularization::default(),
+                LdltRegularization::default(),
                 Par::Seq,
-                MemStack::new(&mut self.mem),
+                stack,
                 Default::default(),
-            )
-        {
-            return Err(index);
+            );
+            if let Err(faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index }) = res {
+                return Err(if index < m {
+                    HalfFail::Singular
+                } else {
+                    HalfFail::Trailing
+                });
+            }
+        } else if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
+            index,
+        }) = self.symbolic.factorize_numeric_llt(
+            &mut self.l_values,
+            a,
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        ) {
+            return Err(HalfFail::NotPositive(index));
         }
-        let (m, nb) = (self.m, self.pattern.nrows());
-        let s = nb - m;
         let (cp, ri) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        // The diagonal entry of Bᵢ in column j (0 if not stored).
+        let diag = |j: usize| {
+            if cp[j] < cp[j + 1] && ri[cp[j]] == j {
+                self.values[cp[j]]
+            } else {
+                0.0
+            }
+        };
+        let mut own = Pivots::new();
         self.m33.fill(0.0);
         for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values) {
             let nrows = ncols + pat.len();
@@ -534,14 +755,14 @@ impl Half {
                 let j = b + c;
                 let d = blk[c + c * nrows];
                 if j < m {
-                    // The half's own pivot against its diagonal entry.
-                    let a = if cp[j] < cp[j + 1] && ri[cp[j]] == j {
-                        self.values[cp[j]]
+                    if ldlt {
+                        own.add(d);
                     } else {
-                        0.0
-                    };
-                    if d * d <= tiny * a.abs() {
-                        return Err(j);
+                        // The half's own pivot against its diagonal entry.
+                        if d * d <= tiny * diag(j).abs() {
+                            return Err(HalfFail::NotPositive(j));
+                        }
+                        own.add(d * d);
                     }
                     continue;
                 }
@@ -553,27 +774,62 @@ impl Half {
                 for (t, &r) in pat.iter().enumerate() {
                     col[r - m] = blk[ncols + t + c * nrows];
                 }
+                if ldlt {
+                    self.d33[j - m] = d;
+                    col[j - m] = 1.0;
+                }
             }
         }
         let mm = MatRef::from_column_major_slice(&self.m33, s, s);
+        let lhs = if ldlt {
+            // Mᵢ Dᵢ, and the growth of the trailing LDLᵀ: max_j Σ_k M_jk² |D_k|.
+            self.md.resize(s * s, 0.0);
+            let mut g = vec![0.0_f64; s];
+            for k in 0..s {
+                let dk = self.d33[k];
+                for j in k..s {
+                    let q = j + k * s;
+                    self.md[q] = self.m33[q] * dk;
+                    g[j] += self.m33[q] * self.md[q].abs();
+                }
+            }
+            let growth = g.iter().fold(0.0_f64, |a, &v| a.max(v));
+            let a33 = (m..nb).fold(0.0_f64, |a, j| a.max(diag(j).abs()));
+            let t33 = (0..s).fold(0.0_f64, |a, j| {
+                let t: f64 = (0..=j)
+                    .map(|k| self.md[j + k * s] * self.m33[j + k * s])
+                    .sum();
+                a.max(t.abs())
+            });
+            // (A NaN growth fails too.)
+            let bound = TRAILING_GROWTH * a33.max(t33);
+            if growth.is_nan() || growth > bound {
+                return Err(HalfFail::Trailing);
+            }
+            self.indefinite = own.negative > 0 || self.d33.iter().any(|&d| d < 0.0);
+            MatRef::from_column_major_slice(&self.md, s, s)
+        } else {
+            mm
+        };
         faer::linalg::matmul::triangular::matmul(
             MatMut::from_column_major_slice_mut(&mut self.schur, s, s),
             BlockStructure::TriangularLower,
             Accum::Replace,
-            mm,
+            lhs,
             BlockStructure::TriangularLower,
             mm.transpose(),
             BlockStructure::TriangularUpper,
             1.0,
             Par::Seq,
         );
-        Ok(())
+        Ok(own)
     }
 
-    /// Forward substitution through the half's own columns: x[..m] ← L_ii⁻¹ x[..m], and
-    /// x[m..] −= L₃ᵢ x[..m] (the supernodes straddling the boundary processed up to it).
+    /// Forward substitution through the half's own columns: y = L_ii⁻¹ x[..m],
+    /// x[m..] −= L₃ᵢ y, and x[..m] ← y, or D_ii⁻¹ y after an LDLᵀ (the supernodes
+    /// straddling the boundary processed up to it).
     fn forward(&mut self) {
-        let m = self.m;
+        let (m, ldlt) = (self.m, self.ldlt);
         let (x, w) = (&mut self.x, &mut self.work);
         for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values) {
             if b >= m {
@@ -585,8 +841,9 @@ impl Half {
             w.resize(pat.len(), 0.0);
             for c in 0..kc {
                 let col = &blk[c * nrows..(c + 1) * nrows];
-                let v = x[b + c] / col[c];
-                x[b + c] = v;
+                // LDLᵀ: the unit L's forward step, then D⁻¹ on the half's own unknown.
+                let v = if ldlt { x[b + c] } else { x[b + c] / col[c] };
+                x[b + c] = if ldlt { v / col[c] } else { v };
                 for (xr, l) in x[b + c + 1..b + ncols].iter_mut().zip(&col[c + 1..ncols]) {
                     *xr -= l * v;
                 }
@@ -601,9 +858,9 @@ impl Half {
     }
 
     /// Back substitution through the half's own columns, the separator's unknowns in
-    /// x[m..]: x[..m] ← L_ii⁻ᵀ (x[..m] − L₃ᵢᵀ x[m..]).
+    /// x[m..]: x[..m] ← L_ii⁻ᵀ (x[..m] − L₃ᵢᵀ x[m..]) (L_ii unit after an LDLᵀ).
     fn backward(&mut self) {
-        let m = self.m;
+        let (m, ldlt) = (self.m, self.ldlt);
         let (x, w) = (&mut self.x, &mut self.work);
         for Supernode { b, ncols, pat, blk } in supernodes(&self.symbolic, &self.l_values).rev() {
             if b >= m {
@@ -622,7 +879,7 @@ impl Half {
                 for (wr, l) in w.iter().zip(&col[ncols..]) {
                     v -= l * wr;
                 }
-                x[b + c] = v / col[c];
+                x[b + c] = if ldlt { v } else { v / col[c] };
             }
         }
     }
