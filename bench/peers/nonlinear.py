@@ -752,6 +752,11 @@ def main():
     ap.add_argument("--refine", type=int, default=1, help="beam and wall mesh refinement (1 = the example; the wall's 0.05 m elements)")
     ap.add_argument("--json", default="", help="also write all runs to this file")
     ap.add_argument(
+        "--compression", default="implicit",
+        help="segfem's compression plasticity on the beam and the wall: implicit (its default) or implex "
+             "(compression_integration = \"implex\", as OpenSees' ASDConcrete3D; docs/theory-concrete.md §4)",
+    )
+    ap.add_argument(
         "--tolerance", default="10",
         help="the convergence test of segfem and OpenSees, the same in both: the Euclidean norm of the "
              "unbalanced forces [N] (default 10 N, OpenSees' on the beam), or 'own' for each program's own "
@@ -774,6 +779,18 @@ def main():
     only = args.only.split(",")
     progs = args.programs.split(",")
     tol_n = None if args.tolerance == "own" else float(args.tolerance)
+    if args.compression not in ("implicit", "implex"):
+        sys.exit(f"--compression {args.compression}: implicit or implex")
+
+    def compression(files):
+        """segfem's input with `--compression implex` written into its concrete."""
+        if args.compression == "implex":
+            f = files["segfem"]
+            text = f.read_text()
+            assert 'crack_integration = "implex"' in text
+            f.write_text(text.replace('crack_integration = "implex"',
+                                      'crack_integration = "implex"\ncompression_integration = "implex"', 1))
+        return files
     modes = args.modes.split(",")
     if any(m not in ("one", "all") for m in modes):
         sys.exit(f"--modes {args.modes}: each mode is one or all")
@@ -797,7 +814,7 @@ def main():
             print("\n".join(lines), flush=True)
         peers.MODE = None
     if "beam" in only:
-        files = write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm, tol_n=tol_n)
+        files = compression(write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm, tol_n=tol_n))
         nodes, _, _, _ = beam_mesh(args.refine)
         ofiles = oofem_beam.write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}" / "oofem", args.oofem_law,
                                        beta=args.oofem_beta, maxiter=args.oofem_maxiter, rtolf=args.oofem_rtolf,
@@ -809,7 +826,7 @@ def main():
             "OOFEM": lambda: run_oofem(ofiles, oofem_beam.parse_beam),
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
-        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm, {tol_text}"
+        name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm, {tol_text}, segfem compression {args.compression}"
         for mode in modes:
             peers.MODE = mode
             lines, res = bench(f"{name} [{mode}]", runners, args.rounds, beam_answers)
@@ -818,14 +835,14 @@ def main():
             print("\n".join(lines), flush=True)
         peers.MODE = None
     if "wall" in only:
-        files = write_wall(args.refine, peers.WORK / f"nl_wall_{args.refine}", tol_n=tol_n)
+        files = compression(write_wall(args.refine, peers.WORK / f"nl_wall_{args.refine}", tol_n=tol_n))
         nodes, _, _, _ = wall_mesh(args.refine)
         runners = {
             "segfem": lambda: run_segfem(files["segfem"], wall_rows_segfem),
             "OpenSees": lambda: run_opensees(files["OpenSees"]),
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
-        name = f"shear wall refine {args.refine}, Q8, {2 * len(nodes)} dofs, to 20 mm, {tol_text}"
+        name = f"shear wall refine {args.refine}, Q8, {2 * len(nodes)} dofs, to 20 mm, {tol_text}, segfem compression {args.compression}"
         for mode in modes:
             peers.MODE = mode
             lines, res = bench(f"{name} [{mode}]", runners, args.rounds, wall_answers)
