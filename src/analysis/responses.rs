@@ -5,10 +5,12 @@
 use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
 use super::tendon_time::BarPointTime;
-use crate::elements::bar::{bar_point_response, bar_strain_row, BarKinematics, BarStage};
+use crate::elements::bar::{
+    bar_point_response, bar_point_small_strain, bar_strain_row, BarKinematics, BarStage,
+};
 use crate::elements::continuum::{
-    gauss_geometry, rule_points, ContinuumElement, Formulation, GaussGeometry, GaussOutput,
-    Integration, NodeBlocks, TangentMemo,
+    gauss_geometry, rule_points, BarTerm, ContinuumElement, Formulation, GaussGeometry,
+    GaussOutput, Integration, NodeBlocks, TangentMemo,
 };
 use crate::elements::{ElementResponse, Response};
 use crate::materials::point::{Material, PointState, TimeContext, UpdateError};
@@ -64,8 +66,14 @@ impl GeometryCache {
 
     /// The geometry of element `e` (`n` nodes, `n_pts` Gauss points), if stored.
     fn get(&self, e: usize, n: usize, n_pts: usize) -> Option<GaussGeometry> {
+        self.packed(e).map(|d| GaussGeometry::unpack(d, n, n_pts))
+    }
+
+    /// The packed values of element `e` ([`GaussGeometry::pack`]), if stored: the element
+    /// loop reads them in place.
+    fn packed(&self, e: usize) -> Option<&[f64]> {
         let d = &self.data[self.offset[e]..self.offset[e + 1]];
-        (!d.is_empty()).then(|| GaussGeometry::unpack(d, n, n_pts))
+        (!d.is_empty()).then_some(d)
     }
 }
 
@@ -94,7 +102,7 @@ impl Kept {
         let locals = geometry.as_ref().map(|g| LocalMaterials::new(model, g));
         Self {
             geometry,
-            memos: small_strain.then(|| TangentMemos::new(model, blocks)),
+            memos: small_strain.then(|| TangentMemos::new(model, blocks, bar_gps)),
             bar_rows: if small_strain {
                 bar_strain_rows(model, bar_gps)
             } else {
@@ -112,8 +120,9 @@ impl Kept {
 
 /// The tangent memos of the small-strain continuum elements ([`TangentMemo`]), for a
 /// nonlinear run in small strain: one per element with a Gauss-geometry cache (none for
-/// incompatible modes), each 1 + 9 n_pts + 4 × (wanted node blocks) values (a Q8 of 9
-/// points assembled by its lower triangle: 226 values, 1.8 kB; a Q4 of 4 points: 77).
+/// incompatible modes), each 1 + 9 n_pts + (embedded bar points) + 4 × (wanted node
+/// blocks) values (a Q8 of 9 points assembled by its lower triangle: 226 values, 1.8 kB,
+/// and one per bar point; a Q4 of 4 points: 77).
 pub struct TangentMemos {
     /// Start of each element's memo in `data` (elements + 1).
     offset: Vec<usize>,
@@ -121,15 +130,20 @@ pub struct TangentMemos {
 }
 
 impl TangentMemos {
-    /// Empty memos for every small-strain element of `model` with the wanted `blocks`.
-    pub fn new(model: &Model, blocks: &[NodeBlocks]) -> Self {
+    /// Empty memos for every small-strain element of `model` with the wanted `blocks` and
+    /// the embedded bar points `bar_gps` (bar, point).
+    pub fn new(model: &Model, blocks: &[NodeBlocks], bar_gps: &[(usize, usize)]) -> Self {
+        let mut bars = vec![0; model.elements.len()];
+        for &(b, p) in bar_gps {
+            bars[model.bars[b].points[p].element] += 1;
+        }
         let mut offset = Vec::with_capacity(model.elements.len() + 1);
         offset.push(0);
         let mut len = 0;
-        for (el, b) in model.elements.iter().zip(blocks) {
+        for ((el, b), nb) in model.elements.iter().zip(blocks).zip(bars) {
             if el.integration != Integration::Incompatible {
                 let n_pts = rule_points(el.kind, el.integration).len();
-                len += TangentMemo::len(el.nodes.len(), n_pts, *b);
+                len += TangentMemo::len(el.nodes.len(), n_pts, *b, nb);
             }
             offset.push(len);
         }
@@ -453,46 +467,24 @@ impl HostChunk<'_> {
                 v
             });
         let states = owned.as_deref().unwrap_or(base);
-        let cached = geometry.and_then(|c| c.get(e, nn, t.len()));
-        let element = ContinuumElement {
-            formulation: Formulation::new(el.kind, el.integration, tl),
-            coords,
-            thickness: region.thickness,
-            material: mat,
-            localised: local.is_some(),
-            time,
-            imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
-            blocks: blocks[e],
-            geometry: cached.as_ref(),
-            memo: std::cell::Cell::from_mut(memo).as_slice_of_cells(),
-        };
-        element.response(
-            ue,
-            states,
-            (t, o),
-            Response {
-                f: fe,
-                k: tangent.then_some(&mut *ke),
-            },
-        )?;
-        // Embedded bars hosted by this element, through the one bar-point law.
+        let cached = geometry.and_then(|c| c.packed(e));
+        let formulation = Formulation::new(el.kind, el.integration, tl);
         let kinematics = if tl {
             BarKinematics::TotalLagrangian
         } else {
             BarKinematics::SmallStrain
         };
         let bc0 = bar_offset[e] - b0;
-        for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
-            .iter()
-            .zip(bt.iter_mut().zip(bo.iter_mut()))
-            .enumerate()
-        {
+        let gps = &bar_gps[bar_offset[e]..bar_offset[e + 1]];
+        // The stage of the element's bar point i, as its law sees it.
+        let stage = |i: usize| {
+            let (b, p) = gps[i];
             let bar = &model.bars[b];
             // Relaxation of a tendon's steel: a stress-free strain.
             let relax = bar_time[bc0 + i]
                 .as_ref()
                 .map_or(0.0, |r| r.relax_strain.trial);
-            let stage = match bar_phase[b] {
+            match bar_phase[b] {
                 BarPhase::Inactive => BarStage::Absent,
                 BarPhase::Locked => BarStage::Locked {
                     stress: bar.bonding_stress(p) - bar.steel.es * relax,
@@ -503,7 +495,89 @@ impl HostChunk<'_> {
                     relax,
                     thermal: bar_imposed.get(bc0 + i).copied().unwrap_or(0.0),
                 },
-            };
+            }
+        };
+        // Small strain with the bars' strain rows cached: the bars' laws first and their
+        // terms added by the element after its points' (the same additions in the same
+        // order as below), so that the element's tangent memo covers them.
+        let rows = bar_rows
+            .get(bc0..bc0 + gps.len())
+            .filter(|_| matches!(formulation, Formulation::SmallStrain { .. }) && !gps.is_empty());
+        let mut on_stack = [BarTerm::default(); 8];
+        let mut on_heap = Vec::new();
+        let terms: &[BarTerm] = match rows {
+            Some(rows) => {
+                let terms = if gps.len() <= on_stack.len() {
+                    &mut on_stack[..gps.len()]
+                } else {
+                    on_heap.resize(gps.len(), BarTerm::default());
+                    &mut on_heap[..]
+                };
+                for (i, (((&(b, p), g), (st, out)), term)) in gps
+                    .iter()
+                    .zip(rows)
+                    .zip(bt.iter_mut().zip(bo.iter_mut()))
+                    .zip(terms.iter_mut())
+                    .enumerate()
+                {
+                    let bar = &model.bars[b];
+                    let (r, factors) = bar_point_small_strain(
+                        g,
+                        bar.points[p].point.weight_length,
+                        &bar.steel,
+                        bar.area,
+                        stage(i),
+                        &bar_committed[bc0 + i],
+                        ue,
+                    );
+                    *st = r.state;
+                    *out = BarOutput {
+                        strain: r.strain,
+                        stress: r.stress,
+                        plastic_strain: r.plastic_strain,
+                    };
+                    if let Some((force, stiffness)) = factors {
+                        *term = BarTerm {
+                            row: g,
+                            force,
+                            stiffness,
+                        };
+                    }
+                }
+                terms
+            }
+            None => &[],
+        };
+        let element = ContinuumElement {
+            formulation,
+            coords,
+            thickness: region.thickness,
+            material: mat,
+            localised: local.is_some(),
+            time,
+            imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
+            blocks: blocks[e],
+            geometry: cached,
+            memo: std::cell::Cell::from_mut(memo).as_slice_of_cells(),
+            bars: terms,
+        };
+        element.response(
+            ue,
+            states,
+            (t, o),
+            Response {
+                f: fe,
+                k: tangent.then_some(&mut *ke),
+            },
+        )?;
+        if rows.is_some() {
+            return Ok(());
+        }
+        // Embedded bars hosted by this element, through the one bar-point law.
+        for (i, (&(b, p), (st, out))) in
+            gps.iter().zip(bt.iter_mut().zip(bo.iter_mut())).enumerate()
+        {
+            let bar = &model.bars[b];
             let r = bar_point_response(
                 kinematics,
                 el.kind,
@@ -512,7 +586,7 @@ impl HostChunk<'_> {
                 bar_rows.get(bc0 + i),
                 &bar.steel,
                 bar.area,
-                stage,
+                stage(i),
                 &bar_committed[bc0 + i],
                 ue,
                 fe,
