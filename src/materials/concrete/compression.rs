@@ -394,7 +394,9 @@ struct Lu4 {
 }
 
 impl Lu4 {
-    /// Eliminate `a`; None for a (numerically) singular or non-finite pivot.
+    /// Eliminate `a`; None for a (numerically) singular or non-finite pivot. Plain index
+    /// loops of constant bounds, which the compiler unrolls.
+    #[inline(always)]
     fn new(mut a: [[f64; 4]; 4]) -> Option<Self> {
         let mut piv = [0; 4];
         let mut f = [[0.0; 4]; 4];
@@ -415,9 +417,8 @@ impl Lu4 {
             for r in c + 1..4 {
                 let fr = a[r][c] / a[c][c];
                 f[r][c] = fr;
-                let pivot_row = a[c];
-                for (ark, ack) in a[r].iter_mut().zip(pivot_row.iter()).skip(c) {
-                    *ark -= fr * ack;
+                for k in c..4 {
+                    a[r][k] -= fr * a[c][k];
                 }
             }
         }
