@@ -418,16 +418,12 @@ impl HostChunk<'_> {
             bar_offset,
             b0,
             bar_rows,
-            bar_committed,
-            bar_phase,
-            bar_eps_ref,
-            bar_time,
             imposed,
-            bar_imposed,
             stages,
             blocks,
             geometry,
             locals,
+            ..
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -469,37 +465,11 @@ impl HostChunk<'_> {
         let states = owned.as_deref().unwrap_or(base);
         let cached = geometry.and_then(|c| c.packed(e));
         let formulation = Formulation::new(el.kind, el.integration, tl);
-        let kinematics = if tl {
-            BarKinematics::TotalLagrangian
-        } else {
-            BarKinematics::SmallStrain
-        };
         let bc0 = bar_offset[e] - b0;
         let gps = &bar_gps[bar_offset[e]..bar_offset[e + 1]];
-        // The stage of the element's bar point i, as its law sees it.
-        let stage = |i: usize| {
-            let (b, p) = gps[i];
-            let bar = &model.bars[b];
-            // Relaxation of a tendon's steel: a stress-free strain.
-            let relax = bar_time[bc0 + i]
-                .as_ref()
-                .map_or(0.0, |r| r.relax_strain.trial);
-            match bar_phase[b] {
-                BarPhase::Inactive => BarStage::Absent,
-                BarPhase::Locked => BarStage::Locked {
-                    stress: bar.bonding_stress(p) - bar.steel.es * relax,
-                },
-                BarPhase::Bonded => BarStage::Bonded {
-                    eps_ref: bar_eps_ref[bc0 + i],
-                    prestrain: bar.bonding_stress(p) / bar.steel.es,
-                    relax,
-                    thermal: bar_imposed.get(bc0 + i).copied().unwrap_or(0.0),
-                },
-            }
-        };
         // Small strain with the bars' strain rows cached: the bars' laws first and their
         // terms added by the element after its points' (the same additions in the same
-        // order as below), so that the element's tangent memo covers them.
+        // order as `bars_after`), so that the element's tangent memo covers them.
         let rows = bar_rows
             .get(bc0..bc0 + gps.len())
             .filter(|_| matches!(formulation, Formulation::SmallStrain { .. }) && !gps.is_empty());
@@ -513,37 +483,7 @@ impl HostChunk<'_> {
                     on_heap.resize(gps.len(), BarTerm::default());
                     &mut on_heap[..]
                 };
-                for (i, (((&(b, p), g), (st, out)), term)) in gps
-                    .iter()
-                    .zip(rows)
-                    .zip(bt.iter_mut().zip(bo.iter_mut()))
-                    .zip(terms.iter_mut())
-                    .enumerate()
-                {
-                    let bar = &model.bars[b];
-                    let (r, factors) = bar_point_small_strain(
-                        g,
-                        bar.points[p].point.weight_length,
-                        &bar.steel,
-                        bar.area,
-                        stage(i),
-                        &bar_committed[bc0 + i],
-                        ue,
-                    );
-                    *st = r.state;
-                    *out = BarOutput {
-                        strain: r.strain,
-                        stress: r.stress,
-                        plastic_strain: r.plastic_strain,
-                    };
-                    if let Some((force, stiffness)) = factors {
-                        *term = BarTerm {
-                            row: g,
-                            force,
-                            stiffness,
-                        };
-                    }
-                }
+                self.bar_terms(e, rows, ue, (bt, bo), terms);
                 terms
             }
             None => &[],
@@ -570,27 +510,125 @@ impl HostChunk<'_> {
                 k: tangent.then_some(&mut *ke),
             },
         )?;
-        if rows.is_some() {
-            return Ok(());
+        if rows.is_none() {
+            self.bars_after(
+                e,
+                (el.kind, coords),
+                ue,
+                (bt, bo),
+                fe,
+                tangent.then_some(ke),
+            );
         }
-        // Embedded bars hosted by this element, through the one bar-point law.
+        Ok(())
+    }
+
+    /// The stage of element `e`'s bar point `i` (in the chunk's order), as its law sees it.
+    fn bar_stage(&self, e: usize, i: usize) -> BarStage {
+        let (b, p) = self.bar_gps[self.bar_offset[e] + i];
+        let c = self.bar_offset[e] - self.b0 + i;
+        let bar = &self.model.bars[b];
+        // Relaxation of a tendon's steel: a stress-free strain.
+        let relax = self.bar_time[c]
+            .as_ref()
+            .map_or(0.0, |r| r.relax_strain.trial);
+        match self.bar_phase[b] {
+            BarPhase::Inactive => BarStage::Absent,
+            BarPhase::Locked => BarStage::Locked {
+                stress: bar.bonding_stress(p) - bar.steel.es * relax,
+            },
+            BarPhase::Bonded => BarStage::Bonded {
+                eps_ref: self.bar_eps_ref[c],
+                prestrain: bar.bonding_stress(p) / bar.steel.es,
+                relax,
+                thermal: self.bar_imposed.get(c).copied().unwrap_or(0.0),
+            },
+        }
+    }
+
+    /// The laws of element `e`'s bar points in small strain with their strain rows `rows`
+    /// at the element displacements `ue`: trial states and outputs into `bt`, `bo`, the
+    /// terms the element adds into `terms` (an absent point's left empty).
+    fn bar_terms<'r>(
+        &self,
+        e: usize,
+        rows: &'r [[f64; ND]],
+        ue: &[f64],
+        (bt, bo): (&mut [SteelState], &mut [BarOutput]),
+        terms: &mut [BarTerm<'r>],
+    ) {
+        let gps = &self.bar_gps[self.bar_offset[e]..self.bar_offset[e + 1]];
+        let c0 = self.bar_offset[e] - self.b0;
+        for (i, (((&(b, p), g), (st, out)), term)) in gps
+            .iter()
+            .zip(rows)
+            .zip(bt.iter_mut().zip(bo.iter_mut()))
+            .zip(terms.iter_mut())
+            .enumerate()
+        {
+            let bar = &self.model.bars[b];
+            let (r, factors) = bar_point_small_strain(
+                g,
+                bar.points[p].point.weight_length,
+                &bar.steel,
+                bar.area,
+                self.bar_stage(e, i),
+                &self.bar_committed[c0 + i],
+                ue,
+            );
+            *st = r.state;
+            *out = BarOutput {
+                strain: r.strain,
+                stress: r.stress,
+                plastic_strain: r.plastic_strain,
+            };
+            if let Some((force, stiffness)) = factors {
+                *term = BarTerm {
+                    row: g,
+                    force,
+                    stiffness,
+                };
+            }
+        }
+    }
+
+    /// Element `e`'s bar points through the one bar-point law, added to the element's
+    /// force `fe` and tangent `ke` after its own response (host kind and node coordinates
+    /// `host`, element displacements `ue`): the total Lagrangian kinematics, or small
+    /// strain without cached rows.
+    fn bars_after(
+        &self,
+        e: usize,
+        (kind, coords): (crate::model::ElementKind, &[[f64; 2]]),
+        ue: &[f64],
+        (bt, bo): (&mut [SteelState], &mut [BarOutput]),
+        fe: &mut [f64],
+        mut ke: Option<&mut [f64]>,
+    ) {
+        let kinematics = if self.tl {
+            BarKinematics::TotalLagrangian
+        } else {
+            BarKinematics::SmallStrain
+        };
+        let gps = &self.bar_gps[self.bar_offset[e]..self.bar_offset[e + 1]];
+        let c0 = self.bar_offset[e] - self.b0;
         for (i, (&(b, p), (st, out))) in
             gps.iter().zip(bt.iter_mut().zip(bo.iter_mut())).enumerate()
         {
-            let bar = &model.bars[b];
+            let bar = &self.model.bars[b];
             let r = bar_point_response(
                 kinematics,
-                el.kind,
+                kind,
                 coords,
                 &bar.points[p].point,
-                bar_rows.get(bc0 + i),
+                self.bar_rows.get(c0 + i),
                 &bar.steel,
                 bar.area,
-                stage(i),
-                &bar_committed[bc0 + i],
+                self.bar_stage(e, i),
+                &self.bar_committed[c0 + i],
                 ue,
                 fe,
-                tangent.then_some(&mut *ke),
+                ke.as_deref_mut(),
             );
             *st = r.state;
             *out = BarOutput {
@@ -599,6 +637,5 @@ impl HostChunk<'_> {
                 plastic_strain: r.plastic_strain,
             };
         }
-        Ok(())
     }
 }
