@@ -5,10 +5,12 @@
 use super::families::{BarOutput, BarPhase, Families};
 use super::stages::StageState;
 use super::tendon_time::BarPointTime;
-use crate::elements::bar::{bar_point_response, bar_strain_row, BarKinematics, BarStage};
+use crate::elements::bar::{
+    bar_point_response, bar_point_small_strain, bar_strain_row, BarKinematics, BarStage,
+};
 use crate::elements::continuum::{
-    gauss_geometry, rule_points, ContinuumElement, Formulation, GaussGeometry, GaussOutput,
-    Integration, NodeBlocks, TangentMemo,
+    gauss_geometry, rule_points, BarTerm, ContinuumElement, Formulation, GaussGeometry,
+    GaussOutput, Integration, NodeBlocks, TangentMemo,
 };
 use crate::elements::{ElementResponse, Response};
 use crate::materials::point::{Material, PointState, TimeContext, UpdateError};
@@ -64,8 +66,14 @@ impl GeometryCache {
 
     /// The geometry of element `e` (`n` nodes, `n_pts` Gauss points), if stored.
     fn get(&self, e: usize, n: usize, n_pts: usize) -> Option<GaussGeometry> {
+        self.packed(e).map(|d| GaussGeometry::unpack(d, n, n_pts))
+    }
+
+    /// The packed values of element `e` ([`GaussGeometry::pack`]), if stored: the element
+    /// loop reads them in place.
+    fn packed(&self, e: usize) -> Option<&[f64]> {
         let d = &self.data[self.offset[e]..self.offset[e + 1]];
-        (!d.is_empty()).then(|| GaussGeometry::unpack(d, n, n_pts))
+        (!d.is_empty()).then_some(d)
     }
 }
 
@@ -94,7 +102,7 @@ impl Kept {
         let locals = geometry.as_ref().map(|g| LocalMaterials::new(model, g));
         Self {
             geometry,
-            memos: small_strain.then(|| TangentMemos::new(model, blocks)),
+            memos: small_strain.then(|| TangentMemos::new(model, blocks, bar_gps)),
             bar_rows: if small_strain {
                 bar_strain_rows(model, bar_gps)
             } else {
@@ -112,8 +120,9 @@ impl Kept {
 
 /// The tangent memos of the small-strain continuum elements ([`TangentMemo`]), for a
 /// nonlinear run in small strain: one per element with a Gauss-geometry cache (none for
-/// incompatible modes), each 1 + 9 n_pts + 4 × (wanted node blocks) values (a Q8 of 9
-/// points assembled by its lower triangle: 226 values, 1.8 kB; a Q4 of 4 points: 77).
+/// incompatible modes), each 1 + 9 n_pts + (embedded bar points) + 4 × (wanted node
+/// blocks) values (a Q8 of 9 points assembled by its lower triangle: 226 values, 1.8 kB,
+/// and one per bar point; a Q4 of 4 points: 77).
 pub struct TangentMemos {
     /// Start of each element's memo in `data` (elements + 1).
     offset: Vec<usize>,
@@ -121,15 +130,20 @@ pub struct TangentMemos {
 }
 
 impl TangentMemos {
-    /// Empty memos for every small-strain element of `model` with the wanted `blocks`.
-    pub fn new(model: &Model, blocks: &[NodeBlocks]) -> Self {
+    /// Empty memos for every small-strain element of `model` with the wanted `blocks` and
+    /// the embedded bar points `bar_gps` (bar, point).
+    pub fn new(model: &Model, blocks: &[NodeBlocks], bar_gps: &[(usize, usize)]) -> Self {
+        let mut bars = vec![0; model.elements.len()];
+        for &(b, p) in bar_gps {
+            bars[model.bars[b].points[p].element] += 1;
+        }
         let mut offset = Vec::with_capacity(model.elements.len() + 1);
         offset.push(0);
         let mut len = 0;
-        for (el, b) in model.elements.iter().zip(blocks) {
+        for ((el, b), nb) in model.elements.iter().zip(blocks).zip(bars) {
             if el.integration != Integration::Incompatible {
                 let n_pts = rule_points(el.kind, el.integration).len();
-                len += TangentMemo::len(el.nodes.len(), n_pts, *b);
+                len += TangentMemo::len(el.nodes.len(), n_pts, *b, nb);
             }
             offset.push(len);
         }
@@ -404,16 +418,12 @@ impl HostChunk<'_> {
             bar_offset,
             b0,
             bar_rows,
-            bar_committed,
-            bar_phase,
-            bar_eps_ref,
-            bar_time,
             imposed,
-            bar_imposed,
             stages,
             blocks,
             geometry,
             locals,
+            ..
         } = *self;
         let el = &model.elements[e];
         let region = &model.regions[el.region];
@@ -453,9 +463,33 @@ impl HostChunk<'_> {
                 v
             });
         let states = owned.as_deref().unwrap_or(base);
-        let cached = geometry.and_then(|c| c.get(e, nn, t.len()));
+        let cached = geometry.and_then(|c| c.packed(e));
+        let formulation = Formulation::new(el.kind, el.integration, tl);
+        let bc0 = bar_offset[e] - b0;
+        let gps = &bar_gps[bar_offset[e]..bar_offset[e + 1]];
+        // Small strain with the bars' strain rows cached: the bars' laws first and their
+        // terms added by the element after its points' (the same additions in the same
+        // order as `bars_after`), so that the element's tangent memo covers them.
+        let rows = bar_rows
+            .get(bc0..bc0 + gps.len())
+            .filter(|_| matches!(formulation, Formulation::SmallStrain { .. }) && !gps.is_empty());
+        let mut on_stack = [BarTerm::default(); 8];
+        let mut on_heap = Vec::new();
+        let terms: &[BarTerm] = match rows {
+            Some(rows) => {
+                let terms = if gps.len() <= on_stack.len() {
+                    &mut on_stack[..gps.len()]
+                } else {
+                    on_heap.resize(gps.len(), BarTerm::default());
+                    &mut on_heap[..]
+                };
+                self.bar_terms(e, rows, ue, (bt, bo), terms);
+                terms
+            }
+            None => &[],
+        };
         let element = ContinuumElement {
-            formulation: Formulation::new(el.kind, el.integration, tl),
+            formulation,
             coords,
             thickness: region.thickness,
             material: mat,
@@ -463,8 +497,9 @@ impl HostChunk<'_> {
             time,
             imposed: imposed.get(c0..c0 + t.len()).unwrap_or(&[]),
             blocks: blocks[e],
-            geometry: cached.as_ref(),
+            geometry: cached,
             memo: std::cell::Cell::from_mut(memo).as_slice_of_cells(),
+            bars: terms,
         };
         element.response(
             ue,
@@ -475,48 +510,125 @@ impl HostChunk<'_> {
                 k: tangent.then_some(&mut *ke),
             },
         )?;
-        // Embedded bars hosted by this element, through the one bar-point law.
-        let kinematics = if tl {
+        if rows.is_none() {
+            self.bars_after(
+                e,
+                (el.kind, coords),
+                ue,
+                (bt, bo),
+                fe,
+                tangent.then_some(ke),
+            );
+        }
+        Ok(())
+    }
+
+    /// The stage of element `e`'s bar point `i` (in the chunk's order), as its law sees it.
+    fn bar_stage(&self, e: usize, i: usize) -> BarStage {
+        let (b, p) = self.bar_gps[self.bar_offset[e] + i];
+        let c = self.bar_offset[e] - self.b0 + i;
+        let bar = &self.model.bars[b];
+        // Relaxation of a tendon's steel: a stress-free strain.
+        let relax = self.bar_time[c]
+            .as_ref()
+            .map_or(0.0, |r| r.relax_strain.trial);
+        match self.bar_phase[b] {
+            BarPhase::Inactive => BarStage::Absent,
+            BarPhase::Locked => BarStage::Locked {
+                stress: bar.bonding_stress(p) - bar.steel.es * relax,
+            },
+            BarPhase::Bonded => BarStage::Bonded {
+                eps_ref: self.bar_eps_ref[c],
+                prestrain: bar.bonding_stress(p) / bar.steel.es,
+                relax,
+                thermal: self.bar_imposed.get(c).copied().unwrap_or(0.0),
+            },
+        }
+    }
+
+    /// The laws of element `e`'s bar points in small strain with their strain rows `rows`
+    /// at the element displacements `ue`: trial states and outputs into `bt`, `bo`, the
+    /// terms the element adds into `terms` (an absent point's left empty).
+    fn bar_terms<'r>(
+        &self,
+        e: usize,
+        rows: &'r [[f64; ND]],
+        ue: &[f64],
+        (bt, bo): (&mut [SteelState], &mut [BarOutput]),
+        terms: &mut [BarTerm<'r>],
+    ) {
+        let gps = &self.bar_gps[self.bar_offset[e]..self.bar_offset[e + 1]];
+        let c0 = self.bar_offset[e] - self.b0;
+        for (i, (((&(b, p), g), (st, out)), term)) in gps
+            .iter()
+            .zip(rows)
+            .zip(bt.iter_mut().zip(bo.iter_mut()))
+            .zip(terms.iter_mut())
+            .enumerate()
+        {
+            let bar = &self.model.bars[b];
+            let (r, factors) = bar_point_small_strain(
+                g,
+                bar.points[p].point.weight_length,
+                &bar.steel,
+                bar.area,
+                self.bar_stage(e, i),
+                &self.bar_committed[c0 + i],
+                ue,
+            );
+            *st = r.state;
+            *out = BarOutput {
+                strain: r.strain,
+                stress: r.stress,
+                plastic_strain: r.plastic_strain,
+            };
+            if let Some((force, stiffness)) = factors {
+                *term = BarTerm {
+                    row: g,
+                    force,
+                    stiffness,
+                };
+            }
+        }
+    }
+
+    /// Element `e`'s bar points through the one bar-point law, added to the element's
+    /// force `fe` and tangent `ke` after its own response (host kind and node coordinates
+    /// `host`, element displacements `ue`): the total Lagrangian kinematics, or small
+    /// strain without cached rows.
+    fn bars_after(
+        &self,
+        e: usize,
+        (kind, coords): (crate::model::ElementKind, &[[f64; 2]]),
+        ue: &[f64],
+        (bt, bo): (&mut [SteelState], &mut [BarOutput]),
+        fe: &mut [f64],
+        mut ke: Option<&mut [f64]>,
+    ) {
+        let kinematics = if self.tl {
             BarKinematics::TotalLagrangian
         } else {
             BarKinematics::SmallStrain
         };
-        let bc0 = bar_offset[e] - b0;
-        for (i, (&(b, p), (st, out))) in bar_gps[bar_offset[e]..bar_offset[e + 1]]
-            .iter()
-            .zip(bt.iter_mut().zip(bo.iter_mut()))
-            .enumerate()
+        let gps = &self.bar_gps[self.bar_offset[e]..self.bar_offset[e + 1]];
+        let c0 = self.bar_offset[e] - self.b0;
+        for (i, (&(b, p), (st, out))) in
+            gps.iter().zip(bt.iter_mut().zip(bo.iter_mut())).enumerate()
         {
-            let bar = &model.bars[b];
-            // Relaxation of a tendon's steel: a stress-free strain.
-            let relax = bar_time[bc0 + i]
-                .as_ref()
-                .map_or(0.0, |r| r.relax_strain.trial);
-            let stage = match bar_phase[b] {
-                BarPhase::Inactive => BarStage::Absent,
-                BarPhase::Locked => BarStage::Locked {
-                    stress: bar.bonding_stress(p) - bar.steel.es * relax,
-                },
-                BarPhase::Bonded => BarStage::Bonded {
-                    eps_ref: bar_eps_ref[bc0 + i],
-                    prestrain: bar.bonding_stress(p) / bar.steel.es,
-                    relax,
-                    thermal: bar_imposed.get(bc0 + i).copied().unwrap_or(0.0),
-                },
-            };
+            let bar = &self.model.bars[b];
             let r = bar_point_response(
                 kinematics,
-                el.kind,
+                kind,
                 coords,
                 &bar.points[p].point,
-                bar_rows.get(bc0 + i),
+                self.bar_rows.get(c0 + i),
                 &bar.steel,
                 bar.area,
-                stage,
-                &bar_committed[bc0 + i],
+                self.bar_stage(e, i),
+                &self.bar_committed[c0 + i],
                 ue,
                 fe,
-                tangent.then_some(&mut *ke),
+                ke.as_deref_mut(),
             );
             *st = r.state;
             *out = BarOutput {
@@ -525,6 +637,5 @@ impl HostChunk<'_> {
                 plastic_strain: r.plastic_strain,
             };
         }
-        Ok(())
     }
 }

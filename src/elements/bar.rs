@@ -180,6 +180,80 @@ pub struct BarPointResult {
     pub plastic_strain: f64,
 }
 
+/// The steel law of a bar point at `stage` for the bar strain `eps_b` [-] (without the
+/// prestrain, relaxation and thermal strain that `stage` adds): its result and tangent
+/// E_t [Pa]; None for an absent point (no force, state kept).
+fn bar_law(
+    steel: &SteelParams,
+    stage: BarStage,
+    committed: &SteelState,
+    eps_b: f64,
+) -> Option<(BarPointResult, f64)> {
+    match stage {
+        BarStage::Absent => None,
+        BarStage::Locked { stress } => Some((
+            BarPointResult {
+                state: *committed,
+                strain: stress / steel.es,
+                stress,
+                plastic_strain: 0.0,
+            },
+            0.0,
+        )),
+        BarStage::Bonded {
+            eps_ref,
+            prestrain,
+            relax,
+            thermal,
+        } => {
+            let eps = eps_b - eps_ref + prestrain - relax - thermal;
+            let (state, sig, et) = update_uniaxial(steel, committed, eps);
+            Some((
+                BarPointResult {
+                    state,
+                    strain: eps,
+                    stress: sig,
+                    plastic_strain: state.plastic_strain,
+                },
+                et,
+            ))
+        }
+    }
+}
+
+/// The law part of [`bar_point_response`] under small strain with the point's strain row
+/// `g` ([`bar_strain_row`]) and weight `weight_length` [m]: the point's result and, unless
+/// it is absent, the factors σ A w [N] and E_t A w [N] of its force g σ A w and tangent
+/// g E_t A w gᵀ, which the host adds ([`crate::elements::continuum::BarTerm`]; the values
+/// and additions of [`bar_point_response`]).
+#[allow(clippy::too_many_arguments)]
+pub fn bar_point_small_strain(
+    g: &[f64; 2 * MAX_NODES],
+    weight_length: f64,
+    steel: &SteelParams,
+    area: f64,
+    stage: BarStage,
+    committed: &SteelState,
+    u_e: &[f64],
+) -> (BarPointResult, Option<(f64, f64)>) {
+    let eps_b = g.iter().zip(u_e).map(|(a, b)| a * b).sum::<f64>();
+    match bar_law(steel, stage, committed, eps_b) {
+        None => (
+            BarPointResult {
+                state: *committed,
+                strain: 0.0,
+                stress: 0.0,
+                plastic_strain: 0.0,
+            },
+            None,
+        ),
+        Some((res, et)) => {
+            let factors = (res.stress * area * weight_length, et * area * weight_length);
+            (res, Some(factors))
+        }
+    }
+}
+
 /// The bar-point law, the one place an embedded bar point turns its host's displacements
 /// `u_e` [m] into a force: uniaxial steel `steel` at the point's stage, f += g σ A w into
 /// `f` [N] and, if given, K += g E_t A w gᵀ (+ σ A w (d dᵀ ⊗ I₂) under the total Lagrangian
@@ -216,42 +290,13 @@ pub fn bar_point_response(
             (e, g, Some(d))
         }
     };
-    let (res, et) = match stage {
-        BarStage::Absent => {
-            return BarPointResult {
-                state: *committed,
-                strain: 0.0,
-                stress: 0.0,
-                plastic_strain: 0.0,
-            }
-        }
-        BarStage::Locked { stress } => (
-            BarPointResult {
-                state: *committed,
-                strain: stress / steel.es,
-                stress,
-                plastic_strain: 0.0,
-            },
-            0.0,
-        ),
-        BarStage::Bonded {
-            eps_ref,
-            prestrain,
-            relax,
-            thermal,
-        } => {
-            let eps = eps_b - eps_ref + prestrain - relax - thermal;
-            let (state, sig, et) = update_uniaxial(steel, committed, eps);
-            (
-                BarPointResult {
-                    state,
-                    strain: eps,
-                    stress: sig,
-                    plastic_strain: state.plastic_strain,
-                },
-                et,
-            )
-        }
+    let Some((res, et)) = bar_law(steel, stage, committed, eps_b) else {
+        return BarPointResult {
+            state: *committed,
+            strain: 0.0,
+            stress: 0.0,
+            plastic_strain: 0.0,
+        };
     };
     // The two kinematics keep their own rounding order of σ A w (the histories of cracking
     // models branch on a last-bit change: one order would move the total Lagrangian ones).

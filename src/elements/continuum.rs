@@ -83,10 +83,27 @@ pub struct ContinuumElement<'a> {
     pub imposed: &'a [f64],
     /// The node blocks of the tangent to form (the assembly wants one of (a, b), (b, a)).
     pub blocks: NodeBlocks,
-    /// The Gauss-point geometry if already known (a cache; None: computed from `coords`).
-    pub geometry: Option<&'a GaussGeometry>,
+    /// The Gauss-point geometry if already known, as packed by [`GaussGeometry::pack`] (a
+    /// cache read in place; None: computed from `coords`).
+    pub geometry: Option<&'a [f64]>,
     /// The element's tangent memo ([`TangentMemo`]; empty: none), small strain only.
     pub memo: &'a [Cell<f64>],
+    /// The terms of the embedded bar points the element adds after its own ([`BarTerm`];
+    /// small strain only, empty: none, the caller adds its bars).
+    pub bars: &'a [BarTerm<'a>],
+}
+
+/// What an embedded bar point adds to its host's force and tangent in small strain
+/// ([`crate::elements::bar::bar_point_small_strain`]): f += g σ A w, K += g (E_t A w) gᵀ,
+/// added by the host after its own points' terms, so that its tangent memo covers them.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BarTerm<'a> {
+    /// Strain row g (at least 2n entries; empty: an absent point, which adds nothing).
+    pub row: &'a [f64],
+    /// σ A w [N].
+    pub force: f64,
+    /// E_t A w [N].
+    pub stiffness: f64,
 }
 
 impl super::ElementResponse for ContinuumElement<'_> {
@@ -124,18 +141,21 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 return Ok(true);
             }
         };
-        let computed;
-        let geometry = match self.geometry {
-            Some(g) => g,
-            None => {
-                computed = gauss_geometry(kind, integration, c);
-                &computed
-            }
-        };
+        debug_assert!(
+            !tl || self.bars.is_empty(),
+            "bar terms in small strain only"
+        );
         if tl {
+            let computed = match self.geometry {
+                Some(packed) => {
+                    let n = kind.n_nodes();
+                    GaussGeometry::unpack(packed, n, (packed.len() - 1) / (2 * n + 1))
+                }
+                None => gauss_geometry(kind, integration, c),
+            };
             super::total_lagrangian::response_tl(
                 kind,
-                geometry,
+                &computed,
                 t,
                 m,
                 committed,
@@ -149,9 +169,18 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 self.blocks,
             )?;
         } else {
+            let mut buf = [0.0; PACKED_MAX];
+            let packed = match self.geometry {
+                Some(packed) => packed,
+                None => {
+                    let len =
+                        gauss_geometry(kind, integration, c).pack_into(kind.n_nodes(), &mut buf);
+                    &buf[..len]
+                }
+            };
             small_strain(
                 kind,
-                geometry,
+                packed,
                 t,
                 m,
                 committed,
@@ -163,7 +192,7 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 self.time,
                 self.imposed,
                 self.blocks,
-                (self.memo, self.localised),
+                (self.memo, self.localised, self.bars),
             )?;
         }
         Ok(true)
@@ -356,6 +385,22 @@ impl GaussGeometry {
         out.push(self.h);
     }
 
+    /// Write the values of [`GaussGeometry::pack`] for an element of `n` nodes into the
+    /// front of `out` (at least [`PACKED_MAX`] long); their count.
+    pub fn pack_into(&self, n: usize, out: &mut [f64]) -> usize {
+        let s = 2 * n + 1;
+        for (g, (dn, w)) in self.points[..self.n_pts].iter().enumerate() {
+            let row = &mut out[g * s..(g + 1) * s];
+            for a in 0..n {
+                row[2 * a] = dn[a][0];
+                row[2 * a + 1] = dn[a][1];
+            }
+            row[2 * n] = *w;
+        }
+        out[self.n_pts * s] = self.h;
+        self.n_pts * s + 1
+    }
+
     /// The geometry of an element of `n` nodes and `n_pts` points from its packed values
     /// (the same bits as computed).
     pub fn unpack(data: &[f64], n: usize, n_pts: usize) -> Self {
@@ -376,6 +421,9 @@ impl GaussGeometry {
         g
     }
 }
+
+/// The most values [`GaussGeometry::pack`] writes: 9 points of 9 nodes and h.
+pub const PACKED_MAX: usize = 9 * (2 * MAX_NODES + 1) + 1;
 
 /// The Gauss-point geometry of an element of `kind` with nodes at `coords` under the rule
 /// `integration` (computed for all points before any material update).
@@ -420,9 +468,11 @@ pub fn response_at(
     imposed: &[f64],
     blocks: NodeBlocks,
 ) -> Result<(), UpdateError> {
+    let mut buf = [0.0; PACKED_MAX];
+    let len = geometry.pack_into(kind.n_nodes(), &mut buf);
     small_strain(
         kind,
-        geometry,
+        &buf[..len],
         thickness,
         mat,
         committed,
@@ -434,17 +484,88 @@ pub fn response_at(
         time,
         imposed,
         blocks,
-        (&[], false),
+        (&[], false, &[]),
     )
 }
 
-/// [`response_at`] with the element's tangent memo `memo` ([`TangentMemo`]; empty: none):
-/// when every point's tangent D has the bits of the memo's, the tangent is the memo's
-/// (the same function of the same values), else it is formed and kept there.
+/// [`response_at`] with the Gauss geometry `packed` ([`GaussGeometry::pack`], read in
+/// place) and the element's tangent memo `memo` ([`TangentMemo`]; empty: none): when every
+/// point's tangent D has the bits of the memo's, the tangent is the memo's (the same
+/// function of the same values), else it is formed and kept there. Dispatches on the
+/// kind's node count and the rule's point count, so that the loops over nodes and points
+/// have fixed trip counts ([`small_strain_fixed`]).
 #[allow(clippy::too_many_arguments)]
 fn small_strain(
     kind: ElementKind,
-    geometry: &GaussGeometry,
+    packed: &[f64],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+    blocks: NodeBlocks,
+    memo: (&[Cell<f64>], bool, &[BarTerm]),
+) -> Result<(), UpdateError> {
+    let n = kind.n_nodes();
+    let n_pts = (packed.len() - 1) / (2 * n + 1);
+    debug_assert_eq!(packed.len(), n_pts * (2 * n + 1) + 1, "packed geometry");
+    macro_rules! fixed {
+        ($n:literal, $p:literal) => {
+            small_strain_fixed::<$n, $p>(
+                packed, thickness, mat, committed, u, f, k, trial, out, time, imposed, blocks, memo,
+            )
+        };
+    }
+    match (n, n_pts) {
+        (4, 4) => fixed!(4, 4),
+        (8, 9) => fixed!(8, 9),
+        (8, 4) => fixed!(8, 4),
+        (9, 9) => fixed!(9, 9),
+        (9, 4) => fixed!(9, 4),
+        (6, 3) => fixed!(6, 3),
+        // Every kind and rule is above; any other pair would take this general path.
+        _ => small_strain_any(
+            n, n_pts, packed, thickness, mat, committed, u, f, k, trial, out, time, imposed,
+            blocks, memo,
+        ),
+    }
+}
+
+/// [`small_strain`] for `N` nodes and `P` points (fixed trip counts).
+#[allow(clippy::too_many_arguments)]
+fn small_strain_fixed<const N: usize, const P: usize>(
+    packed: &[f64],
+    thickness: f64,
+    mat: &Material,
+    committed: &[PointState],
+    u: &[f64],
+    f: &mut [f64],
+    k: Option<&mut [f64]>,
+    trial: &mut [PointState],
+    out: &mut [GaussOutput],
+    time: &TimeContext,
+    imposed: &[f64],
+    blocks: NodeBlocks,
+    memo: (&[Cell<f64>], bool, &[BarTerm]),
+) -> Result<(), UpdateError> {
+    small_strain_any(
+        N, P, packed, thickness, mat, committed, u, f, k, trial, out, time, imposed, blocks, memo,
+    )
+}
+
+/// [`small_strain`] for `n` nodes and `n_pts` points; inlined into [`small_strain_fixed`]
+/// with constant `n` and `n_pts`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn small_strain_any(
+    n: usize,
+    n_pts: usize,
+    packed: &[f64],
     thickness: f64,
     mat: &Material,
     committed: &[PointState],
@@ -456,15 +577,18 @@ fn small_strain(
     time: &TimeContext,
     imposed: &[f64],
     blocks: NodeBlocks,
-    (memo, localised): (&[Cell<f64>], bool),
+    (memo, localised, bars): (&[Cell<f64>], bool, &[BarTerm]),
 ) -> Result<(), UpdateError> {
-    let n = kind.n_nodes();
     let nd = 2 * n;
-    f[..nd].iter_mut().for_each(|v| *v = 0.0);
+    // One point's values: (∂N/∂x, ∂N/∂y) of every node, then w·det J.
+    let s = nd + 1;
+    let (u, f) = (&u[..nd], &mut f[..nd]);
+    f.iter_mut().for_each(|v| *v = 0.0);
     if let Some(k) = k.as_deref_mut() {
         k[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
     }
-    let (n_pts, geo, h) = (geometry.n_pts, &geometry.points, geometry.h);
+    let geo = &packed[..n_pts * s];
+    let h = packed[n_pts * s];
     // Size-dependent material constants once per element (same values as per point).
     let local = if localised {
         None
@@ -476,13 +600,15 @@ fn small_strain(
     let mut tangents = [[[0.0; 3]; 3]; 9];
     let mut weights = [0.0; 9];
     for g in 0..n_pts {
-        let (dn, wdet) = geo[g];
+        let pt = &geo[g * s..(g + 1) * s];
+        let wdet = pt[nd];
         let mut eps = [0.0; 3];
         for a in 0..n {
+            let (dx, dy) = (pt[2 * a], pt[2 * a + 1]);
             let (ux, uy) = (u[2 * a], u[2 * a + 1]);
-            eps[0] += dn[a][0] * ux;
-            eps[1] += dn[a][1] * uy;
-            eps[2] += dn[a][1] * ux + dn[a][0] * uy;
+            eps[0] += dx * ux;
+            eps[1] += dy * uy;
+            eps[2] += dy * ux + dx * uy;
         }
         // Into the trial slot: no allocation of a new boxed concrete state per point.
         let mech = mechanical(eps, imposed, g);
@@ -494,19 +620,27 @@ fn small_strain(
         let w = wdet * thickness;
         // B_a = [[dx, 0], [0, dy], [dy, dx]]; f_a = Bᵀσ; K_ab = B_aᵀ D B_b.
         for a in 0..n {
-            let (ax, ay) = (dn[a][0], dn[a][1]);
+            let (ax, ay) = (pt[2 * a], pt[2 * a + 1]);
             f[2 * a] += w * (ax * sig[0] + ay * sig[2]);
             f[2 * a + 1] += w * (ay * sig[1] + ax * sig[2]);
         }
         tangents[g] = d;
         weights[g] = w;
     }
+    // The embedded bars, in their order: f += g σ A w.
+    for bar in bars.iter().filter(|b| !b.row.is_empty()) {
+        let g = &bar.row[..nd];
+        for r in 0..nd {
+            f[r] += g[r] * bar.force;
+        }
+    }
     let Some(k) = k else {
         return Ok(());
     };
-    let memo = TangentMemo::of(memo, n, n_pts, blocks);
+    let k = &mut k[..nd * nd];
+    let memo = TangentMemo::of(memo, n, n_pts, blocks, bars.len());
     if let Some(m) = memo {
-        if m.holds(&tangents[..n_pts]) {
+        if m.holds(&tangents[..n_pts], bars) {
             m.copy_into(k, n, blocks);
             return Ok(());
         }
@@ -517,8 +651,8 @@ fn small_strain(
     for a in 0..n {
         let mut rs = [[0.0; 6]; 9];
         for g in 0..n_pts {
-            let (dn, d) = (&geo[g].0, &tangents[g]);
-            let (ax, ay) = (dn[a][0], dn[a][1]);
+            let d = &tangents[g];
+            let (ax, ay) = (geo[g * s + 2 * a], geo[g * s + 2 * a + 1]);
             rs[g] = [
                 ax * d[0][0] + ay * d[2][0],
                 ax * d[0][1] + ay * d[2][1],
@@ -535,7 +669,7 @@ fn small_strain(
             let mut acc = [0.0; 4];
             for g in 0..n_pts {
                 let (r, w) = (&rs[g], weights[g]);
-                let (bx, by) = (geo[g].0[b][0], geo[g].0[b][1]);
+                let (bx, by) = (geo[g * s + 2 * b], geo[g * s + 2 * b + 1]);
                 acc[0] += w * (r[0] * bx + r[2] * by);
                 acc[1] += w * (r[1] * by + r[2] * bx);
                 acc[2] += w * (r[3] * bx + r[5] * by);
@@ -548,86 +682,157 @@ fn small_strain(
             k[row1 + 2 * b + 1] = acc[3];
         }
     }
+    // The bars' K += g (E_t A w) gᵀ, row by row (rows with a zero factor add nothing).
+    for bar in bars.iter().filter(|b| !b.row.is_empty()) {
+        let g = &bar.row[..nd];
+        for r in 0..nd {
+            let gr = g[r] * bar.stiffness;
+            if gr != 0.0 {
+                for c in 0..nd {
+                    k[r * nd + c] += gr * g[c];
+                }
+            }
+        }
+    }
     if let Some(m) = memo {
-        m.keep(&tangents[..n_pts], k, n, blocks);
+        m.keep(&tangents[..n_pts], bars, k, n, blocks);
     }
     Ok(())
 }
 
-/// One small-strain element's tangent memo: its points' tangents D when its tangent was
-/// last formed, and the wanted node blocks of that tangent ([`NodeBlocks`]). In small
-/// strain the tangent is a function of the points' D alone (the geometry, weights and
-/// blocks do not change), so where every D has the memo's bits the tangent has the memo's
-/// bits too, and its B_aᵀ D B_b sums are skipped: the elastic elements of a cracking
-/// model, and IMPL-EX cracked points, whose tangent comes from the committed state, repeat
-/// theirs at every iteration of an increment. Layout (f64 values, [`TangentMemo::len`]): a
-/// flag (1: filled), the n_pts × 9 entries of the D's, then 4 entries per wanted block
-/// (a, b) in the order a, then b.
+/// One small-strain element's tangent memo: its points' tangents D and its bar points'
+/// stiffness factors E_t A w ([`BarTerm`]) when its tangent was last formed, and the wanted
+/// node blocks of that tangent ([`NodeBlocks`]). In small strain the tangent is a function
+/// of the points' D and the bars' factors alone (the geometry, weights, bar strain rows and
+/// blocks do not change), so where every D and factor has the memo's bits the tangent has
+/// the memo's bits too, and its B_aᵀ D B_b sums and the bars' outer products are skipped:
+/// the elastic elements of a cracking model, and IMPL-EX cracked points, whose tangent
+/// comes from the committed state, repeat theirs at every iteration of an increment, and an
+/// elastic or yielded bar its E_t. An absent bar point (no row) and one of factor zero add
+/// nothing to the tangent; both are kept as 0. Layout (f64 values, [`TangentMemo::len`]):
+/// a flag (1: filled), the n_pts × 9 entries of the D's, the bars' factors, then 4 entries
+/// per wanted block (a, b) in the order a, then b.
 #[derive(Clone, Copy)]
 pub struct TangentMemo<'a> {
     cells: &'a [Cell<f64>],
     n_pts: usize,
+    n_bars: usize,
 }
 
 impl<'a> TangentMemo<'a> {
-    /// Values of the memo of an element of `n` nodes, `n_pts` points and wanted `blocks`.
-    pub fn len(n: usize, n_pts: usize, blocks: NodeBlocks) -> usize {
-        let mut wanted = 0;
-        blocks.each(n, |_, _| wanted += 1);
-        1 + 9 * n_pts + 4 * wanted
+    /// Values of the memo of an element of `n` nodes, `n_pts` points, `n_bars` embedded bar
+    /// points and wanted `blocks`.
+    pub fn len(n: usize, n_pts: usize, blocks: NodeBlocks, n_bars: usize) -> usize {
+        1 + 9 * n_pts + n_bars + 4 * blocks.count(n)
     }
 
     /// The memo in `cells` if it has the length of one for this element (else none).
-    fn of(cells: &'a [Cell<f64>], n: usize, n_pts: usize, blocks: NodeBlocks) -> Option<Self> {
-        (!cells.is_empty() && cells.len() == Self::len(n, n_pts, blocks))
-            .then_some(Self { cells, n_pts })
+    fn of(
+        cells: &'a [Cell<f64>],
+        n: usize,
+        n_pts: usize,
+        blocks: NodeBlocks,
+        n_bars: usize,
+    ) -> Option<Self> {
+        (!cells.is_empty() && cells.len() == Self::len(n, n_pts, blocks, n_bars)).then_some(Self {
+            cells,
+            n_pts,
+            n_bars,
+        })
     }
 
-    /// Whether the memo is filled and its D's have the bits of `tangents`.
-    fn holds(&self, tangents: &[[[f64; 3]; 3]]) -> bool {
-        self.cells[0].get() == 1.0
-            && tangents
-                .iter()
-                .flatten()
-                .flatten()
-                .zip(&self.cells[1..])
-                .all(|(d, c)| d.to_bits() == c.get().to_bits())
+    /// A bar's factor as kept: E_t A w, or 0 for an absent point.
+    fn factor(bar: &BarTerm) -> f64 {
+        if bar.row.is_empty() {
+            0.0
+        } else {
+            bar.stiffness
+        }
+    }
+
+    /// Whether the memo is filled and its D's and bar factors have the bits of `tangents`
+    /// and `bars`.
+    fn holds(&self, tangents: &[[[f64; 3]; 3]], bars: &[BarTerm]) -> bool {
+        if self.cells[0].get() != 1.0 {
+            return false;
+        }
+        let kept = &self.cells[1..1 + 9 * tangents.len()];
+        for (d, c) in tangents.iter().zip(kept.chunks_exact(9)) {
+            for i in 0..3 {
+                for j in 0..3 {
+                    if d[i][j].to_bits() != c[3 * i + j].get().to_bits() {
+                        return false;
+                    }
+                }
+            }
+        }
+        let kept = &self.cells[1 + 9 * self.n_pts..1 + 9 * self.n_pts + self.n_bars];
+        bars.iter()
+            .zip(kept)
+            .all(|(b, c)| Self::factor(b).to_bits() == c.get().to_bits())
     }
 
     /// Write the kept blocks into the (zeroed) element matrix `k` of `n` nodes.
     fn copy_into(&self, k: &mut [f64], n: usize, blocks: NodeBlocks) {
         let nd = 2 * n;
-        let kept = &self.cells[1 + 9 * self.n_pts..];
-        let mut i = 0;
-        blocks.each(n, |a, b| {
-            let (r0, r1) = (2 * a * nd + 2 * b, (2 * a + 1) * nd + 2 * b);
-            k[r0] = kept[i].get();
-            k[r0 + 1] = kept[i + 1].get();
-            k[r1] = kept[i + 2].get();
-            k[r1 + 1] = kept[i + 3].get();
-            i += 4;
-        });
+        let mut kept = self.cells[1 + 9 * self.n_pts + self.n_bars..].chunks_exact(4);
+        // Rows 2a and 2a + 1 of K, block by block in the order of [`NodeBlocks::each`].
+        for (a, rows) in k[..nd * nd].chunks_exact_mut(2 * nd).enumerate() {
+            let (k0, k1) = rows.split_at_mut(nd);
+            let mut row = blocks.row(a, n);
+            while row != 0 {
+                let b = row.trailing_zeros() as usize;
+                row &= row - 1;
+                let Some(c) = kept.next() else {
+                    return;
+                };
+                k0[2 * b] = c[0].get();
+                k0[2 * b + 1] = c[1].get();
+                k1[2 * b] = c[2].get();
+                k1[2 * b + 1] = c[3].get();
+            }
+        }
     }
 
-    /// Keep `tangents` and the wanted blocks of the element matrix `k` formed from them.
-    fn keep(&self, tangents: &[[[f64; 3]; 3]], k: &[f64], n: usize, blocks: NodeBlocks) {
-        let nd = 2 * n;
-        for (c, d) in self.cells[1..]
-            .iter()
-            .zip(tangents.iter().flatten().flatten())
-        {
-            c.set(*d);
+    /// Keep `tangents`, the factors of `bars` and the wanted blocks of the element matrix
+    /// `k` formed from them.
+    fn keep(
+        &self,
+        tangents: &[[[f64; 3]; 3]],
+        bars: &[BarTerm],
+        k: &[f64],
+        n: usize,
+        blocks: NodeBlocks,
+    ) {
+        let kept = &self.cells[1..1 + 9 * tangents.len()];
+        for (d, c) in tangents.iter().zip(kept.chunks_exact(9)) {
+            for i in 0..3 {
+                for j in 0..3 {
+                    c[3 * i + j].set(d[i][j]);
+                }
+            }
         }
-        let kept = &self.cells[1 + 9 * self.n_pts..];
-        let mut i = 0;
-        blocks.each(n, |a, b| {
-            let (r0, r1) = (2 * a * nd + 2 * b, (2 * a + 1) * nd + 2 * b);
-            kept[i].set(k[r0]);
-            kept[i + 1].set(k[r0 + 1]);
-            kept[i + 2].set(k[r1]);
-            kept[i + 3].set(k[r1 + 1]);
-            i += 4;
-        });
+        let start = 1 + 9 * self.n_pts;
+        for (c, b) in self.cells[start..start + self.n_bars].iter().zip(bars) {
+            c.set(Self::factor(b));
+        }
+        let nd = 2 * n;
+        let mut kept = self.cells[start + self.n_bars..].chunks_exact(4);
+        for (a, rows) in k[..nd * nd].chunks_exact(2 * nd).enumerate() {
+            let (k0, k1) = rows.split_at(nd);
+            let mut row = blocks.row(a, n);
+            while row != 0 {
+                let b = row.trailing_zeros() as usize;
+                row &= row - 1;
+                let Some(c) = kept.next() else {
+                    return;
+                };
+                c[0].set(k0[2 * b]);
+                c[1].set(k0[2 * b + 1]);
+                c[2].set(k1[2 * b]);
+                c[3].set(k1[2 * b + 1]);
+            }
+        }
         self.cells[0].set(1.0);
     }
 }
@@ -648,6 +853,20 @@ impl NodeBlocks {
     #[inline]
     pub fn has(self, a: usize, b: usize) -> bool {
         self.0 >> (9 * a + b) & 1 == 1
+    }
+
+    /// The wanted blocks (a, b) of row `a` of an element of `n` nodes: bit b.
+    #[inline]
+    pub fn row(self, a: usize, n: usize) -> u64 {
+        (self.0 >> (9 * a)) as u64 & ((1 << n) - 1)
+    }
+
+    /// The number of wanted blocks of an element of `n` nodes.
+    #[inline]
+    pub fn count(self, n: usize) -> usize {
+        (0..n)
+            .map(|a| ((self.0 >> (9 * a)) as u64 & ((1 << n) - 1)).count_ones() as usize)
+            .sum()
     }
 
     /// Call `f(a, b)` for every wanted block of an element of `n` nodes, a then b
@@ -774,6 +993,16 @@ mod tests {
     /// The element matrix of a distorted Q8 of MC90 concrete under the uniform strain
     /// εx = `ex` (nodal displacements ux = ex x), formed with the memo `memo` (empty: none).
     fn q8_matrix(ex: f64, memo: &[Cell<f64>], blocks: NodeBlocks) -> Vec<f64> {
+        q8_matrix_with(ex, memo, blocks, &[])
+    }
+
+    /// [`q8_matrix`] with embedded bar terms `bars`.
+    fn q8_matrix_with(
+        ex: f64,
+        memo: &[Cell<f64>],
+        blocks: NodeBlocks,
+        bars: &[BarTerm],
+    ) -> Vec<f64> {
         let kind = ElementKind::Q8;
         let coords: Vec<[f64; 2]> = kind
             .info()
@@ -791,9 +1020,11 @@ mod tests {
         let mut out = vec![GaussOutput::default(); geo.n_pts];
         let u: Vec<f64> = coords.iter().flat_map(|c| [ex * c[0], 0.0]).collect();
         let (mut f, mut k) = (vec![0.0; 16], vec![f64::NAN; 256]);
+        let mut packed = Vec::new();
+        geo.pack(8, &mut packed);
         small_strain(
             kind,
-            &geo,
+            &packed,
             0.25,
             &mat,
             &committed,
@@ -805,7 +1036,7 @@ mod tests {
             &TimeContext::default(),
             &[],
             blocks,
-            (memo, false),
+            (memo, false, bars),
         )
         .unwrap();
         k
@@ -825,7 +1056,7 @@ mod tests {
         }
         let blocks = NodeBlocks(bits);
         // 1 + 9 points × 9 entries of D + 36 blocks × 4.
-        let len = TangentMemo::len(8, 9, blocks);
+        let len = TangentMemo::len(8, 9, blocks, 0);
         assert_eq!(len, 1 + 81 + 144);
         let mut store = vec![0.0; len];
         let memo = Cell::from_mut(store.as_mut_slice()).as_slice_of_cells();
@@ -843,5 +1074,70 @@ mod tests {
         let cracked = q8_matrix(1e-3, &[], blocks);
         assert!(!same(&cracked, &fresh), "cracking changes the tangent");
         assert!(same(&q8_matrix(1e-3, memo, blocks), &cracked));
+    }
+
+    /// The lower triangle of node blocks of a Q8, as the assembly wants of a symmetric
+    /// matrix.
+    fn lower_q8() -> NodeBlocks {
+        let mut bits = 0u128;
+        for a in 0..8 {
+            for b in 0..=a {
+                bits |= 1 << (9 * a + b);
+            }
+        }
+        NodeBlocks(bits)
+    }
+
+    /// A bar point's terms are in the memo: the memo's tangent with a bar is the one formed
+    /// without the memo, and both differ from the concrete's alone by g (E_t A w) gᵀ on
+    /// every wanted entry (to 1e-15 of the largest entry: one addition of a value below
+    /// it); a bar whose factor changes (yield: E_t drops) takes a new tangent, an absent
+    /// one (no row) adds nothing. (With zero initial yield the compressed points flow, so
+    /// the concrete's own tangent changes between the strains too.)
+    #[test]
+    fn tangent_memo_covers_the_bars() {
+        let blocks = lower_q8();
+        let row: Vec<f64> = (0..16).map(|r| ((r as f64) * 0.7).sin() * 3.0).collect();
+        let bar = |stiffness: f64| BarTerm {
+            row: &row,
+            force: 1e5,
+            stiffness,
+        };
+        let len = TangentMemo::len(8, 9, blocks, 1);
+        assert_eq!(len, 1 + 81 + 1 + 144);
+        let mut store = vec![0.0; len];
+        let memo = Cell::from_mut(store.as_mut_slice()).as_slice_of_cells();
+        let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        for (ks, ex) in [(4e6, 2e-5), (4e6, -4e-5), (4e4, -4e-5)] {
+            let plain = q8_matrix(ex, &[], blocks);
+            let scale = plain.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let fresh = q8_matrix_with(ex, &[], blocks, &[bar(ks)]);
+            assert!(same(&q8_matrix_with(ex, memo, blocks, &[bar(ks)]), &fresh));
+            assert_eq!(store_factor(memo), ks, "the bar's factor kept");
+            blocks.each(8, |a, b| {
+                for (r, c) in [
+                    (2 * a, 2 * b),
+                    (2 * a, 2 * b + 1),
+                    (2 * a + 1, 2 * b),
+                    (2 * a + 1, 2 * b + 1),
+                ] {
+                    let added = fresh[16 * r + c] - plain[16 * r + c];
+                    let expected = row[r] * ks * row[c];
+                    assert!(
+                        (added - expected).abs() <= 1e-15 * scale,
+                        "entry ({r}, {c})"
+                    );
+                }
+            });
+        }
+        // An absent bar point: the concrete's tangent alone.
+        let absent = BarTerm::default();
+        let plain = q8_matrix(2e-5, &[], blocks);
+        assert!(same(&q8_matrix_with(2e-5, memo, blocks, &[absent]), &plain));
+    }
+
+    /// The kept factor of the first bar of a memo of a Q8 of 9 points.
+    fn store_factor(memo: &[Cell<f64>]) -> f64 {
+        memo[1 + 81].get()
     }
 }

@@ -159,17 +159,53 @@ fn law_key(p: &ConcreteParams) -> LawKey {
     ]
 }
 
+/// The [`HardeningLaw`] of a parameter set, kept with the parameters
+/// ([`ConcreteParams`]'s `law_memo`) with the key it was evaluated for: filled at the
+/// first use, read by every later one whose parameters still have that key (the fields
+/// are public, so a set adjusted after its first use is evaluated anew). A clone starts
+/// empty, since a copy is usually made to be adjusted ([`ConcreteParams::for_element`]).
+#[derive(Default)]
+pub struct LawMemo(std::sync::OnceLock<(LawKey, HardeningLaw)>);
+
+impl Clone for LawMemo {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for LawMemo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LawMemo")
+    }
+}
+
 impl HardeningLaw {
-    /// The law of `p`. Memoised per thread for the last parameter set (bit-identical
-    /// inputs give the same law): every update of an uncracked point evaluates it, and its
-    /// constants (the MC90 curve, the start of the linear post-peak branch, the initial
-    /// yield) cost a tenth of a plastic point update.
+    /// The law of `p`: from `p`'s own memo ([`LawMemo`]) when it holds the law of `p`'s
+    /// present values, else memoised per thread for the last parameter set (bit-identical
+    /// inputs give the same law) and kept in `p`'s memo if that is empty. Every update of
+    /// an uncracked or cracked point evaluates it, and its constants (the MC90 curve, the
+    /// start of the linear post-peak branch, the initial yield) cost a tenth of a plastic
+    /// point update.
+    #[inline]
     pub fn new(p: &ConcreteParams) -> Self {
+        let key = law_key(p);
+        if let Some((k, law)) = p.law_memo.0.get() {
+            if *k == key {
+                return *law;
+            }
+        }
+        let law = Self::per_thread(p, key);
+        let _ = p.law_memo.0.set((key, law));
+        law
+    }
+
+    /// The law of `p` (whose key is `key`) through the per-thread memo of the last set.
+    #[inline(never)]
+    fn per_thread(p: &ConcreteParams, key: LawKey) -> Self {
         thread_local! {
             static LAST: std::cell::RefCell<Option<(LawKey, HardeningLaw)>> =
                 const { std::cell::RefCell::new(None) };
         }
-        let key = law_key(p);
         LAST.with(|last| {
             if let Some((k, law)) = &*last.borrow() {
                 if *k == key {
@@ -358,7 +394,9 @@ struct Lu4 {
 }
 
 impl Lu4 {
-    /// Eliminate `a`; None for a (numerically) singular or non-finite pivot.
+    /// Eliminate `a`; None for a (numerically) singular or non-finite pivot. Plain index
+    /// loops of constant bounds, which the compiler unrolls.
+    #[inline(always)]
     fn new(mut a: [[f64; 4]; 4]) -> Option<Self> {
         let mut piv = [0; 4];
         let mut f = [[0.0; 4]; 4];
@@ -379,9 +417,8 @@ impl Lu4 {
             for r in c + 1..4 {
                 let fr = a[r][c] / a[c][c];
                 f[r][c] = fr;
-                let pivot_row = a[c];
-                for (ark, ack) in a[r].iter_mut().zip(pivot_row.iter()).skip(c) {
-                    *ark -= fr * ack;
+                for k in c..4 {
+                    a[r][k] -= fr * a[c][k];
                 }
             }
         }
@@ -1058,5 +1095,31 @@ mod lu4_tests {
             assert_eq!(lu.solve(rhs), fresh(a, rhs));
         }
         assert!(Lu4::new([[0.0; 4]; 4]).is_none());
+    }
+}
+
+#[cfg(test)]
+mod law_memo_tests {
+    use super::*;
+
+    /// The law kept with the parameters follows them: at ε̄ = ε_c1 the MC90 curve gives
+    /// f_cm (numerator and denominator both k_p − 1: equal to round-off, asserted 1e-12
+    /// relative) on parameters at their first use, after f_cm is changed on parameters
+    /// already used (their memo holds the old law), and on a clone changed before its
+    /// first use (a clone starts empty).
+    #[test]
+    fn kept_law_follows_its_parameters() {
+        let peak = |p: &ConcreteParams| HardeningLaw::new(p).curve(p.eps_c1).0;
+        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-12;
+        let mut p = ConcreteParams::from_mc90(38e6, 0.2);
+        assert!(close(peak(&p), 38e6));
+        assert!(p.law_memo.0.get().is_some(), "kept at its first use");
+        p.fcm = 50e6;
+        assert!(close(peak(&p), 50e6));
+        let mut q = p.clone();
+        assert!(q.law_memo.0.get().is_none(), "a clone starts empty");
+        q.fcm = 30e6;
+        assert!(close(peak(&q), 30e6));
+        assert!(close(peak(&p), 50e6));
     }
 }

@@ -251,6 +251,10 @@ pub struct ConcreteParams {
     /// time-independent concrete, the default; see [`creep`]).
     #[serde(skip)]
     pub creep: Option<creep::ConcreteCreep>,
+    /// The hardening law of these parameters, evaluated at its first use
+    /// ([`compression::HardeningLaw::new`]; a copy of the parameters starts empty).
+    #[serde(skip)]
+    pub(crate) law_memo: compression::LawMemo,
 }
 
 impl ConcreteParams {
@@ -295,6 +299,7 @@ impl ConcreteParams {
             crack_shear_limit: cracking::CrackShearLimit::None,
             principal_stress_limit: cracking::PrincipalStressLimit::None,
             creep: None,
+            law_memo: compression::LawMemo::default(),
         }
     }
 
