@@ -3,6 +3,7 @@
 //! factorisation per iteration, solve. faer's supernodal/simplicial Cholesky does the work;
 //! the LLᵀ of a large system ordered by nested dissection, and the LDLᵀ of an indefinite
 //! one, go by halves on two cores ([`super::split`]).
+// long: one solver keeps its private factor storage, analyses and statistics across the whole-matrix LLᵀ/LDLᵀ, the pair at once and the split by halves; the split's own factorisation is in split.rs
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
