@@ -717,6 +717,7 @@ pub fn update_full(
 /// Stress (σx, σy, τxy) [Pa] and tangent [Pa] of [`update_full`], its new state written
 /// into `out` (the trial slot of the point: no state is built and moved per update). On an
 /// error `out` holds no meaningful state.
+// long: the routes of a point (crushed, rotating, cracked, compression plasticity, crack formation, elastic) read as one decision; each route's own work is in its module
 pub fn update_full_into(
     p: &ConcreteParams,
     committed: &ConcreteState,
@@ -815,6 +816,11 @@ pub fn update_full_into(
             let spent = u.ebar > p.eps_c1 && h.sigma_c <= 0.0;
             if u.ebar >= p.eps_cu || spent {
                 out.crushed = true;
+                if p.compression_implex && dt == 0.0 {
+                    // Crushed at the end of the increment, as an IMPL-EX crack forms: the
+                    // extrapolated stress within it (no jump to zero at fixed strain).
+                    return Ok(implex_compression(p, committed, strain, ratio, out));
+                }
                 let r = crushed(p, out, strain);
                 return moved(out, Ok(r));
             }

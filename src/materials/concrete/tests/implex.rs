@@ -314,3 +314,39 @@ fn implex_compression_follows_the_curve_to_first_order() {
         "first order: 40 increments {coarse}, 160 increments {fine}"
     );
 }
+
+/// IMPL-EX in compression crushes a point at the end of the increment: in the increment in
+/// which its implicit state crushes it still answers with the extrapolated stress (elastic
+/// tangent), and from the next one with no stress (the crushed route).
+#[test]
+fn implex_compression_crushes_at_the_end_of_the_increment() {
+    let mut p = params();
+    p.implex = true;
+    p.compression_implex = true;
+    let d = d_matrix(p.ec, p.nu);
+    let mut st = ConcreteState::new();
+    let mut crushed_at = None;
+    for k in 1..=60 {
+        let ratio = if k == 1 { 0.0 } else { 1.0 };
+        let e = [-1e-4 * k as f64, 0.0, 0.0];
+        let (next, sig, tan) = update_extrapolated(&p, &st, &e, 0.1, ratio).unwrap();
+        if next.is_crushed() && !st.is_crushed() {
+            let ep: [f64; 3] = std::array::from_fn(|i| {
+                let c = st.plastic_strain[i];
+                c + ratio * (c - st.plastic_strain_old[i])
+            });
+            let want: f64 = (0..3).map(|j| d[0][j] * (e[j] - ep[j])).sum();
+            assert!(
+                (sig[0] - want).abs() <= 1e-9 * want.abs(),
+                "{sig:?} vs {want}"
+            );
+            assert!(sig[0] < -1e6, "still carrying compression: {sig:?}");
+            assert_eq!(tan, d);
+            crushed_at = Some(k);
+        } else if st.is_crushed() {
+            assert_eq!(sig, [0.0; 3], "increment {k} after crushing");
+        }
+        st = next;
+    }
+    assert!(crushed_at.is_some_and(|k| k < 60), "the path must crush");
+}
