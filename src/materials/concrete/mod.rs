@@ -212,11 +212,11 @@ pub struct ConcreteParams {
     #[serde(default)]
     pub implex: bool,
     /// IMPL-EX integration of the uncracked compression plasticity as well (needs
-    /// [`ConcreteParams::implex`]): within an increment a point that flowed in the last one
-    /// takes the stress of its plastic strain extrapolated from that increment, with the
-    /// elastic tangent; its state (plastic strain, hardening variable, crushing) is the
-    /// implicit return mapping's at the same strain. Load increments only (the
-    /// viscoplastic option keeps its own update). Default false (docs/theory-concrete.md
+    /// [`ConcreteParams::implex`]): within an increment an uncracked point takes the elastic
+    /// stress of its plastic strain extrapolated from the last increment's flow, with the
+    /// elastic tangent, whichever route its implicit update takes; its state (plastic strain, hardening variable, crushing) is the
+    /// implicit return mapping's at the same strain. Load increments only (not with creep,
+    /// the viscoplastic option or rotating cracks). Default false (docs/theory-concrete.md
     /// §4, "IMPL-EX in compression").
     #[serde(default)]
     pub compression_implex: bool,
@@ -758,6 +758,8 @@ pub fn update_full_into(
         return cracking::update_cracked_into(p, committed, strain, char_length, ratio, out);
     }
     let d = d_matrix(p.ec, p.nu);
+    // IMPL-EX compression on every uncracked route (load increments only).
+    let implex_c = p.compression_implex && dt == 0.0;
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let s_tr = matvec(&d, &ee);
     // σ1 once; its direction only where a crack forms (the same bits as before).
@@ -816,7 +818,7 @@ pub fn update_full_into(
             let spent = u.ebar > p.eps_c1 && h.sigma_c <= 0.0;
             if u.ebar >= p.eps_cu || spent {
                 out.crushed = true;
-                if p.compression_implex && dt == 0.0 {
+                if implex_c {
                     // Crushed at the end of the increment, as an IMPL-EX crack forms: the
                     // extrapolated stress within it (no jump to zero at fixed strain).
                     return Ok(implex_compression(p, committed, strain, ratio, out));
@@ -824,7 +826,7 @@ pub fn update_full_into(
                 let r = crushed(p, out, strain);
                 return moved(out, Ok(r));
             }
-            if p.compression_implex && dt == 0.0 {
+            if implex_c {
                 return Ok(implex_compression(p, committed, strain, ratio, out));
             }
             out.stress = u.stress;
@@ -851,7 +853,7 @@ pub fn update_full_into(
             st.crack_strain = [e_n, 0.0];
             st.strain = *strain;
             st.plastic_strain_old = committed.plastic_strain;
-            if p.compression_implex && dt == 0.0 {
+            if implex_c {
                 // The stress of the uncracked routes (no jump where the crack forms).
                 return Ok(implex_compression(p, committed, strain, ratio, st));
             }
@@ -864,7 +866,7 @@ pub fn update_full_into(
     assign(out, committed);
     out.strain = *strain;
     out.plastic_strain_old = committed.plastic_strain;
-    if p.compression_implex && dt == 0.0 {
+    if implex_c {
         // The same extrapolated stress whichever route the implicit state takes: no jump
         // where a point that flowed last increment leaves the plastic route.
         return Ok(implex_compression(p, committed, strain, ratio, out));
