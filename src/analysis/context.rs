@@ -24,6 +24,9 @@ pub(super) struct PathContext<'a, 's> {
     pub timings: &'a mut Timings,
     /// Negative pivots at the last converged increment.
     pub neg_pivots: &'a mut usize,
+    /// The IMPL-EX path error of the attempt being kept (energy norm [-], set by the
+    /// increment controller before the step reports it; None where not measured).
+    pub implex_error: Option<f64>,
 }
 
 impl PathContext<'_, '_> {

@@ -8,7 +8,7 @@
 //! force pieces ([`ArcSizing`], [`external_forces_along`]).
 
 use super::context::PathContext;
-use super::driver::{implex_retry, AnalysisError, Observer};
+use super::driver::{implex_energy_error, implex_retry, AnalysisError, Observer};
 use super::failure::NewtonFailure;
 use super::state::SystemState;
 
@@ -580,15 +580,20 @@ pub(super) fn run<S: Sizing>(
             ctl.again();
             continue;
         }
-        let implex = stepper.implex_controlled();
+        // The IMPL-EX path error is measured at every increment that would be kept (the
+        // report's "how sure"), and decides a retry where a tolerance is set.
+        let measure = stepper.implex_controlled() && ctx.sys.has_implex();
+        let mut measured = None;
         let disp = &ctx.sys.disp;
         let verdict = ctl.converged(iterations, &disp.trial, &disp.committed, |c| {
-            implex && {
+            measure && {
+                let e = implex_energy_error(&*ctx.sys, &mut *ctx.solver, &disp.trial, &f_int);
+                measured = Some(e);
                 let sizes = c.implex_sizes();
-                let energy = (&mut *ctx.solver, &disp.trial[..], &f_int[..]);
-                implex_retry(&*ctx.sys, energy, ctx.timings, sizes, c.implex_last())
+                implex_retry(&*ctx.sys, e, ctx.timings, sizes, c.implex_last())
             }
         });
+        ctx.implex_error = measured;
         match verdict {
             Verdict::Probed => {
                 // Throw the probe's state away; keep the committed state in case the

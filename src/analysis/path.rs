@@ -104,6 +104,7 @@ impl PathContext<'_, '_> {
             negative_pivots: self.solver.negative_pivots,
             arc_length_factor,
             control_force,
+            implex_error: self.implex_error,
         })?;
         self.timings.output_s += t.elapsed().as_secs_f64();
         check_stop(obs, step, increment, end_of_step)

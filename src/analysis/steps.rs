@@ -87,6 +87,7 @@ pub fn run_with(
             factors: &mut factors,
             timings: &mut timings,
             neg_pivots: &mut neg_pivots,
+            implex_error: None,
         };
         let result = if matches!(step.kind, StepKind::Displacement | StepKind::ArcLength) {
             super::path::run_step(&mut ctx, si, step, obs)
@@ -470,6 +471,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
             negative_pivots: ctx.solver.negative_pivots,
             arc_length_factor: None,
             control_force: None,
+            implex_error: ctx.implex_error,
         })?;
         ctx.timings.output_s += t.elapsed().as_secs_f64();
         check_stop(obs, si, ctl.increment, end_of_step)?;

@@ -1061,20 +1061,28 @@ impl<'m> System<'m> {
                 if !params.implex || stages.is_some_and(|s| !s.element_acts(e)) {
                     return None;
                 }
+                // Most points have no error (uncracked, or cracks on their envelope): the
+                // element's geometry only where one has.
+                let h = responses::crack_band_width(model, self.kept.geometry(), e);
+                let errors: Vec<[f64; 3]> = (self.gp_offset[e]..self.gp_offset[e + 1])
+                    .map(|gp| match (&c.points.committed[gp], &c.points.trial[gp]) {
+                        (PointState::Concrete(cs), PointState::Concrete(ts)) => {
+                            crate::materials::concrete::implex::point_stress_error(
+                                params, cs, ts, h, ratio,
+                            )
+                        }
+                        _ => [0.0; 3],
+                    })
+                    .collect();
+                if errors.iter().all(|ds| *ds == [0.0; 3]) {
+                    return None;
+                }
                 let geo = responses::element_geometry(model, self.kept.geometry(), e);
                 let thickness = model.regions[el.region].thickness;
                 let n = el.nodes.len();
                 let mut f = vec![0.0; 2 * n];
                 let mut any = false;
-                for (g, gp) in (self.gp_offset[e]..self.gp_offset[e + 1]).enumerate() {
-                    let (PointState::Concrete(cs), PointState::Concrete(ts)) =
-                        (&c.points.committed[gp], &c.points.trial[gp])
-                    else {
-                        continue;
-                    };
-                    let ds = crate::materials::concrete::implex::point_stress_error(
-                        params, cs, ts, geo.h, ratio,
-                    );
+                for (g, &ds) in errors.iter().enumerate() {
                     if ds == [0.0; 3] || g >= geo.n_pts {
                         continue;
                     }

@@ -489,6 +489,9 @@ pub struct FailureRow {
     pub end: String,
     /// The first failure met (see [`segfem::results::ultimate`]).
     pub mode: String,
+    /// The IMPL-EX path error around the peak (None without IMPL-EX concrete).
+    #[serde(skip)]
+    pub path_error: Option<segfem::results::ultimate::PathError>,
     /// Solver and assembly figures (up to the last converged increment when the run stopped early).
     pub timings: steps::Timings,
 }
@@ -602,10 +605,9 @@ pub fn seed_failure_of(text: &str, refine: usize, concrete: bool) -> Result<Fail
         .model;
     let mut obs = Reach::default();
     let (result, timings) = run_keeping_timings(&model, &mut obs);
-    let mode = obs
-        .watch
-        .finish(&model, result.is_ok())
-        .map_or_else(String::new, |u| u.mode);
+    let ultimate = obs.watch.finish(&model, result.is_ok());
+    let path_error = ultimate.as_ref().and_then(|u| u.path_error.clone());
+    let mode = ultimate.map_or_else(String::new, |u| u.mode);
     let end = match result {
         Ok(_) => {
             if obs.deflection <= -0.12 + 1e-9 {
@@ -639,6 +641,7 @@ pub fn seed_failure_of(text: &str, refine: usize, concrete: bool) -> Result<Fail
         crushed: obs.crushed,
         end,
         mode,
+        path_error,
         timings,
     })
 }

@@ -115,6 +115,15 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                     s.solve_s
                 );
                 print_line_searches(&t.line_searches);
+                if let Some(p) = &x.path_error {
+                    outln!(
+                        "{:>28} IMPL-EX path error {:.1e} at the peak ({}), largest {:.1e}",
+                        "",
+                        p.at_peak,
+                        if p.flagged() { "flagged" } else { "not flagged" },
+                        p.largest
+                    );
+                }
             }
             Err(e) => {
                 eprintln!("error: {e}");

@@ -323,6 +323,7 @@ impl<'m> Recorder<'m> {
             negative_pivots: w.negative_pivots,
             arc_length_factor: w.arc_length_factor,
             control_force: w.control_force,
+            implex_error: None,
         };
         self.write_vtu(&snap)
     }

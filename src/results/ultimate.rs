@@ -68,13 +68,64 @@ pub struct Ultimate {
     /// verdict's loads are upper bounds (`results::strength`); empty otherwise.
     #[serde(default)]
     pub upper_bound: String,
+    /// How sure the peak is: the IMPL-EX path error of the increments at the peak (None
+    /// without IMPL-EX concrete).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path_error: Option<PathError>,
 }
+
+/// The IMPL-EX path error in the energy norm ([`crate::analysis::steps::Snapshot::implex_error`],
+/// docs/theory-concrete.md §5.2 "How sure the peak is") around the peak of a run to
+/// failure (summary.json `ultimate.path_error`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PathError {
+    /// The largest error of the increments of the peak's step up to the peak whose load
+    /// measure is within [`PEAK_BAND`] of the peak [-].
+    pub at_peak: f64,
+    /// The largest error of all measured increments [-].
+    pub largest: f64,
+    /// The level above which the peak is flagged as depending on the increment size
+    /// ([`PATH_ERROR_FLAG`]) [-].
+    pub limit: f64,
+}
+
+impl PathError {
+    /// True if the peak is flagged: its increments' path error exceeds the limit.
+    pub fn flagged(&self) -> bool {
+        self.at_peak > self.limit
+    }
+
+    /// The flag in words (summary.json `warnings`, the verdict), None when not flagged.
+    pub fn warning(&self) -> Option<String> {
+        self.flagged().then(|| {
+            format!(
+                "the peak may depend on the increment size: IMPL-EX path error {:.1e} at the peak (> {:.0e}; smaller increments, or [solver] implex_force_tolerance = 3e-3 with implex_force_norm = \"energy\", bound it)",
+                self.at_peak, self.limit
+            )
+        })
+    }
+}
+
+/// Increments whose load measure is within this fraction of the peak's, up to the peak in
+/// its step, are the peak's increments for [`PathError::at_peak`] [-].
+pub const PEAK_BAND: f64 = 0.02;
+
+/// IMPL-EX path error (energy norm) at the peak above which the peak is flagged [-]. Set
+/// on the runs of docs/validation.md ("How sure the peak is"): at fixed increments the
+/// flexural runs (seed beam, RC example at 1× and 8×) have at most 4.4e-3 at their peak
+/// and peaks 0.1–2.4 % apart over a factor 8 of increments; the shear beams B1 and OA1
+/// 3.8e-3–9.1e-3 where their peaks are within 2 % of the finest run's, and 1.0e-2–1.9e-2
+/// where they are 3–24 % above it.
+pub const PATH_ERROR_FLAG: f64 = 1e-2;
 
 impl fmt::Display for Ultimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         self.verdict(f)?;
         if !self.upper_bound.is_empty() {
             write!(f, "; upper bound: {}", self.upper_bound)?;
+        }
+        if let Some(w) = self.path_error.as_ref().and_then(PathError::warning) {
+            write!(f, "; {w}")?;
         }
         Ok(())
     }
@@ -140,6 +191,8 @@ struct Row {
     /// The increment belongs to a displacement or arc-length step.
     path: bool,
     negative_pivots: usize,
+    /// The increment's IMPL-EX path error (energy norm) [-], where measured.
+    implex_error: Option<f64>,
 }
 
 /// Mode of a peak that is the first cracking of the concrete (the load falls as the first
@@ -192,6 +245,7 @@ impl UltimateWatch {
             control_force: snap.control_force,
             path: model.steps[snap.step].path.is_some(),
             negative_pivots: snap.negative_pivots,
+            implex_error: snap.implex_error,
         });
         if self.tendon_yield.is_none() {
             for (t, st) in model.tendons.iter().zip(sys.tendon_states()) {
@@ -406,6 +460,27 @@ impl UltimateWatch {
         })
     }
 
+    /// The IMPL-EX path error around the peak (row `peak` of the load measure `v`); None
+    /// where no increment measured it.
+    fn path_error(&self, v: &[f64], peak: usize) -> Option<PathError> {
+        let largest = self
+            .rows
+            .iter()
+            .filter_map(|r| r.implex_error)
+            .reduce(f64::max)?;
+        let step = self.rows[peak].step;
+        let band = (1.0 - PEAK_BAND) * v[peak];
+        let at_peak = (0..=peak)
+            .filter(|&k| self.rows[k].step == step && v[k] >= band)
+            .filter_map(|k| self.rows[k].implex_error)
+            .fold(0.0, f64::max);
+        Some(PathError {
+            at_peak,
+            largest,
+            limit: PATH_ERROR_FLAG,
+        })
+    }
+
     /// Stresses of elastic concrete past its strength, first met first; their load is the
     /// verdict's load measure in runs to failure.
     pub fn strength_findings(&self, model: &Model) -> Vec<StrengthFinding> {
@@ -483,6 +558,7 @@ impl UltimateWatch {
             _ => String::new(),
         };
         Some(Ultimate {
+            path_error: self.path_error(&v, peak),
             reached,
             upper_bound,
             mode,
@@ -636,6 +712,7 @@ mod tests {
                 control_force: Some(f),
                 path: true,
                 negative_pivots: 0,
+                implex_error: None,
             })
             .collect();
         let w = UltimateWatch {
@@ -659,6 +736,30 @@ mod tests {
             w.limit_point(&v, 2).map(|e| e.mode),
             Some("loss of equilibrium")
         );
+    }
+
+    /// The peak's path error is the largest of the increments up to the peak, in its step,
+    /// within 2 % of its load: a large error early in the path (first cracking) or after
+    /// the peak does not flag it, one in the band does; none measured gives None.
+    #[test]
+    fn the_path_error_at_the_peak_is_taken_over_the_increments_leading_to_it() {
+        let (mut w, v) = watch(&[50.0, 90.0, 98.5, 99.0, 100.0, 60.0]);
+        assert_eq!(w.path_error(&v, 4), None);
+        let errors = [0.2, 5e-3, 3e-3, 4e-3, 2e-3, 0.5];
+        for (r, e) in w.rows.iter_mut().zip(errors) {
+            r.implex_error = Some(e);
+        }
+        let p = w.path_error(&v, 4).unwrap();
+        assert_eq!((p.at_peak, p.largest), (4e-3, 0.5));
+        assert!(!p.flagged() && p.warning().is_none());
+        // 1.5e-2 at 98.5 (1.5 % below the peak): inside the band, flagged.
+        w.rows[2].implex_error = Some(1.5e-2);
+        let p = w.path_error(&v, 4).unwrap();
+        assert!(p.flagged());
+        assert!(p.warning().unwrap().contains("1.5e-2"));
+        // The same increment in another step is not the peak's.
+        w.rows[2].step = 1;
+        assert_eq!(w.path_error(&v, 4).unwrap().at_peak, 4e-3);
     }
 }
 

@@ -400,6 +400,24 @@ fn summary_section(dir: &Path) -> (String, String) {
             ),
         );
     }
+    let p = &v["ultimate"]["path_error"];
+    if let (Some(at), Some(largest), Some(limit)) = (
+        p["at_peak"].as_f64(),
+        p["largest"].as_f64(),
+        p["limit"].as_f64(),
+    ) {
+        row(
+            "IMPL-EX path error (energy norm)",
+            format!(
+                "{at:.1e} at the peak ({}: flagged above {limit:.0e}); largest {largest:.1e}",
+                if at > limit {
+                    "the peak may depend on the increment size"
+                } else {
+                    "not flagged"
+                }
+            ),
+        );
+    }
     if let Some(m) = v["peak_memory_bytes"].as_f64() {
         row("peak memory [MiB]", format!("{:.1}", m / 1048576.0));
     }
