@@ -297,6 +297,69 @@ def asd_laws(h):
     return te, ts, td, ce, cs
 
 
+def opensees_head(nodes, elems, asd_opts, h):
+    """The start of an OpenSees script of the beam or the wall: the timer, the model, the nodes
+    and the two concrete materials (1: ASDConcrete3D on the laws of `asd_laws(h)` with the
+    options `asd_opts`, e.g. "'-implex', "; 2: elastic)."""
+    te, ts, td, ce, cs = asd_laws(h)
+    E, nu = BEAM["E"], BEAM["nu"]
+    return f"""import openseespy.opensees as ops, json, math, time
+t0 = time.perf_counter()
+ops.wipe(); ops.model('basic', '-ndm', 2, '-ndf', 2)
+nodes = {nodes!r}
+elems = {elems!r}
+for k, (x, y) in enumerate(nodes):
+    ops.node(k + 1, x, y)
+ops.nDMaterial('ASDConcrete3D', 1, {E!r}, {nu!r}, '-Te', *{te!r}, '-Ts', *{ts!r}, '-Td', *{td!r},
+               '-Ce', *{ce!r}, '-Cs', *{cs!r}, {asd_opts}'-autoRegularization', {h!r})
+ops.nDMaterial('ElasticIsotropic', 2, {E!r}, {nu!r})
+"""
+
+
+def opensees_stepping(tol_n, calls):
+    """The end of an OpenSees script of the beam or the wall, after its load pattern and its
+    `record()` (the row of a converged increment): the solver, segfem's convergence test
+    (`tol_n` [N], 10 N for None), the stepping of `run(total, n)` and the result file.
+    `calls` runs the steps (e.g. "run(0.0005, 25) and run(0.0195, 120)"); the pseudo-time is
+    the control displacement's magnitude [m], in either direction."""
+    return f"""ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Transformation')
+# The same test as segfem's with --tolerance (segfem's example: 1e-4 of its force scale).
+ops.test('NormUnbalance', {10.0 if tol_n is None else tol_n!r}, 30)
+ops.algorithm('Newton')
+ops.analysis('Static')
+t1 = time.perf_counter()
+rows, iters, fails = [], 0, 0
+def run(total, n):
+    # segfem's increments; a failed increment is halved (up to 8 times, as segfem's
+    # max_cuts) and the size regrows after each success.
+    global iters, fails
+    du0 = total / n
+    done, du = 0.0, du0
+    while abs(done) < abs(total) - 1e-12:
+        du = math.copysign(min(abs(du), abs(total - done)), total)
+        ops.integrator('LoadControl', abs(du))
+        ok = ops.analyze(1)
+        iters += ops.testIter()
+        if ok != 0:
+            fails += 1
+            du /= 2
+            if abs(du) < abs(du0) / 256:
+                return False
+            continue
+        done += du
+        ops.reactions()
+        rows.append(record())
+        if abs(du) < abs(du0):
+            du *= 2
+    return True
+okk = {calls}
+t2 = time.perf_counter()
+json.dump({{'rows': rows, 'iterations': iters, 'failed_attempts': fails, 'completed': okk,
+           'increments': len(rows), 'setup_s': t1 - t0, 'analysis_s': t2 - t1}}, open('opensees_result.json', 'w'))
+print('RESULT', max(r[1] for r in rows))
+"""
+
+
 def write_beam(r, d, implex=True, stop_mm=24.0, tol_n=None):
     """The beam to 24 mm (the example), or only its first `stop_mm` <= 0.5 mm (the first
     step's 0.02 mm increments: elastic start and first cracking, where OOFEM gets to).
@@ -330,7 +393,6 @@ def write_beam(r, d, implex=True, stop_mm=24.0, tol_n=None):
     nodes, elems, idx, (nx, ny_b, ny) = beam_mesh(r)
     L = BEAM["L"]
     h = 0.05 / r
-    te, ts, td, ce, cs = asd_laws(h)
     bars = [idx[(i, 2 * r)] for i in range(2 * nx + 1)]
     stirrups = []
     for s in range(6):
@@ -340,22 +402,11 @@ def write_beam(r, d, implex=True, stop_mm=24.0, tol_n=None):
     sym = [idx[(2 * nx, j)] for j in range(2 * ny_b + 1)]
     ctrl = idx[(round(1.1 * 2 * nx / L), 2 * ny)]
     mid = idx[(2 * nx, 0)]
-    E, nu = BEAM["E"], BEAM["nu"]
     # Implicit ASDConcrete3D (-tangent: consistent tangent by perturbation) was tried first:
     # it stopped at 1.1 mm (P 59 kN, cracking, before yield) after 8 cuts.
     asd_opts = "'-implex', " if implex else "'-tangent', "
     (d / "opensees.py").write_text(
-        f"""import openseespy.opensees as ops, json, time
-t0 = time.perf_counter()
-ops.wipe(); ops.model('basic', '-ndm', 2, '-ndf', 2)
-nodes = {nodes!r}
-elems = {elems!r}
-for k, (x, y) in enumerate(nodes):
-    ops.node(k + 1, x, y)
-ops.nDMaterial('ASDConcrete3D', 1, {E!r}, {nu!r}, '-Te', *{te!r}, '-Ts', *{ts!r}, '-Td', *{td!r},
-               '-Ce', *{ce!r}, '-Cs', *{cs!r}, {asd_opts}'-autoRegularization', {h!r})
-ops.nDMaterial('ElasticIsotropic', 2, {E!r}, {nu!r})
-ops.nDMaterial('ElasticIsotropic', 3, 200e9, 0.3)
+        opensees_head(nodes, elems, asd_opts, h) + f"""ops.nDMaterial('ElasticIsotropic', 3, 200e9, 0.3)
 ops.nDMaterial('ElasticIsotropic', 4, 1e6, 0.0)
 mats = {{'concrete': 1, 'celastic': 2, 'plate': 3, 'void': 4}}
 for k, (e, reg) in enumerate(elems):
@@ -376,43 +427,10 @@ ops.fix({sup} + 1, 0, 1)
 for k in {sym!r}:
     ops.fix(k + 1, 1, 0)
 ops.timeSeries('Linear', 1); ops.pattern('Plain', 1, 1); ops.sp({ctrl} + 1, 2, -1.0)
-ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Transformation')
-# The same test as segfem's with --tolerance (segfem's example: 1e-4 of its force scale).
-ops.test('NormUnbalance', {10.0 if tol_n is None else tol_n!r}, 30)
-ops.algorithm('Newton')
-ops.analysis('Static')
-t1 = time.perf_counter()
-rows, iters, fails = [], 0, 0
-def run(total, n):
-    # The example's increments; a failed increment is halved (up to 8 times, as segfem's
-    # max_cuts) and the size regrows after each success.
-    global iters, fails
-    du0 = total / n
-    done, du = 0.0, du0
-    while abs(done) < abs(total) - 1e-12:
-        du = max(du, total - done)
-        ops.integrator('LoadControl', -du)  # pseudo-time = plate displacement [m], downwards
-        ok = ops.analyze(1)
-        iters += ops.testIter()
-        if ok != 0:
-            fails += 1
-            du /= 2
-            if abs(du) < abs(du0) / 256:
-                return False
-            continue
-        done += du
-        s = max(ops.eleResponse(e, 'axialForce')[0] for e in bottom) / 6.03e-4
-        ops.reactions()
-        rows.append((ops.nodeDisp({ctrl} + 1, 2), -ops.nodeReaction({ctrl} + 1, 2), ops.nodeDisp({mid} + 1, 2), s))
-        if abs(du) < abs(du0):
-            du *= 2
-    return True
-okk = {'run(-0.0005, 25) and run(-0.0235, 120)' if stop_mm >= 24.0 else f'run({-stop_mm / 1e3!r}, {round(stop_mm / 0.02)})'}
-t2 = time.perf_counter()
-json.dump({{'rows': rows, 'iterations': iters, 'failed_attempts': fails, 'completed': okk,
-           'increments': len(rows), 'setup_s': t1 - t0, 'analysis_s': t2 - t1}}, open('opensees_result.json', 'w'))
-print('RESULT', max(r[1] for r in rows))
-"""
+def record():
+    s = max(ops.eleResponse(e, 'axialForce')[0] for e in bottom) / 6.03e-4
+    return (ops.nodeDisp({ctrl} + 1, 2), -ops.nodeReaction({ctrl} + 1, 2), ops.nodeDisp({mid} + 1, 2), s)
+""" + opensees_stepping(tol_n, 'run(-0.0005, 25) and run(-0.0235, 120)' if stop_mm >= 24.0 else f'run({-stop_mm / 1e3!r}, {round(stop_mm / 0.02)})')
     )
     return {"segfem": d / "segfem.toml", "OpenSees": d / "opensees.py"}
 
@@ -567,7 +585,6 @@ max_cuts = 8
     )
     nodes, elems, idx, (nx, ny) = wall_mesh(r)
     L = H + WALL["top"]
-    te, ts, td, ce, cs = asd_laws(h)
     ix = lambda x: round(x * 2 * nx / L)  # noqa: E731
     jy = lambda y: round(y * 2 * ny / lw)  # noqa: E731
     trusses = []  # (node list along the bar, area)
@@ -580,19 +597,8 @@ max_cuts = 8
         trusses.append((line, a))
     base = [idx[(0, j)] for j in range(2 * ny + 1)]
     ctrl = idx[(ix(WALL_CONTROL[0]), jy(WALL_CONTROL[1]))]
-    E, nu = BEAM["E"], BEAM["nu"]
     (d / "opensees.py").write_text(
-        f"""import openseespy.opensees as ops, json, time
-t0 = time.perf_counter()
-ops.wipe(); ops.model('basic', '-ndm', 2, '-ndf', 2)
-nodes = {nodes!r}
-elems = {elems!r}
-for k, (x, y) in enumerate(nodes):
-    ops.node(k + 1, x, y)
-ops.nDMaterial('ASDConcrete3D', 1, {E!r}, {nu!r}, '-Te', *{te!r}, '-Ts', *{ts!r}, '-Td', *{td!r},
-               '-Ce', *{ce!r}, '-Cs', *{cs!r}, '-implex', '-autoRegularization', {h!r})
-ops.nDMaterial('ElasticIsotropic', 2, {E!r}, {nu!r})
-mats = {{'concrete': (1, {t!r}), 'top': (2, {WALL['t_top']!r})}}
+        opensees_head(nodes, elems, "'-implex', ", h) + f"""mats = {{'concrete': (1, {t!r}), 'top': (2, {WALL['t_top']!r})}}
 for k, (e, reg) in enumerate(elems):
     m, th = mats[reg]
     ops.element('quad8n', k + 1, *[v + 1 for v in e], th, 'PlaneStress', m)
@@ -608,42 +614,10 @@ for n, (line, a) in enumerate({trusses!r}):
 for k in {base!r}:
     ops.fix(k + 1, 1, 1)
 ops.timeSeries('Linear', 1); ops.pattern('Plain', 1, 1); ops.sp({ctrl} + 1, 2, 1.0)
-ops.system('UmfPack'); ops.numberer('RCM'); ops.constraints('Transformation')
-ops.test('NormUnbalance', {10.0 if tol_n is None else tol_n!r}, 30)
-ops.algorithm('Newton')
-ops.analysis('Static')
-t1 = time.perf_counter()
-rows, iters, fails = [], 0, 0
-def run(total, n):
-    # As the beam's: a failed increment is halved (up to 8 times), the size regrows after
-    # each success.
-    global iters, fails
-    du0 = total / n
-    done, du = 0.0, du0
-    while done < total - 1e-12:
-        du = min(du, total - done)
-        ops.integrator('LoadControl', du)  # pseudo-time = the beam's sideways displacement [m]
-        ok = ops.analyze(1)
-        iters += ops.testIter()
-        if ok != 0:
-            fails += 1
-            du /= 2
-            if du < du0 / 256:
-                return False
-            continue
-        done += du
-        s = max(ops.eleResponse(e, 'axialForce')[0] / a for e, a in edge)
-        ops.reactions()
-        rows.append((ops.nodeDisp({ctrl} + 1, 2), ops.nodeReaction({ctrl} + 1, 2), s))
-        if du < du0:
-            du *= 2
-    return True
-okk = run(0.0005, 25) and run({stop_mm / 1e3 - 0.0005!r}, 120)
-t2 = time.perf_counter()
-json.dump({{'rows': rows, 'iterations': iters, 'failed_attempts': fails, 'completed': okk,
-           'increments': len(rows), 'setup_s': t1 - t0, 'analysis_s': t2 - t1}}, open('opensees_result.json', 'w'))
-print('RESULT', max(r[1] for r in rows))
-"""
+def record():
+    s = max(ops.eleResponse(e, 'axialForce')[0] / a for e, a in edge)
+    return (ops.nodeDisp({ctrl} + 1, 2), ops.nodeReaction({ctrl} + 1, 2), s)
+""" + opensees_stepping(tol_n, f'run(0.0005, 25) and run({stop_mm / 1e3 - 0.0005!r}, 120)')
     )
     return {"segfem": d / "segfem.toml", "OpenSees": d / "opensees.py"}
 
@@ -796,6 +770,16 @@ def main():
         sys.exit(f"--modes {args.modes}: each mode is one or all")
     load0 = peers.os.getloadavg()[0]
     tol_text = "each program's own test" if tol_n is None else f"both at ||unbalance||_2 <= {tol_n:g} N, no energy test"
+    def each_mode(key, name, runners, answers):
+        """The runs of one problem in every mode of --modes, into the table and the dump."""
+        for mode in modes:
+            peers.MODE = mode
+            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, answers)
+            table.extend(lines)
+            dump[f"{key} {mode}"] = res
+            print("\n".join(lines), flush=True)
+        peers.MODE = None
+
     if "panel" in only:
         files = write_panel(args.panel_n, peers.WORK / f"nl_panel_{args.panel_n}", args.panel_crack, tol_n)
         ofiles = oofem_beam.write_panel(peers.WORK / f"nl_panel_{args.panel_n}" / "oofem", args.oofem_law)
@@ -806,13 +790,7 @@ def main():
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"PV19 panel, {args.panel_n}x{args.panel_n} Q4, {2 * (args.panel_n + 1) ** 2} dofs, {tol_text}"
-        for mode in modes:
-            peers.MODE = mode
-            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, panel_answers)
-            table += lines
-            dump[f"panel {mode}"] = res
-            print("\n".join(lines), flush=True)
-        peers.MODE = None
+        each_mode("panel", name, runners, panel_answers)
     if "beam" in only:
         files = compression(write_beam(args.refine, peers.WORK / f"nl_beam_{args.refine}", stop_mm=args.stop_mm, tol_n=tol_n))
         nodes, _, _, _ = beam_mesh(args.refine)
@@ -827,13 +805,7 @@ def main():
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"RC beam (examples/rc-beam.toml) refine {args.refine}, Q8, {2 * len(nodes)} dofs, to {args.stop_mm} mm, {tol_text}, segfem compression {args.compression}"
-        for mode in modes:
-            peers.MODE = mode
-            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, beam_answers)
-            table += lines
-            dump[f"beam {mode}"] = res
-            print("\n".join(lines), flush=True)
-        peers.MODE = None
+        each_mode("beam", name, runners, beam_answers)
     if "wall" in only:
         files = compression(write_wall(args.refine, peers.WORK / f"nl_wall_{args.refine}", tol_n=tol_n))
         nodes, _, _, _ = wall_mesh(args.refine)
@@ -843,13 +815,7 @@ def main():
         }
         runners = {p: f for p, f in runners.items() if p == "segfem" or p in progs}
         name = f"shear wall refine {args.refine}, Q8, {2 * len(nodes)} dofs, to 20 mm, {tol_text}, segfem compression {args.compression}"
-        for mode in modes:
-            peers.MODE = mode
-            lines, res = bench(f"{name} [{mode}]", runners, args.rounds, wall_answers)
-            table += lines
-            dump[f"wall {mode}"] = res
-            print("\n".join(lines), flush=True)
-        peers.MODE = None
+        each_mode("wall", name, runners, wall_answers)
     print(f"\n{peers.time.strftime('%Y-%m-%d %H:%M UTC', peers.time.gmtime())}, {peers.processor()}, "
           f"load average at the start: {load0:.2f}, at the end: {peers.os.getloadavg()[0]:.2f}")
     print("\n".join(table))

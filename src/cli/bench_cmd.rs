@@ -120,7 +120,11 @@ pub(crate) fn bench_seed_failure(refine: Vec<usize>, concrete: bool) -> ExitCode
                         "{:>28} IMPL-EX path error {:.1e} at the peak ({}), largest {:.1e}",
                         "",
                         p.at_peak,
-                        if p.flagged() { "flagged" } else { "not flagged" },
+                        if p.flagged() {
+                            "flagged"
+                        } else {
+                            "not flagged"
+                        },
                         p.largest
                     );
                 }
