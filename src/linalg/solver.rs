@@ -1660,6 +1660,80 @@ mod tests {
         assert_eq!(split.stats.factorisations, 10);
     }
 
+    /// The growth guard of LDLᵀ by halves ([`super::split::TRAILING_GROWTH`]): half 1's
+    /// border matrix B₁ = [A₁₁ A₁₃; A₃₁ A₃₃] is factorised by unpivoted LDLᵀ through its
+    /// trailing (separator) block, whose product stands in for A₃₃ − L₃₁ D₁ L₃₁ᵀ. With the
+    /// first separator column's pivot there made ε = 1e-9, the multipliers of the separator
+    /// rows coupled to it are ~1/ε, and the trailing growth max_j Σ_k M_jk² |D_k| ~1e9 is
+    /// far past its bound (1e6 × ~8, the separator's diagonal): the factorisation goes to
+    /// the whole matrix (counted in `split_ldlt_to_whole`), where that pivot is not small
+    /// (half 2 adds to it); its negative pivots are still the dense eigenvalues' count and
+    /// its solution the dense LU's. The pivot is placed by moving that column's diagonal
+    /// entry by its pivot minus ε, the pivot taken from an unpivoted dense LDLᵀ of B₁
+    /// written here (the columns before it do not depend on that entry).
+    #[test]
+    fn ldlt_by_halves_falls_back_to_the_whole_matrix_past_the_growth_guard() {
+        use faer::linalg::solvers::Solve;
+        let m = 21;
+        let n = m * m;
+        let order = grid_dissection(m);
+        let (p, mut vals) = shifted_laplacian(m, 0.37);
+        let mut split = SparseCholesky::build(&p, FACTOR_KIND, Some(&order), 0).unwrap();
+        let sp = split.split.as_ref().unwrap().split;
+        let dense = |vals: &[f64]| {
+            let mut a = faer::Mat::<f64>::zeros(n, n);
+            for j in 0..n {
+                for t in p.col_ptr[j]..p.col_ptr[j + 1] {
+                    a[(p.row_idx[t], j)] = vals[t];
+                    a[(j, p.row_idx[t])] = vals[t];
+                }
+            }
+            a
+        };
+        // B₁ in its elimination order: half 1's own columns, then the separator's.
+        let rows: Vec<usize> = order[..sp.n1]
+            .iter()
+            .chain(&order[sp.n1 + sp.n2..])
+            .copied()
+            .collect();
+        let a = dense(&vals);
+        let nb = rows.len();
+        let q = sp.n1;
+        let mut l = faer::Mat::<f64>::from_fn(nb, nb, |i, j| a[(rows[i], rows[j])]);
+        let mut d = vec![0.0; q + 1];
+        for j in 0..=q {
+            d[j] = l[(j, j)] - (0..j).map(|k| l[(j, k)] * l[(j, k)] * d[k]).sum::<f64>();
+            for i in j + 1..nb {
+                let s: f64 = (0..j).map(|k| l[(i, k)] * l[(j, k)] * d[k]).sum();
+                l[(i, j)] = (l[(i, j)] - s) / d[j];
+            }
+        }
+        let eps = 1e-9;
+        vals[p.position(rows[q], rows[q]).unwrap()] += eps - d[q];
+        let a = dense(&vals);
+        let ev = a.self_adjoint_eigenvalues(Side::Lower).unwrap();
+        let expected = ev.iter().filter(|&&v| v < 0.0).count();
+        // The count is not a matter of round-off: no eigenvalue near 0.
+        let gap = ev.iter().fold(f64::INFINITY, |g, v| g.min(v.abs()));
+        assert!(expected > 0 && gap > 1e-3, "{expected} negative, gap {gap}");
+        let negative = split.factorize_indefinite(&p, &vals).unwrap();
+        assert_eq!(split.stats.split_ldlt_to_whole, 1, "the guard did not act");
+        assert_eq!(negative, expected);
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        let mut x = b.clone();
+        split.solve_in_place(&mut x);
+        let y = a
+            .partial_piv_lu()
+            .solve(faer::Mat::<f64>::from_fn(n, 1, |i, _| b[i]));
+        let norm = (0..n).fold(0.0_f64, |s, i| s.max(y[(i, 0)].abs()));
+        let diff = (0..n).fold(0.0_f64, |s, i| s.max((x[i] - y[(i, 0)]).abs()));
+        // Two solves of a matrix of condition κ = max|λ| / min|λ| agree to ~κ·1e-16 of
+        // the solution; 1e-15·κ leaves a factor 4 for the unpivoted LDLᵀ's growth, as in
+        // `ldlt_by_halves_inertia_and_solution`.
+        let kappa = ev.iter().fold(0.0_f64, |s, v| s.max(v.abs())) / gap;
+        assert!(diff <= 1e-15 * kappa * norm, "{diff} of {norm}, κ {kappa}");
+    }
+
     /// LDLᵀ by halves of a singular matrix (a zero row and column) in half 1, half 2 or
     /// the separator: [`SolverError::Singular`], as the whole matrix's LDLᵀ says; the
     /// separator's zero row makes both halves' trailing blocks singular, which goes to the

@@ -790,7 +790,7 @@ impl Half {
                 for j in k..s {
                     let q = j + k * s;
                     self.md[q] = self.m33[q] * dk;
-                    g[j] += self.m33[q] * self.md[q].abs();
+                    g[j] += (self.m33[q] * self.md[q]).abs();
                 }
             }
             let growth = g.iter().fold(0.0_f64, |a, &v| a.max(v));
