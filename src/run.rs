@@ -620,12 +620,7 @@ pub fn run_file_opts(
         !matches!(error, Some(AnalysisError::NotConverged(_))) && failures.is_empty(),
     );
     let strength_exceeded = watch.strength_findings(&model);
-    warnings.extend(ultimate.iter().flat_map(|u| u.unfinished.iter().cloned()));
-    warnings.extend(
-        (ultimate.iter())
-            .filter_map(|u| u.path_error.as_ref())
-            .filter_map(|p| p.warning()),
-    );
+    warnings.extend(ultimate.iter().flat_map(|u| u.warnings()));
     warnings.extend(strength_exceeded.iter().map(|f| f.text.clone()));
     warnings.extend(sustained);
     if error.is_some() || !failures.is_empty() {

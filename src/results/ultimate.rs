@@ -132,6 +132,13 @@ impl fmt::Display for Ultimate {
 }
 
 impl Ultimate {
+    /// The verdict's warnings (summary.json `warnings`): the arc-length steps that used up
+    /// their increments, and the path error's flag.
+    pub fn warnings(&self) -> impl Iterator<Item = String> + '_ {
+        (self.unfinished.iter().cloned())
+            .chain(self.path_error.as_ref().and_then(PathError::warning))
+    }
+
     /// The verdict without its upper-bound note.
     fn verdict(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let value = |v: f64| {
