@@ -214,8 +214,10 @@ pub struct ConcreteParams {
     /// IMPL-EX integration of the uncracked compression plasticity as well (needs
     /// [`ConcreteParams::implex`]): within an increment an uncracked point takes the elastic
     /// stress of its plastic strain extrapolated from the last increment's flow, with the
-    /// elastic tangent, whichever route its implicit update takes; its state (plastic strain, hardening variable, crushing) is the
-    /// implicit return mapping's at the same strain. Load increments only (not with creep,
+    /// elastic tangent, whichever route its implicit update takes, and a cracked point's
+    /// crack-axis directions the elastic stress of their 1-D compressive plastic strain
+    /// extrapolated the same way (tangent E); the state (plastic strains, hardening
+    /// variables, crushing) is the implicit laws' at the same strain. Load increments only (not with creep,
     /// the viscoplastic option or rotating cracks). Default false (docs/theory-concrete.md
     /// §4, "IMPL-EX in compression").
     #[serde(default)]
