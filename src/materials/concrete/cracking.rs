@@ -442,7 +442,7 @@ pub fn update_cracked(
 /// E (e + p̃) in compression (tangent E, no softening and no lateral-strain term), the
 /// tension law (IMPL-EX crack or elastic) at e + p̃ otherwise; and a point whose implicit
 /// state crushes is crushed at the end of the increment, answering with that stress in it.
-// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit, shear cap) read as one table of cases against docs/theory-concrete.md
+// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit cracks and compression, shear cap) read as one table of cases against docs/theory-concrete.md
 pub fn update_cracked_into(
     p: &ConcreteParams,
     committed: &ConcreteState,
