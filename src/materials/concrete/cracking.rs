@@ -390,7 +390,7 @@ fn direction(
 /// IMPL-EX compressive plastic strain of crack-axis direction `i` [-] (magnitude) for an
 /// increment with extrapolation ratio `ratio` [-]: p̃ = p_n + r (p_n − p_n−1) from the last
 /// two committed states, never backwards.
-pub(super) fn implex_plastic(committed: &ConcreteState, i: usize, ratio: f64) -> f64 {
+fn implex_plastic(committed: &ConcreteState, i: usize, ratio: f64) -> f64 {
     let (pn, po) = (committed.dir_plastic[i], committed.dir_plastic_old[i]);
     pn + ratio.max(0.0) * (pn - po).max(0.0)
 }
