@@ -30,8 +30,9 @@ const MAGIC: &str = "segfem checkpoint";
 /// construction stage reached (staged models restart) and the recorder's joint openings; 10:
 /// the one-way supports' contact points and statuses, and the recorder's lifted points per
 /// row; 11: the concrete points' plastic strain before the committed one (IMPL-EX in
-/// compression).
-const VERSION: u32 = 11;
+/// compression); 12: the crack-axis directions' compressive plastic strains before the
+/// committed ones (IMPL-EX compression of cracked points).
+const VERSION: u32 = 12;
 /// Bytes of the trailing checksum.
 const CHECKSUM_BYTES: usize = 8;
 
@@ -50,6 +51,7 @@ const LAYOUTS: &[(u32, u64)] = &[
     (9, 7_976_921_271_131_270_574),
     (10, 5_454_227_443_183_593_876),
     (11, 3_136_055_901_800_596_340),
+    (12, 4_395_502_844_849_288_628),
 ];
 
 #[derive(Serialize, Deserialize)]

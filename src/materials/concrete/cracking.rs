@@ -387,28 +387,69 @@ fn direction(
     r
 }
 
-/// Stress update of a cracked point (`committed.n_cracks` ≥ 1).
+/// IMPL-EX compressive plastic strain of crack-axis direction `i` [-] (magnitude) for an
+/// increment with extrapolation ratio `ratio` [-]: p̃ = p_n + r (p_n − p_n−1) from the last
+/// two committed states, never backwards.
+fn implex_plastic(committed: &ConcreteState, i: usize, ratio: f64) -> f64 {
+    let (pn, po) = (committed.dir_plastic[i], committed.dir_plastic_old[i]);
+    pn + ratio.max(0.0) * (pn - po).max(0.0)
+}
+
+/// Stress [Pa] and tangent [Pa] of a crack-axis direction within an IMPL-EX-compression
+/// increment, at strain `e` [-] with the extrapolated compressive plastic strain `pt` [-]
+/// ([`implex_plastic`]): with x = e + pt, E x in compression (x < 0), else the direction's
+/// tension law at x (the IMPL-EX crack law, or E x for an uncracked direction). Linear in
+/// compression, continuous at x = 0 (both sides give 0) and its tangent positive.
+fn implex_direction(
+    p: &ConcreteParams,
+    law: &compression::HardeningLaw,
+    alpha: f64,
+    h: DirHistory,
+    pt: f64,
+    e: f64,
+) -> (f64, f64) {
+    let x = e + pt;
+    if x < 0.0 {
+        return (p.ec * x, p.ec);
+    }
+    // The tension side of `direction` at elastic strain x: its plastic strain is pt.
+    let r = direction(p, law, alpha, DirHistory { plastic: pt, ..h }, e);
+    (r.sigma, r.k)
+}
+
+/// Stress update of a cracked point (`committed.n_cracks` ≥ 1); `implex_c`: IMPL-EX
+/// compression in the crack-axis directions (see [`update_cracked_into`]).
 pub fn update_cracked(
     p: &ConcreteParams,
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
     ratio: f64,
+    implex_c: bool,
 ) -> UpdateResult {
     let mut st = committed.clone();
-    let (s, d) = update_cracked_into(p, committed, strain, char_length, ratio, &mut st)?;
+    let (s, d) = update_cracked_into(p, committed, strain, char_length, ratio, implex_c, &mut st)?;
     Ok((st, s, d))
 }
 
 /// [`update_cracked`] with the new state written into `out` (left as it was on an error):
 /// the element loop's trial slot, without a state built and moved twice.
-// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit, shear cap) read as one table of cases against docs/theory-concrete.md
+///
+/// `implex_c` (`compression_integration = "implex"`, docs/theory-concrete.md §4): the state
+/// is the implicit laws' as without it, but within the increment each crack-axis direction
+/// answers with its law at the elastic strain e + p̃ of its compressive plastic strain
+/// extrapolated from the last increment, p̃ = p_n + r (p_n − p_n−1) ([`implex_direction`]):
+/// E (e + p̃) in compression (tangent E, no softening and no lateral-strain term), the
+/// tension law (IMPL-EX crack or elastic) at e + p̃ otherwise; and a point whose implicit
+/// state crushes is crushed at the end of the increment, answering with that stress in it.
+// long: the cracked point's stress and tangent per crack state (one/two cracks, IMPL-EX or implicit cracks and compression, shear cap) read as one table of cases against docs/theory-concrete.md
 pub fn update_cracked_into(
     p: &ConcreteParams,
     committed: &ConcreteState,
     strain: &[f64; 3],
     char_length: f64,
     ratio: f64,
+    implex_c: bool,
     out: &mut ConcreteState,
 ) -> Result<([f64; 3], [[f64; 3]; 3]), MaterialError> {
     if matches!(p.tension, super::TensionSoftening::CrackBand { .. })
@@ -433,9 +474,9 @@ pub fn update_cracked_into(
         super::reduction::factor(p, lateral(1), char_length),
         super::reduction::factor(p, lateral(0), char_length),
     ];
-    let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
+    let history = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
         let cracked = (i as u8) < n_cracks;
-        let h = DirHistory {
+        DirHistory {
             cracked,
             emax: crack_max[i],
             ebar: committed.dir_ebar[i],
@@ -443,8 +484,10 @@ pub fn update_cracked_into(
             frozen: committed.frozen[i],
             extrapolated: (p.implex && cracked).then(|| extrapolate(i)),
             reduction: red[i],
-        };
-        direction(p, &law, alpha, h, el[i])
+        }
+    };
+    let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
+        direction(p, &law, alpha, history(i, n_cracks, crack_max), el[i])
     };
     let r0 = eval(0, n_cracks, &crack_max);
     let mut r1 = eval(1, n_cracks, &crack_max);
@@ -469,13 +512,28 @@ pub fn update_cracked_into(
     st.crack_strain = [r0.e_el, if n_cracks >= 2 { r1.e_el } else { 0.0 }];
     st.dir_ebar = [r0.ebar, r1.ebar];
     st.dir_plastic = [r0.plastic, r1.plastic];
+    st.dir_plastic_old = committed.dir_plastic;
     st.crack_max_old = committed.crack_max;
     st.cutoff_max_old = committed.cutoff_max;
     if formed_second {
         st.crack_max_old[1] = st.crack_max[1];
     }
+    // IMPL-EX compression: each direction's stress and tangent in the increment at the
+    // committed crack state (a crack formed in it is elastic in it), with the lateral
+    // strain's term gone (the reduction acts through the implicit state only).
+    let (mut r0, mut r1) = (r0, r1);
+    if implex_c {
+        for (i, r) in [&mut r0, &mut r1].into_iter().enumerate() {
+            let h = history(i, committed.n_cracks, &committed.crack_max);
+            let pt = implex_plastic(committed, i, ratio);
+            (r.sigma, r.k) = implex_direction(p, &law, alpha, h, pt, el[i]);
+            r.d_lateral = 0.0;
+        }
+    }
     if r0.ebar >= r0.beta * p.eps_cu || r1.ebar >= r1.beta * p.eps_cu {
         st.crushed = true;
+    }
+    if st.crushed && !implex_c {
         st.stress = [0.0; 3];
         let d = super::d_matrix(p.ec, p.nu).map(|r| r.map(|v| v * p.residual_stiffness));
         return Ok(([0.0; 3], d));

@@ -214,8 +214,10 @@ pub struct ConcreteParams {
     /// IMPL-EX integration of the uncracked compression plasticity as well (needs
     /// [`ConcreteParams::implex`]): within an increment an uncracked point takes the elastic
     /// stress of its plastic strain extrapolated from the last increment's flow, with the
-    /// elastic tangent, whichever route its implicit update takes; its state (plastic strain, hardening variable, crushing) is the
-    /// implicit return mapping's at the same strain. Load increments only (not with creep,
+    /// elastic tangent, whichever route its implicit update takes, and a cracked point's
+    /// crack-axis directions the elastic stress of their 1-D compressive plastic strain
+    /// extrapolated the same way (tangent E); the state (plastic strains, hardening
+    /// variables, crushing) is the implicit laws' at the same strain. Load increments only (not with creep,
     /// the viscoplastic option or rotating cracks). Default false (docs/theory-concrete.md
     /// §4, "IMPL-EX in compression").
     #[serde(default)]
@@ -509,6 +511,11 @@ pub struct ConcreteState {
     pub(crate) crack_strain: [f64; 2],
     pub(crate) dir_ebar: [f64; 2],
     pub(crate) dir_plastic: [f64; 2],
+    /// `dir_plastic` of the state before the committed one [-] (IMPL-EX compression of the
+    /// crack-axis directions: the last increment's compressive plastic flow is
+    /// `dir_plastic` minus this).
+    #[serde(default)]
+    pub(crate) dir_plastic_old: [f64; 2],
     pub(crate) crushed: bool,
     /// Crack branch held for the rest of an increment, per crack direction: 0 free,
     /// 1 on the loading envelope, −1 on the unloading secant (see
@@ -561,6 +568,7 @@ impl ConcreteState {
             crack_strain: [0.0; 2],
             dir_ebar: [0.0; 2],
             dir_plastic: [0.0; 2],
+            dir_plastic_old: [0.0; 2],
             crushed: false,
             frozen: [0; 2],
             crack_max_old: [0.0; 2],
@@ -754,12 +762,21 @@ pub fn update_full_into(
             rotating::update(p, committed, strain, char_length, ratio),
         );
     }
+    // IMPL-EX compression on every uncracked route and in the crack-axis directions of
+    // cracked points (load increments only).
+    let implex_c = p.compression_implex && dt == 0.0;
     if committed.n_cracks > 0 {
-        return cracking::update_cracked_into(p, committed, strain, char_length, ratio, out);
+        return cracking::update_cracked_into(
+            p,
+            committed,
+            strain,
+            char_length,
+            ratio,
+            implex_c,
+            out,
+        );
     }
     let d = d_matrix(p.ec, p.nu);
-    // IMPL-EX compression on every uncracked route (load increments only).
-    let implex_c = p.compression_implex && dt == 0.0;
     let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
     let s_tr = matvec(&d, &ee);
     // σ1 once; its direction only where a crack forms (the same bits as before).
@@ -843,6 +860,7 @@ pub fn update_full_into(
         st.crack_max = [0.0; 2];
         st.dir_ebar = [ebar_n; 2];
         st.dir_plastic = [0.0; 2];
+        st.dir_plastic_old = [0.0; 2];
         if p.implex {
             // Explicit formation: the stress stays elastic in this increment; the crack
             // carries its strain at formation as e_max with zero rate.
@@ -860,7 +878,7 @@ pub fn update_full_into(
             st.stress = s_tr;
             return Ok((s_tr, d));
         }
-        let r = cracking::update_cracked(p, out, strain, char_length, ratio);
+        let r = cracking::update_cracked(p, out, strain, char_length, ratio, implex_c);
         return moved(out, r);
     }
     assign(out, committed);
@@ -913,6 +931,7 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
         crack_strain,
         dir_ebar,
         dir_plastic,
+        dir_plastic_old,
         crushed,
         frozen,
         crack_max_old,
@@ -933,6 +952,7 @@ fn assign(out: &mut ConcreteState, c: &ConcreteState) {
     out.crack_strain = *crack_strain;
     out.dir_ebar = *dir_ebar;
     out.dir_plastic = *dir_plastic;
+    out.dir_plastic_old = *dir_plastic_old;
     out.crushed = *crushed;
     out.frozen = *frozen;
     out.crack_max_old = *crack_max_old;
