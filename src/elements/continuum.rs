@@ -106,6 +106,35 @@ pub struct BarTerm<'a> {
     pub stiffness: f64,
 }
 
+/// One element's pass over its material points: what the points are updated with and
+/// where the answer goes; the arguments the small-strain, total Lagrangian and
+/// incompatible-mode responses share.
+pub struct PointsPass<'c, 'o> {
+    /// Thickness [m].
+    pub thickness: f64,
+    /// Material of every point.
+    pub mat: &'c Material,
+    /// Committed point states.
+    pub committed: &'c [PointState],
+    /// The element's nodal displacements (ux, uy per node) [m].
+    pub u: &'c [f64],
+    /// Internal force (2n) [N], written.
+    pub f: &'o mut [f64],
+    /// Row-major tangent (2n × 2n) [N/m], formed only when given.
+    pub k: Option<&'o mut [f64]>,
+    /// Trial point states, written.
+    pub trial: &'o mut [PointState],
+    /// Gauss outputs, written.
+    pub out: &'o mut [GaussOutput],
+    /// Time increment of the analysis clock [d].
+    pub time: &'c TimeContext,
+    /// Imposed (stress-free) normal strain θ [-] of each Gauss point (empty: none).
+    pub imposed: &'c [f64],
+    /// The node blocks of the tangent to form ([`NodeBlocks::ALL`]: all; the
+    /// incompatible-mode element forms all).
+    pub blocks: NodeBlocks,
+}
+
 impl super::ElementResponse for ContinuumElement<'_> {
     type Committed = [PointState];
     /// The points' trial states and Gauss outputs.
@@ -127,16 +156,19 @@ impl super::ElementResponse for ContinuumElement<'_> {
             Formulation::IncompatibleModes => {
                 super::incompatible::response_at(
                     c,
-                    t,
-                    m,
-                    committed,
-                    u,
-                    f,
-                    k,
-                    trial,
-                    out,
-                    self.time,
-                    self.imposed,
+                    PointsPass {
+                        thickness: t,
+                        mat: m,
+                        committed,
+                        u,
+                        f,
+                        k,
+                        trial,
+                        out,
+                        time: self.time,
+                        imposed: self.imposed,
+                        blocks: NodeBlocks::ALL,
+                    },
                 )?;
                 return Ok(true);
             }
@@ -156,17 +188,19 @@ impl super::ElementResponse for ContinuumElement<'_> {
             super::total_lagrangian::response_tl(
                 kind,
                 &computed,
-                t,
-                m,
-                committed,
-                u,
-                f,
-                k,
-                trial,
-                out,
-                self.time,
-                self.imposed,
-                self.blocks,
+                PointsPass {
+                    thickness: t,
+                    mat: m,
+                    committed,
+                    u,
+                    f,
+                    k,
+                    trial,
+                    out,
+                    time: self.time,
+                    imposed: self.imposed,
+                    blocks: self.blocks,
+                },
             )?;
         } else {
             let mut buf = [0.0; PACKED_MAX];
@@ -181,17 +215,19 @@ impl super::ElementResponse for ContinuumElement<'_> {
             small_strain(
                 kind,
                 packed,
-                t,
-                m,
-                committed,
-                u,
-                f,
-                k,
-                trial,
-                out,
-                self.time,
-                self.imposed,
-                self.blocks,
+                PointsPass {
+                    thickness: t,
+                    mat: m,
+                    committed,
+                    u,
+                    f,
+                    k,
+                    trial,
+                    out,
+                    time: self.time,
+                    imposed: self.imposed,
+                    blocks: self.blocks,
+                },
                 (self.memo, self.localised, self.bars),
             )?;
         }
@@ -329,32 +365,37 @@ pub fn response_with_time(
         debug_assert!(kind.info().incompatible_modes, "checked at input");
         return super::incompatible::response_at(
             coords,
-            thickness,
-            mat,
-            committed,
-            u,
-            f,
-            Some(k),
-            trial,
-            out,
-            time,
-            &[],
+            PointsPass {
+                thickness,
+                mat,
+                committed,
+                u,
+                f,
+                k: Some(k),
+                trial,
+                out,
+                time,
+                imposed: &[],
+                blocks: NodeBlocks::ALL,
+            },
         );
     }
     response_at(
         kind,
         &gauss_geometry(kind, integration, coords),
-        thickness,
-        mat,
-        committed,
-        u,
-        f,
-        Some(k),
-        trial,
-        out,
-        time,
-        &[],
-        NodeBlocks::ALL,
+        PointsPass {
+            thickness,
+            mat,
+            committed,
+            u,
+            f,
+            k: Some(k),
+            trial,
+            out,
+            time,
+            imposed: &[],
+            blocks: NodeBlocks::ALL,
+        },
     )
 }
 
@@ -452,40 +493,14 @@ pub fn gauss_geometry(
 /// holds the stress-free normal strain θ of each Gauss point (empty: none): the material
 /// sees ε − θ (1, 1, 0), the output keeps the total strain ε. Only the node blocks `blocks`
 /// of the tangent are formed (the others are zero; [`NodeBlocks::ALL`]: all).
-#[allow(clippy::too_many_arguments)]
 pub fn response_at(
     kind: ElementKind,
     geometry: &GaussGeometry,
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-    blocks: NodeBlocks,
+    pass: PointsPass<'_, '_>,
 ) -> Result<(), UpdateError> {
     let mut buf = [0.0; PACKED_MAX];
     let len = geometry.pack_into(kind.n_nodes(), &mut buf);
-    small_strain(
-        kind,
-        &buf[..len],
-        thickness,
-        mat,
-        committed,
-        u,
-        f,
-        k,
-        trial,
-        out,
-        time,
-        imposed,
-        blocks,
-        (&[], false, &[]),
-    )
+    small_strain(kind, &buf[..len], pass, (&[], false, &[]))
 }
 
 /// [`response_at`] with the Gauss geometry `packed` ([`GaussGeometry::pack`], read in
@@ -494,21 +509,10 @@ pub fn response_at(
 /// function of the same values), else it is formed and kept there. Dispatches on the
 /// kind's node count and the rule's point count, so that the loops over nodes and points
 /// have fixed trip counts ([`small_strain_fixed`]).
-#[allow(clippy::too_many_arguments)]
 fn small_strain(
     kind: ElementKind,
     packed: &[f64],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-    blocks: NodeBlocks,
+    pass: PointsPass<'_, '_>,
     memo: (&[Cell<f64>], bool, &[BarTerm]),
 ) -> Result<(), UpdateError> {
     let n = kind.n_nodes();
@@ -516,9 +520,7 @@ fn small_strain(
     debug_assert_eq!(packed.len(), n_pts * (2 * n + 1) + 1, "packed geometry");
     macro_rules! fixed {
         ($n:literal, $p:literal) => {
-            small_strain_fixed::<$n, $p>(
-                packed, thickness, mat, committed, u, f, k, trial, out, time, imposed, blocks, memo,
-            )
+            small_strain_fixed::<$n, $p>(packed, pass, memo)
         };
     }
     match (n, n_pts) {
@@ -529,56 +531,42 @@ fn small_strain(
         (9, 4) => fixed!(9, 4),
         (6, 3) => fixed!(6, 3),
         // Every kind and rule is above; any other pair would take this general path.
-        _ => small_strain_any(
-            n, n_pts, packed, thickness, mat, committed, u, f, k, trial, out, time, imposed,
-            blocks, memo,
-        ),
+        _ => small_strain_any(n, n_pts, packed, pass, memo),
     }
 }
 
 /// [`small_strain`] for `N` nodes and `P` points (fixed trip counts).
-#[allow(clippy::too_many_arguments)]
 fn small_strain_fixed<const N: usize, const P: usize>(
     packed: &[f64],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-    blocks: NodeBlocks,
+    pass: PointsPass<'_, '_>,
     memo: (&[Cell<f64>], bool, &[BarTerm]),
 ) -> Result<(), UpdateError> {
-    small_strain_any(
-        N, P, packed, thickness, mat, committed, u, f, k, trial, out, time, imposed, blocks, memo,
-    )
+    small_strain_any(N, P, packed, pass, memo)
 }
 
 /// [`small_strain`] for `n` nodes and `n_pts` points; inlined into [`small_strain_fixed`]
 /// with constant `n` and `n_pts`.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn small_strain_any(
     n: usize,
     n_pts: usize,
     packed: &[f64],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    mut k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-    blocks: NodeBlocks,
+    pass: PointsPass<'_, '_>,
     (memo, localised, bars): (&[Cell<f64>], bool, &[BarTerm]),
 ) -> Result<(), UpdateError> {
+    let PointsPass {
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        mut k,
+        trial,
+        out,
+        time,
+        imposed,
+        blocks,
+    } = pass;
     let nd = 2 * n;
     // One point's values: (∂N/∂x, ∂N/∂y) of every node, then w·det J.
     let s = nd + 1;
@@ -1025,17 +1013,19 @@ mod tests {
         small_strain(
             kind,
             &packed,
-            0.25,
-            &mat,
-            &committed,
-            &u,
-            &mut f,
-            Some(&mut k),
-            &mut trial,
-            &mut out,
-            &TimeContext::default(),
-            &[],
-            blocks,
+            PointsPass {
+                thickness: 0.25,
+                mat: &mat,
+                committed: &committed,
+                u: &u,
+                f: &mut f,
+                k: Some(&mut k),
+                trial: &mut trial,
+                out: &mut out,
+                time: &TimeContext::default(),
+                imposed: &[],
+                blocks,
+            },
             (memo, false, bars),
         )
         .unwrap();

@@ -14,9 +14,11 @@
 //! states is stored and a cut step retries cleanly. The element then returns
 //! f = ∫ Bᵀ σ t dA and the condensed tangent K = K_uu − K_uα K_αα⁻¹ K_αu.
 
-use super::continuum::{gauss_geometry, rule_points, GaussGeometry, GaussOutput, Integration};
+use super::continuum::{
+    gauss_geometry, rule_points, GaussGeometry, GaussOutput, Integration, PointsPass,
+};
 use crate::fem::shape::{jacobian, MAX_NODES};
-use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
+use crate::materials::point::{update_into, PointState, UpdateError};
 use crate::model::ElementKind;
 
 /// Local Newton iterations allowed for α.
@@ -115,21 +117,21 @@ fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
 
 /// Force and condensed tangent of a Q4 with incompatible modes; arguments as
 /// [`super::continuum::response_at`].
-#[allow(clippy::too_many_arguments)]
 // long: the local Newton on the modes α and the static condensation share the per-point stresses and tangents it fills; split, they would pass them all
-pub fn response_at(
-    coords: &[[f64; 2]],
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-) -> Result<(), UpdateError> {
+pub fn response_at(coords: &[[f64; 2]], pass: PointsPass<'_, '_>) -> Result<(), UpdateError> {
+    let PointsPass {
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        k,
+        trial,
+        out,
+        time,
+        imposed,
+        blocks: _,
+    } = pass;
     let pts = rule_points(ElementKind::Q4, Integration::Full);
     let GaussGeometry {
         n_pts,
@@ -283,6 +285,8 @@ pub fn response_at(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::elements::continuum::NodeBlocks;
+    use crate::materials::point::{Material, TimeContext};
 
     fn elastic() -> Material {
         Material::Elastic {
@@ -303,16 +307,19 @@ mod tests {
         let (mut f, mut k) = ([0.0; 8], [0.0; 64]);
         response_at(
             coords,
-            0.25,
-            &mat,
-            &committed,
-            u,
-            &mut f,
-            Some(&mut k),
-            &mut trial,
-            &mut out,
-            &TimeContext::default(),
-            &[],
+            PointsPass {
+                thickness: 0.25,
+                mat: &mat,
+                committed: &committed,
+                u,
+                f: &mut f,
+                k: Some(&mut k),
+                trial: &mut trial,
+                out: &mut out,
+                time: &TimeContext::default(),
+                imposed: &[],
+                blocks: NodeBlocks::ALL,
+            },
         )
         .unwrap();
         (f, k, out)

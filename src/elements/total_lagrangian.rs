@@ -14,8 +14,8 @@
 //! - f = ∫ B_Lᵀ S t dA₀; K = ∫ B_Lᵀ D B_L t dA₀ + ∫ (∇N_aᵀ Ŝ ∇N_b) I₂ t dA₀ (the
 //!   initial-stress matrix), areas and thickness of the undeformed element.
 
-use super::continuum::{GaussOutput, NodeBlocks};
-use crate::materials::point::{update_into, Material, PointState, TimeContext, UpdateError};
+use super::continuum::{GaussOutput, PointsPass};
+use crate::materials::point::{update_into, UpdateError};
 use crate::model::ElementKind;
 
 /// Green–Lagrange strain (E₁₁, E₂₂, 2E₁₂) [-] of a displacement gradient
@@ -48,22 +48,24 @@ pub fn displacement_gradient(dn: &[[f64; 2]], u: &[f64], n: usize) -> [[f64; 2];
 /// `f` [N] and (if `k` is given) tangent `k` [N/m] at the nodal displacements `u` [m]; the
 /// Gauss outputs hold E [-] and S [Pa]. Only the node blocks `blocks` of the tangent are
 /// formed (the others are zero; see [`NodeBlocks`]).
-#[allow(clippy::too_many_arguments)]
 pub fn response_tl(
     kind: ElementKind,
     geometry: &super::continuum::GaussGeometry,
-    thickness: f64,
-    mat: &Material,
-    committed: &[PointState],
-    u: &[f64],
-    f: &mut [f64],
-    mut k: Option<&mut [f64]>,
-    trial: &mut [PointState],
-    out: &mut [GaussOutput],
-    time: &TimeContext,
-    imposed: &[f64],
-    blocks: NodeBlocks,
+    pass: PointsPass<'_, '_>,
 ) -> Result<(), UpdateError> {
+    let PointsPass {
+        thickness,
+        mat,
+        committed,
+        u,
+        f,
+        mut k,
+        trial,
+        out,
+        time,
+        imposed,
+        blocks,
+    } = pass;
     let n = kind.n_nodes();
     let nd = 2 * n;
     f[..nd].iter_mut().for_each(|v| *v = 0.0);
@@ -175,7 +177,10 @@ pub fn response_tl(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elements::continuum::{gauss_geometry, response_at, rule_points, Integration};
+    use crate::elements::continuum::{
+        gauss_geometry, response_at, rule_points, Integration, NodeBlocks,
+    };
+    use crate::materials::point::{Material, PointState, TimeContext};
 
     const KINDS: [ElementKind; 4] = crate::fem::kinds::ALL;
 
@@ -227,17 +232,19 @@ mod tests {
         response_tl(
             kind,
             &gauss_geometry(kind, Integration::Full, &c),
-            0.3,
-            &mat,
-            &committed,
-            u,
-            &mut f,
-            tangent.then_some(&mut k[..]),
-            &mut trial,
-            &mut out,
-            &TimeContext::default(),
-            &[],
-            NodeBlocks::ALL,
+            PointsPass {
+                thickness: 0.3,
+                mat: &mat,
+                committed: &committed,
+                u,
+                f: &mut f,
+                k: tangent.then_some(&mut k[..]),
+                trial: &mut trial,
+                out: &mut out,
+                time: &TimeContext::default(),
+                imposed: &[],
+                blocks: NodeBlocks::ALL,
+            },
         )
         .unwrap();
         (f, k, out)
@@ -280,17 +287,19 @@ mod tests {
                     respond(
                         kind,
                         &gauss_geometry(kind, Integration::Full, &c),
-                        0.3,
-                        &elastic(),
-                        &committed,
-                        &u,
-                        &mut f,
-                        Some(&mut k),
-                        &mut trial,
-                        &mut out,
-                        &TimeContext::default(),
-                        &[],
-                        blocks,
+                        PointsPass {
+                            thickness: 0.3,
+                            mat: &elastic(),
+                            committed: &committed,
+                            u: &u,
+                            f: &mut f,
+                            k: Some(&mut k),
+                            trial: &mut trial,
+                            out: &mut out,
+                            time: &TimeContext::default(),
+                            imposed: &[],
+                            blocks,
+                        },
                     )
                     .unwrap();
                     (f, k)
@@ -386,17 +395,19 @@ mod tests {
             response_at(
                 kind,
                 &gauss_geometry(kind, Integration::Full, &x),
-                0.3,
-                &elastic(),
-                &committed,
-                &u,
-                &mut fl,
-                None,
-                &mut trial,
-                &mut out,
-                &TimeContext::default(),
-                &[],
-                NodeBlocks::ALL,
+                PointsPass {
+                    thickness: 0.3,
+                    mat: &elastic(),
+                    committed: &committed,
+                    u: &u,
+                    f: &mut fl,
+                    k: None,
+                    trial: &mut trial,
+                    out: &mut out,
+                    time: &TimeContext::default(),
+                    imposed: &[],
+                    blocks: NodeBlocks::ALL,
+                },
             )
             .unwrap();
             assert!((out[0].strain[0] - (c - 1.0)).abs() < 1e-12);
@@ -420,17 +431,19 @@ mod tests {
             response_at(
                 kind,
                 &gauss_geometry(kind, Integration::Full, &coords(kind)),
-                0.3,
-                &elastic(),
-                &committed,
-                &u,
-                &mut fl,
-                None,
-                &mut trial,
-                &mut out,
-                &TimeContext::default(),
-                &[],
-                NodeBlocks::ALL,
+                PointsPass {
+                    thickness: 0.3,
+                    mat: &elastic(),
+                    committed: &committed,
+                    u: &u,
+                    f: &mut fl,
+                    k: None,
+                    trial: &mut trial,
+                    out: &mut out,
+                    time: &TimeContext::default(),
+                    imposed: &[],
+                    blocks: NodeBlocks::ALL,
+                },
             )
             .unwrap();
             let fmax = fl.iter().fold(0.0f64, |m, v| m.max(v.abs()));
