@@ -179,8 +179,9 @@ struct Half {
     m: usize,
     /// Lower-triangle pattern of Bᵢ.
     pattern: SymbolicSparseColMat<usize>,
-    /// For each stored entry of `pattern`, its position in the caller's value array.
-    source: Vec<usize>,
+    /// For each stored entry of `pattern`, its position in the caller's value array (32 bits:
+    /// the analysis is made only below `u32::MAX` entries).
+    source: Vec<u32>,
     values: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
@@ -387,13 +388,13 @@ impl SplitCholesky {
             let mut next = col_ptr[..nb].to_vec();
             let nnz = col_ptr[nb];
             let mut row_idx = vec![0usize; nnz];
-            let mut source = vec![0usize; nnz];
+            let mut source = vec![0u32; nnz];
             for (r, range) in columns() {
                 let rl = local(h, r).expect("the half's own column");
                 for q in range {
                     if let Some(c) = local(h, up_idx[q] as usize) {
                         row_idx[next[c]] = rl;
-                        source[next[c]] = up_src[q] as usize;
+                        source[next[c]] = up_src[q];
                         next[c] += 1;
                     }
                 }
@@ -697,7 +698,7 @@ impl Half {
     /// own pivots, and form Mᵢ Mᵢᵀ (Mᵢ Dᵢ Mᵢᵀ). Ok: the own pivots (l_jj² or D_j).
     fn factorize(&mut self, values: &[f64], tiny: f64, ldlt: bool) -> Result<Pivots, HalfFail> {
         for (v, &p) in self.values.iter_mut().zip(&self.source) {
-            *v = values[p];
+            *v = values[p as usize];
         }
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
