@@ -330,6 +330,7 @@ impl<'m> System<'m> {
             },
         };
         let blocks = (0..model.elements.len())
+            .into_par_iter()
             .map(|e| {
                 let number = numbers.number(Family::Continuum, e);
                 let n = model.elements[e].nodes.len();
