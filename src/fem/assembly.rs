@@ -167,71 +167,7 @@ impl Assembler {
             let nd = 2 * nodes.len();
             scatter_ptr.push(scatter_ptr.last().copied().unwrap_or(0) + nd * nd);
         }
-        // The assembled entries of each element's matrix: counted, then written in place
-        // chunk-parallel (a full map with markers for the entries left out, packed afterwards, faulted in and
-        // wrote 64 + 72 MB more at 5e5 dofs).
-        let n_el = elem_nodes.len();
-        let el_chunks = n_el.div_ceil(ELEM_CHUNK);
-        // The equations of an element's dofs, in its matrix numbering.
-        let eqs_of = |nodes: &[usize], eqs: &mut Vec<usize>| {
-            eqs.clear();
-            eqs.extend(
-                nodes
-                    .iter()
-                    .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]]),
-            );
-        };
-        let assembled = |i: usize, j: usize| i != CONSTRAINED && j != CONSTRAINED && i >= j;
-        let ends: Vec<Vec<usize>> = elem_nodes
-            .par_chunks(ELEM_CHUNK)
-            .map(|chunk| {
-                let mut eqs = Vec::new();
-                let mut total = 0;
-                chunk
-                    .iter()
-                    .map(|nodes| {
-                        eqs_of(nodes, &mut eqs);
-                        total += eqs
-                            .iter()
-                            .map(|&i| eqs.iter().filter(|&&j| assembled(i, j)).count())
-                            .sum::<usize>();
-                        total
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut packed_ptr = Vec::with_capacity(n_el + 1);
-        packed_ptr.push(0usize);
-        for e in &ends {
-            let base = packed_ptr.last().copied().unwrap_or(0);
-            packed_ptr.extend(e.iter().map(|&x| base + x));
-        }
-        drop(ends);
-        let el_range = |c: usize| c * ELEM_CHUNK..((c + 1) * ELEM_CHUNK).min(n_el);
-        let mut packed = vec![(0u32, 0u32); packed_ptr[n_el]];
-        split_parts(&mut packed, el_chunks, |c| {
-            let r = el_range(c);
-            packed_ptr[r.end] - packed_ptr[r.start]
-        })
-        .into_par_iter()
-        .zip(elem_nodes.par_chunks(ELEM_CHUNK))
-        .for_each(|(s, chunk)| {
-            let mut eqs = Vec::new();
-            let mut k = 0;
-            for nodes in chunk {
-                eqs_of(nodes, &mut eqs);
-                let nd = eqs.len();
-                for (li, &i) in eqs.iter().enumerate() {
-                    for (lj, &j) in eqs.iter().enumerate() {
-                        if assembled(i, j) {
-                            let p = pattern.position(i, j).expect("pattern covers element");
-                            s[k] = ((li * nd + lj) as u32, p as u32);
-                            k += 1;
-                        }
-                    }
-                }
-            }
-        });
+        let (packed, packed_ptr) = pack(&pattern, elem_nodes, dofs);
         Self {
             pattern: std::sync::Arc::new(pattern),
             node_ptr,
@@ -275,6 +211,79 @@ impl Assembler {
             values[p as usize] += k[l as usize];
         }
     }
+}
+
+/// Assembled entries (element matrix index, value position) and the start of each element's
+/// entries in them (length: elements + 1).
+type Packed = (Vec<(u32, u32)>, Vec<usize>);
+
+/// The assembled entries of every element's matrix ([`Assembler::packed`]) and their starts:
+/// counted, then written in place chunk-parallel (a full map with markers for the entries
+/// left out, packed afterwards, faulted in and wrote 64 + 72 MB more at 5e5 dofs).
+fn pack(pattern: &LowerPattern, elem_nodes: &[Vec<usize>], dofs: &DofMap) -> Packed {
+    let n_el = elem_nodes.len();
+    let el_chunks = n_el.div_ceil(ELEM_CHUNK);
+    // The equations of an element's dofs, in its matrix numbering.
+    let eqs_of = |nodes: &[usize], eqs: &mut Vec<usize>| {
+        eqs.clear();
+        eqs.extend(
+            nodes
+                .iter()
+                .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]]),
+        );
+    };
+    let assembled = |i: usize, j: usize| i != CONSTRAINED && j != CONSTRAINED && i >= j;
+    let ends: Vec<Vec<usize>> = elem_nodes
+        .par_chunks(ELEM_CHUNK)
+        .map(|chunk| {
+            let mut eqs = Vec::new();
+            let mut total = 0;
+            chunk
+                .iter()
+                .map(|nodes| {
+                    eqs_of(nodes, &mut eqs);
+                    total += eqs
+                        .iter()
+                        .map(|&i| eqs.iter().filter(|&&j| assembled(i, j)).count())
+                        .sum::<usize>();
+                    total
+                })
+                .collect()
+        })
+        .collect();
+    let mut packed_ptr = Vec::with_capacity(n_el + 1);
+    packed_ptr.push(0usize);
+    for e in &ends {
+        let base = packed_ptr.last().copied().unwrap_or(0);
+        packed_ptr.extend(e.iter().map(|&x| base + x));
+    }
+    drop(ends);
+    let el_range = |c: usize| c * ELEM_CHUNK..((c + 1) * ELEM_CHUNK).min(n_el);
+    let mut packed = vec![(0u32, 0u32); packed_ptr[n_el]];
+    split_parts(&mut packed, el_chunks, |c| {
+        let r = el_range(c);
+        packed_ptr[r.end] - packed_ptr[r.start]
+    })
+    .into_par_iter()
+    .zip(elem_nodes.par_chunks(ELEM_CHUNK))
+    .for_each(|(s, chunk)| {
+        let mut eqs = Vec::new();
+        let mut k = 0;
+        for nodes in chunk {
+            eqs_of(nodes, &mut eqs);
+            let nd = eqs.len();
+            for (li, &i) in eqs.iter().enumerate() {
+                for (lj, &j) in eqs.iter().enumerate() {
+                    if assembled(i, j) {
+                        let p = pattern.position(i, j).expect("pattern covers element");
+                        s[k] = ((li * nd + lj) as u32, p as u32);
+                        k += 1;
+                    }
+                }
+            }
+        }
+    });
+    (packed, packed_ptr)
 }
 
 /// `v` cut into `parts` consecutive slices, part c of `len(c)` entries.
