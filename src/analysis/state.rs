@@ -146,7 +146,7 @@ pub(crate) mod layout {
     use crate::elements::interface::InterfacePointState;
     use crate::elements::tendon::{SpanState, TendonState};
     use crate::materials::chain::{ChainState, SteelRelaxationChain};
-    use crate::materials::point::PointState;
+    use crate::materials::point::{AgeingState, PointState};
     use crate::materials::steel::SteelState;
 
     /// The sample state.
@@ -217,12 +217,12 @@ pub(crate) mod layout {
                     points: Staged::new(vec![
                         PointState::Elastic,
                         PointState::Concrete(Box::default()),
-                        PointState::Ageing {
+                        PointState::Ageing(Box::new(AgeingState {
                             chain: ChainState {
                                 hidden: vec![[1.0, 2.0, 3.0]],
                             },
                             strain: [4.0, 5.0, 6.0],
-                        },
+                        })),
                     ]),
                     // The elastic point's outputs are not saved (read back as zero).
                     gauss: Staged::new(vec![

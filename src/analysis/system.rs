@@ -249,16 +249,19 @@ impl<'m> System<'m> {
             model.interfaces.len(),
             model.tendons.len(),
         ]);
-        let elem_nodes: Vec<Vec<usize>> = Family::ALL
-            .iter()
-            .flat_map(|f| -> Box<dyn Iterator<Item = Vec<usize>>> {
-                match f {
-                    Family::Continuum => Box::new(model.elements.iter().map(|e| e.nodes.clone())),
-                    Family::Joint => Box::new(model.interfaces.iter().map(|i| i.nodes.clone())),
-                    Family::Tendon => Box::new(model.tendons.iter().map(|t| t.tie_nodes())),
+        let mut elem_nodes: Vec<Vec<usize>> = Vec::with_capacity(numbers.total());
+        for f in Family::ALL {
+            match f {
+                // A list per element: copied on all cores (0.25 million at 5e5 dofs).
+                Family::Continuum => {
+                    elem_nodes.par_extend(model.elements.par_iter().map(|e| e.nodes.clone()))
                 }
-            })
-            .collect();
+                Family::Joint => {
+                    elem_nodes.extend(model.interfaces.iter().map(|i| i.nodes.clone()))
+                }
+                Family::Tendon => elem_nodes.extend(model.tendons.iter().map(|t| t.tie_nodes())),
+            }
+        }
         assert_eq!(elem_nodes.len(), numbers.total());
         let linear = model.materials.iter().all(|m| m.law.is_linear())
             && model.interfaces.is_empty()
@@ -327,6 +330,7 @@ impl<'m> System<'m> {
             },
         };
         let blocks = (0..model.elements.len())
+            .into_par_iter()
             .map(|e| {
                 let number = numbers.number(Family::Continuum, e);
                 let n = model.elements[e].nodes.len();

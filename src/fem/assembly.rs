@@ -6,10 +6,6 @@ use super::dofs::{DofMap, CONSTRAINED};
 use crate::linalg::pattern::{incidence, LowerPattern};
 use rayon::prelude::*;
 
-/// Position marker for an element matrix entry that is not assembled (constrained dof or
-/// strictly upper triangle).
-const SKIP: u32 = u32::MAX;
-
 /// Pattern and scatter maps for a list of element dof lists.
 #[derive(Debug, Clone)]
 pub struct Assembler {
@@ -100,45 +96,66 @@ impl Assembler {
         drop(chunks);
         // Lower pattern over equations: column j = eq of (node a, dir), rows = eqs ≥ j among
         // the dofs of neighbours of a. Equations are numbered in node order, so sorting the
-        // neighbour list sorts the rows.
+        // neighbour list sorts the rows. Counted first, then written in place chunk-parallel
+        // (collecting per-chunk rows and joining them faulted in and copied the pattern
+        // twice: 38 MB at 5e5 dofs).
         let n = dofs.n_eq;
-        let cols: Vec<(Vec<usize>, Vec<usize>)> = (0..n_nodes.div_ceil(NODE_CHUNK))
+        let n_chunks = n_nodes.div_ceil(NODE_CHUNK);
+        let node_range = |c: usize| c * NODE_CHUNK..((c + 1) * NODE_CHUNK).min(n_nodes);
+        // The rows of column (a, da) in increasing order, given j = its equation.
+        let rows_of = |a: usize, j: usize| {
+            node_adj[node_ptr[a]..node_ptr[a + 1]]
+                .iter()
+                .flat_map(|&b| [dofs.eq[2 * b as usize], dofs.eq[2 * b as usize + 1]])
+                .filter(move |&i| i != CONSTRAINED && i >= j)
+        };
+        let counts: Vec<Vec<usize>> = (0..n_chunks)
             .into_par_iter()
             .map(|c| {
-                let (a0, a1) = (c * NODE_CHUNK, ((c + 1) * NODE_CHUNK).min(n_nodes));
-                let mut rows = Vec::with_capacity((a1 - a0) * 20);
-                let mut len = Vec::with_capacity(2 * (a1 - a0));
-                for a in a0..a1 {
+                let mut len = Vec::with_capacity(2 * NODE_CHUNK);
+                for a in node_range(c) {
                     for da in 0..2 {
                         let j = dofs.eq[2 * a + da];
-                        if j == CONSTRAINED {
-                            continue;
+                        if j != CONSTRAINED {
+                            len.push(rows_of(a, j).count());
                         }
-                        let s = rows.len();
-                        for &b in &node_adj[node_ptr[a]..node_ptr[a + 1]] {
-                            for db in 0..2 {
-                                let i = dofs.eq[2 * b as usize + db];
-                                if i != CONSTRAINED && i >= j {
-                                    rows.push(i);
-                                }
-                            }
-                        }
-                        len.push(rows.len() - s);
                     }
                 }
-                (rows, len)
+                len
             })
             .collect();
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0usize);
-        let mut row_idx = Vec::with_capacity(cols.iter().map(|c| c.0.len()).sum());
-        for (rows, len) in &cols {
-            row_idx.extend_from_slice(rows);
-            for l in len {
-                col_ptr.push(col_ptr.last().copied().unwrap_or(0) + l);
-            }
+        for l in counts.iter().flatten() {
+            col_ptr.push(col_ptr.last().copied().unwrap_or(0) + l);
         }
-        drop(cols);
+        // Each chunk's columns are consecutive equations (numbered in node order).
+        let mut chunk_start = Vec::with_capacity(n_chunks + 1);
+        chunk_start.push(0usize);
+        for len in &counts {
+            chunk_start.push(chunk_start.last().copied().unwrap_or(0) + len.len());
+        }
+        drop(counts);
+        let mut row_idx = vec![0usize; col_ptr[n]];
+        split_parts(&mut row_idx, n_chunks, |c| {
+            col_ptr[chunk_start[c + 1]] - col_ptr[chunk_start[c]]
+        })
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(c, part)| {
+            let mut k = 0;
+            for a in node_range(c) {
+                for da in 0..2 {
+                    let j = dofs.eq[2 * a + da];
+                    if j != CONSTRAINED {
+                        for i in rows_of(a, j) {
+                            part[k] = i;
+                            k += 1;
+                        }
+                    }
+                }
+            }
+        });
         let pattern = LowerPattern {
             n,
             col_ptr,
@@ -150,44 +167,7 @@ impl Assembler {
             let nd = 2 * nodes.len();
             scatter_ptr.push(scatter_ptr.last().copied().unwrap_or(0) + nd * nd);
         }
-        // Each chunk of elements fills its own part of the map in place (collecting the
-        // parts and joining them copied the whole map again: 64 MB at 5e5 dofs).
-        let mut scatter = vec![0u32; scatter_ptr.last().copied().unwrap_or(0)];
-        let mut parts: Vec<&mut [u32]> = Vec::with_capacity(elem_nodes.len().div_ceil(ELEM_CHUNK));
-        let mut rest = &mut scatter[..];
-        for c in 0..elem_nodes.len().div_ceil(ELEM_CHUNK) {
-            let (e0, e1) = (c * ELEM_CHUNK, ((c + 1) * ELEM_CHUNK).min(elem_nodes.len()));
-            let (part, tail) = rest.split_at_mut(scatter_ptr[e1] - scatter_ptr[e0]);
-            parts.push(part);
-            rest = tail;
-        }
-        parts
-            .into_par_iter()
-            .zip(elem_nodes.par_chunks(ELEM_CHUNK))
-            .for_each(|(s, chunk)| {
-                let mut eqs = Vec::new();
-                let mut k = 0;
-                for nodes in chunk {
-                    eqs.clear();
-                    eqs.extend(
-                        nodes
-                            .iter()
-                            .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]]),
-                    );
-                    for &i in &eqs {
-                        for &j in &eqs {
-                            s[k] = if i == CONSTRAINED || j == CONSTRAINED || i < j {
-                                SKIP
-                            } else {
-                                pattern.position(i, j).expect("pattern covers element") as u32
-                            };
-                            k += 1;
-                        }
-                    }
-                }
-            });
-        let (packed, packed_ptr) = pack(&scatter, &scatter_ptr);
-        drop(scatter);
+        let (packed, packed_ptr) = pack(&pattern, elem_nodes, dofs);
         Self {
             pattern: std::sync::Arc::new(pattern),
             node_ptr,
@@ -225,49 +205,97 @@ impl Assembler {
             k.len(),
             "element {e}: matrix size and scatter map differ"
         );
-        // The entries that are not SKIP, in the same order: the same additions.
+        // The assembled entries in the matrix's row-major order: the same additions as a
+        // walk over the whole matrix.
         for &(l, p) in &self.packed[self.packed_ptr[e]..self.packed_ptr[e + 1]] {
             values[p as usize] += k[l as usize];
         }
     }
 }
 
-/// Assembled entries (element matrix index, value position) and the end or start of each
-/// element's entries in them.
+/// Assembled entries (element matrix index, value position) and the start of each element's
+/// entries in them (length: elements + 1).
 type Packed = (Vec<(u32, u32)>, Vec<usize>);
 
-/// The assembled entries of every element's map ([`Assembler::packed`]) and their starts,
-/// built chunk-parallel (the linear runs build the map once and assemble once or twice).
-fn pack(scatter: &[u32], scatter_ptr: &[usize]) -> Packed {
-    let n_el = scatter_ptr.len() - 1;
-    let parts: Vec<Packed> = (0..n_el.div_ceil(ELEM_CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            let (e0, e1) = (c * ELEM_CHUNK, ((c + 1) * ELEM_CHUNK).min(n_el));
-            let mut out = Vec::new();
-            let mut ends = Vec::with_capacity(e1 - e0);
-            for e in e0..e1 {
-                let s = &scatter[scatter_ptr[e]..scatter_ptr[e + 1]];
-                out.extend(
-                    s.iter()
-                        .enumerate()
-                        .filter(|(_, &p)| p != SKIP)
-                        .map(|(l, &p)| (l as u32, p)),
-                );
-                ends.push(out.len());
-            }
-            (out, ends)
+/// The assembled entries of every element's matrix ([`Assembler::packed`]) and their starts:
+/// counted, then written in place chunk-parallel (a full map with markers for the entries
+/// left out, packed afterwards, faulted in and wrote 64 + 72 MB more at 5e5 dofs).
+fn pack(pattern: &LowerPattern, elem_nodes: &[Vec<usize>], dofs: &DofMap) -> Packed {
+    let n_el = elem_nodes.len();
+    let el_chunks = n_el.div_ceil(ELEM_CHUNK);
+    // The equations of an element's dofs, in its matrix numbering.
+    let eqs_of = |nodes: &[usize], eqs: &mut Vec<usize>| {
+        eqs.clear();
+        eqs.extend(
+            nodes
+                .iter()
+                .flat_map(|&a| [dofs.eq[2 * a], dofs.eq[2 * a + 1]]),
+        );
+    };
+    let assembled = |i: usize, j: usize| i != CONSTRAINED && j != CONSTRAINED && i >= j;
+    let ends: Vec<Vec<usize>> = elem_nodes
+        .par_chunks(ELEM_CHUNK)
+        .map(|chunk| {
+            let mut eqs = Vec::new();
+            let mut total = 0;
+            chunk
+                .iter()
+                .map(|nodes| {
+                    eqs_of(nodes, &mut eqs);
+                    total += eqs
+                        .iter()
+                        .map(|&i| eqs.iter().filter(|&&j| assembled(i, j)).count())
+                        .sum::<usize>();
+                    total
+                })
+                .collect()
         })
         .collect();
-    let mut packed = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
-    let mut ptr = Vec::with_capacity(n_el + 1);
-    ptr.push(0);
-    for (out, ends) in parts {
-        let base = packed.len();
-        ptr.extend(ends.iter().map(|&x| base + x));
-        packed.extend_from_slice(&out);
+    let mut packed_ptr = Vec::with_capacity(n_el + 1);
+    packed_ptr.push(0usize);
+    for e in &ends {
+        let base = packed_ptr.last().copied().unwrap_or(0);
+        packed_ptr.extend(e.iter().map(|&x| base + x));
     }
-    (packed, ptr)
+    drop(ends);
+    let el_range = |c: usize| c * ELEM_CHUNK..((c + 1) * ELEM_CHUNK).min(n_el);
+    let mut packed = vec![(0u32, 0u32); packed_ptr[n_el]];
+    split_parts(&mut packed, el_chunks, |c| {
+        let r = el_range(c);
+        packed_ptr[r.end] - packed_ptr[r.start]
+    })
+    .into_par_iter()
+    .zip(elem_nodes.par_chunks(ELEM_CHUNK))
+    .for_each(|(s, chunk)| {
+        let mut eqs = Vec::new();
+        let mut k = 0;
+        for nodes in chunk {
+            eqs_of(nodes, &mut eqs);
+            let nd = eqs.len();
+            for (li, &i) in eqs.iter().enumerate() {
+                for (lj, &j) in eqs.iter().enumerate() {
+                    if assembled(i, j) {
+                        let p = pattern.position(i, j).expect("pattern covers element");
+                        s[k] = ((li * nd + lj) as u32, p as u32);
+                        k += 1;
+                    }
+                }
+            }
+        }
+    });
+    (packed, packed_ptr)
+}
+
+/// `v` cut into `parts` consecutive slices, part c of `len(c)` entries.
+fn split_parts<T>(v: &mut [T], parts: usize, len: impl Fn(usize) -> usize) -> Vec<&mut [T]> {
+    let mut out = Vec::with_capacity(parts);
+    let mut rest = v;
+    for c in 0..parts {
+        let (part, tail) = rest.split_at_mut(len(c));
+        out.push(part);
+        rest = tail;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -263,7 +263,8 @@ pub fn loose_coincident(
         .filter(|&(n, _)| used[n])
         .map(|(n, p)| (cell(*p), n))
         .collect();
-    sorted.sort_unstable();
+    // Distinct keys (the node is part of each): the same order on any number of threads.
+    rayon::slice::ParallelSliceMut::par_sort_unstable(&mut sorted[..]);
     let (mut count, mut first): (usize, Option<(usize, usize, usize)>) = (0, None);
     let mut pair = |i: usize, j: usize| {
         // i, j: positions in `sorted`; (m, n) the pair's nodes, m < n.

@@ -2,6 +2,7 @@
 //! nearest node, nodes and element edges on a line segment.
 
 use crate::model::Model;
+use rayon::prelude::*;
 
 pub use crate::model::model_size;
 
@@ -22,12 +23,13 @@ fn in_corners(corners: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
 /// True if `p` lies in some element of the mesh (within a tolerance of 1e-6 × model size).
 pub fn inside_mesh(model: &Model, p: [f64; 2]) -> bool {
     let tol = 1e-6 * model_size(model);
-    model.elements.iter().any(|e| {
-        let c: Vec<[f64; 2]> = e.nodes[..e.kind.n_corners()]
-            .iter()
-            .map(|&n| model.nodes[n])
-            .collect();
-        in_corners(&c, p, tol)
+    model.elements.par_iter().any(|e| {
+        let nc = e.kind.n_corners();
+        let mut c = [[0.0; 2]; 4];
+        for (k, &n) in e.nodes[..nc].iter().enumerate() {
+            c[k] = model.nodes[n];
+        }
+        in_corners(&c[..nc], p, tol)
     })
 }
 
@@ -113,28 +115,46 @@ fn edges_on_segment_of(
     }
     let param = |p: [f64; 2]| ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len; // [m] along a→b
     let off_line = |p: [f64; 2]| ((p[0] - a[0]) * ey - (p[1] - a[1]) * ex).abs() / len;
-    for e in model.elements.iter().filter(|e| keep(e)) {
-        for local in e.kind.edges() {
-            let nodes: Vec<usize> = local.iter().map(|&l| e.nodes[l]).collect();
-            if !nodes.iter().all(|&n| off_line(model.nodes[n]) <= tol) {
-                continue;
-            }
-            let mut key = [nodes[0], nodes[1]];
-            key.sort_unstable();
-            if !seen.insert(key) {
-                continue;
-            }
-            let (s0, s1) = (param(model.nodes[nodes[0]]), param(model.nodes[nodes[1]]));
-            let (lo, hi) = (s0.min(s1).max(0.0), s0.max(s1).min(len));
-            if hi - lo <= tol {
-                continue;
-            }
-            // Straight edge: r is linear in the distance along it.
-            let to_r = |s: f64| -1.0 + 2.0 * (s - s0) / (s1 - s0);
-            let (r0, r1) = (to_r(lo), to_r(hi));
-            out.push((nodes, [r0.min(r1), r0.max(r1)]));
-            covered += hi - lo;
+    // The edges on the line, found on all cores (kept in element and edge order), then
+    // walked in that order.
+    let on_line: Vec<(usize, usize)> = model
+        .elements
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(k, e)| {
+            e.kind
+                .edges()
+                .iter()
+                .enumerate()
+                .filter_map(move |(q, local)| {
+                    local
+                        .iter()
+                        .all(|&l| off_line(model.nodes[e.nodes[l]]) <= tol)
+                        .then_some((k, q))
+                })
+        })
+        .collect();
+    for (k, q) in on_line {
+        let e = &model.elements[k];
+        if !keep(e) {
+            continue;
         }
+        let nodes: Vec<usize> = e.kind.edges()[q].iter().map(|&l| e.nodes[l]).collect();
+        let mut key = [nodes[0], nodes[1]];
+        key.sort_unstable();
+        if !seen.insert(key) {
+            continue;
+        }
+        let (s0, s1) = (param(model.nodes[nodes[0]]), param(model.nodes[nodes[1]]));
+        let (lo, hi) = (s0.min(s1).max(0.0), s0.max(s1).min(len));
+        if hi - lo <= tol {
+            continue;
+        }
+        // Straight edge: r is linear in the distance along it.
+        let to_r = |s: f64| -1.0 + 2.0 * (s - s0) / (s1 - s0);
+        let (r0, r1) = (to_r(lo), to_r(hi));
+        out.push((nodes, [r0.min(r1), r0.max(r1)]));
+        covered += hi - lo;
     }
     (out, covered)
 }

@@ -461,7 +461,7 @@ impl SparseCholesky {
             &mut self.mem,
             MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
         );
-        let split_len: usize = halves.iter().flatten().map(Vec::len).sum();
+        let split_len: usize = halves.iter().flat_map(|h| &h.0).map(Vec::len).sum();
         if l_values.len().max(split_len) >= TOUCH_AHEAD_VALUES
             || pending.is_some()
             || spare.is_some()

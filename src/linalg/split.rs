@@ -29,7 +29,7 @@
 //! MᵢMᵢᵀ, in S) instead of once: small for the plane meshes' separators (a cross-section of
 //! the mesh), against half of everything below them.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::matmul::triangular::BlockStructure;
@@ -179,12 +179,16 @@ struct Half {
     m: usize,
     /// Lower-triangle pattern of Bᵢ.
     pattern: SymbolicSparseColMat<usize>,
-    /// For each stored entry of `pattern`, its position in the caller's value array.
-    source: Vec<usize>,
+    /// For each stored entry of `pattern`, its position in the caller's value array (32 bits:
+    /// the analysis is made only below `u32::MAX` entries).
+    source: Vec<u32>,
     values: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
+    /// The numeric factorisation's scratch (LLᵀ or LDLᵀ), given back by
+    /// [`SplitCholesky::release`] and allocated anew by the next factorisation.
     mem: MemBuffer,
+    mem_req: StackReq,
     /// Mᵢ (dense s × s, column-major, lower; unit diagonal after an LDLᵀ) and then
     /// Mᵢ Mᵢᵀ or Mᵢ Dᵢ Mᵢᵀ (lower).
     m33: Vec<f64>,
@@ -387,13 +391,13 @@ impl SplitCholesky {
             let mut next = col_ptr[..nb].to_vec();
             let nnz = col_ptr[nb];
             let mut row_idx = vec![0usize; nnz];
-            let mut source = vec![0usize; nnz];
+            let mut source = vec![0u32; nnz];
             for (r, range) in columns() {
                 let rl = local(h, r).expect("the half's own column");
                 for q in range {
                     if let Some(c) = local(h, up_idx[q] as usize) {
                         row_idx[next[c]] = rl;
-                        source[next[c]] = up_src[q] as usize;
+                        source[next[c]] = up_src[q];
                         next[c] += 1;
                     }
                 }
@@ -438,6 +442,7 @@ impl SplitCholesky {
                 values: vec![0.0; nnz],
                 l_values,
                 mem,
+                mem_req: req,
                 symbolic,
                 m33: vec![0.0; s * s],
                 schur: vec![0.0; s * s],
@@ -492,12 +497,18 @@ impl SplitCholesky {
             + self.split.s * self.split.s
     }
 
-    /// Give the factor values back (the analysis stays).
-    pub fn release(&mut self) -> Vec<Vec<f64>> {
+    /// Give the factor values and the halves' scratch back (the analysis stays; the next
+    /// factorisation allocates both anew).
+    pub fn release(&mut self) -> (Vec<Vec<f64>>, Vec<MemBuffer>) {
         self.halves
             .iter_mut()
-            .map(|h| std::mem::take(&mut h.l_values))
-            .collect()
+            .map(|h| {
+                (
+                    std::mem::take(&mut h.l_values),
+                    std::mem::replace(&mut h.mem, MemBuffer::new(StackReq::EMPTY)),
+                )
+            })
+            .unzip()
     }
 
     /// `order[k]`: the original equation eliminated k-th.
@@ -697,7 +708,7 @@ impl Half {
     /// own pivots, and form Mᵢ Mᵢᵀ (Mᵢ Dᵢ Mᵢᵀ). Ok: the own pivots (l_jj² or D_j).
     fn factorize(&mut self, values: &[f64], tiny: f64, ldlt: bool) -> Result<Pivots, HalfFail> {
         for (v, &p) in self.values.iter_mut().zip(&self.source) {
-            *v = values[p];
+            *v = values[p as usize];
         }
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
@@ -707,6 +718,9 @@ impl Half {
         self.ldlt = ldlt;
         self.indefinite = false;
         let a = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
+        if self.mem.len() < self.mem_req.size_bytes() {
+            self.mem = MemBuffer::new(self.mem_req);
+        }
         let stack = MemStack::new(&mut self.mem);
         if ldlt {
             let res = self.symbolic.factorize_numeric_ldlt(
@@ -923,6 +937,15 @@ mod tests {
                 .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()));
             assert!(diff <= 1e-10 * scale, "difference {diff} of {scale}");
         }
+        // Factor and scratch given back, then factorised again (both allocated anew): the
+        // same solution to the bit.
+        let b: Vec<f64> = (0..p.n).map(|i| (i as f64 * 0.11).cos()).collect();
+        let (mut x, mut y) = (b.clone(), b);
+        split.solve_in_place(&mut x);
+        split.release();
+        split.factorize(p, &k).unwrap();
+        split.solve_in_place(&mut y);
+        assert_eq!(x, y);
     }
 
     /// The RC beam refined 4× (Q8, 32,084 equations, element dissection).

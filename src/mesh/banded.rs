@@ -3,6 +3,7 @@
 //! plane-stress idealisation of I, T and box sections.
 
 use crate::model::ElementKind;
+use rayon::prelude::*;
 
 /// One horizontal band, listed from the bottom up.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,9 +66,11 @@ pub fn generate(
         }
     }
     let g = |i: usize, j: usize| id[j * ncols + i];
-    let mut elements = Vec::with_capacity(nx * row_region.len());
-    for (r, &region) in row_region.iter().enumerate() {
-        for c in 0..nx {
+    // Row by row, left to right (a node list per element: built on all cores).
+    let elements = (0..nx * row_region.len())
+        .into_par_iter()
+        .map(|k| {
+            let (r, c) = (k / nx, k % nx);
             let (i, j) = (c * order, r * order);
             let el = (0..kind.n_nodes())
                 .map(|a| {
@@ -75,9 +78,9 @@ pub fn generate(
                     g(i + di, j + dj)
                 })
                 .collect();
-            elements.push((el, region));
-        }
-    }
+            (el, row_region[r])
+        })
+        .collect();
     GeneratedMesh { nodes, elements }
 }
 

@@ -11,6 +11,7 @@ use crate::mesh::banded::{self, Band};
 use crate::mesh::segmental;
 use crate::model::ElementKind;
 use crate::model::{Element, Model, Region};
+use rayon::prelude::*;
 
 /// A generated or read mesh: nodes [m], elements, the joints between segments and the gmsh
 /// physical groups (empty for the other mesh types).
@@ -549,18 +550,29 @@ pub(super) fn check_generated(
         ));
     }
     let size = limits::extent(nodes);
-    for (i, (conn, _)) in elements.iter().enumerate() {
-        let c: Vec<[f64; 2]> = conn.iter().map(|&n| nodes[n]).collect();
-        let ids: Vec<u64> = conn.iter().map(|&n| n as u64 + 1).collect();
-        if let Some(m) = limits::degenerate(&c, kind.n_corners(), &ids, size) {
-            return Err(ctx.err(
-                "mesh",
-                format!(
-                    "generated element {}: {m}; check the lengths, depths and divisions",
-                    i + 1
-                ),
-            ));
-        }
+    let nc = kind.n_corners();
+    // Only the corners are read: no list per element, and the elements checked in
+    // parallel, the first failing one in element order reported.
+    let failed = elements
+        .par_iter()
+        .enumerate()
+        .find_map_first(|(i, (conn, _))| {
+            let mut c = [[0.0; 2]; 4];
+            let mut ids = [0u64; 4];
+            for (k, &n) in conn[..nc].iter().enumerate() {
+                c[k] = nodes[n];
+                ids[k] = n as u64 + 1;
+            }
+            limits::degenerate(&c[..nc], nc, &ids[..nc], size).map(|m| (i, m))
+        });
+    if let Some((i, m)) = failed {
+        return Err(ctx.err(
+            "mesh",
+            format!(
+                "generated element {}: {m}; check the lengths, depths and divisions",
+                i + 1
+            ),
+        ));
     }
     Ok(())
 }
