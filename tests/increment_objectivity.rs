@@ -237,6 +237,20 @@ fn summary_and_report_state_the_path_error_of_an_arc_length_run() {
     );
 }
 
+/// The shear beam `id` of validation/beams/beams.csv and the model keys of the bench's
+/// option named `option`.
+fn shear_beam(id: &str, option: &str) -> (beam_bench::Beam, &'static str) {
+    use crate::beam_bench::{options, read_beams};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
+    let beam = read_beams(&path)
+        .unwrap()
+        .into_iter()
+        .find(|b| b.id == id)
+        .unwrap();
+    let keys = options().into_iter().find(|o| o.0 == option).unwrap().1;
+    (beam, keys)
+}
+
 /// The path error at the peak flags a peak that depends on the increment (issue 38 item
 /// 3: "it says how sure it is"): OA1 (no stirrups, brittle diagonal tension; 10 Q8 rows,
 /// the default model, fixed increments) at 0.2 mm plate increments is flagged (measured
@@ -246,18 +260,8 @@ fn summary_and_report_state_the_path_error_of_an_arc_length_run() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release test: two shear beam runs")]
 fn shear_beam_peak_that_depends_on_the_increment_is_flagged() {
-    use crate::beam_bench::{options, read_beams, run_beam_solver};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beam = read_beams(&path)
-        .unwrap()
-        .into_iter()
-        .find(|b| b.id == "OA1")
-        .unwrap();
-    let keys = options()
-        .into_iter()
-        .find(|o| o.0 == "fixed, seed β")
-        .unwrap()
-        .1;
+    use crate::beam_bench::run_beam_solver;
+    let (beam, keys) = shear_beam("OA1", "fixed, seed β");
     let run = |inc_mm: f64| run_beam_solver(&beam, keys, 10, -20e-3, inc_mm * 1e-3, "").unwrap();
     let (coarse, half) = (run(0.2), run(0.1));
     let p = coarse
@@ -328,7 +332,7 @@ fn summary_and_report_state_the_path_error_at_the_peak() {
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_shear_beam() {
-    use crate::beam_bench::{options, read_beams, run_beam_solver};
+    use crate::beam_bench::run_beam_solver;
     let var = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
     let id = var("SEGFEM_BEAM", "OA1");
     let rows: usize = var("SEGFEM_ROWS", "10").parse().unwrap();
@@ -341,13 +345,7 @@ fn measure_shear_beam() {
     let norm = std::env::var("SEGFEM_IMPLEX_NORM")
         .ok()
         .map(|v| format!("\"{v}\""));
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beam = read_beams(&path)
-        .unwrap()
-        .into_iter()
-        .find(|b| b.id == id)
-        .unwrap();
-    let keys = options().into_iter().find(|o| o.0 == option).unwrap().1;
+    let (beam, keys) = shear_beam(&id, &option);
     let mut solver = String::new();
     for (key, v) in [
         ("increment_tolerance", &tol),
@@ -401,18 +399,8 @@ fn measure_shear_beam() {
     ignore = "release test: two shear-beam runs to failure"
 )]
 fn shear_beam_peak_with_the_global_implex_control_does_not_depend_on_the_increment() {
-    use crate::beam_bench::{options, read_beams, run_beam_solver};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/beams/beams.csv");
-    let beam = read_beams(&path)
-        .unwrap()
-        .into_iter()
-        .find(|b| b.id == "OA1")
-        .unwrap();
-    let keys = options()
-        .into_iter()
-        .find(|o| o.0 == "fixed, seed β")
-        .unwrap()
-        .1;
+    use crate::beam_bench::run_beam_solver;
+    let (beam, keys) = shear_beam("OA1", "fixed, seed β");
     let solver = "implex_force_tolerance = 5e-3\n";
     let run =
         |inc_mm: f64| run_beam_solver(&beam, keys, 10, -20e-3, inc_mm * 1e-3, solver).unwrap();

@@ -147,29 +147,27 @@ impl super::ElementResponse for ContinuumElement<'_> {
         (trial, out): Self::Trial<'_>,
         into: super::Response<'_>,
     ) -> Result<bool, UpdateError> {
-        let (c, t, m) = (self.coords, self.thickness, self.material);
-        let (f, k) = (into.f, into.k);
-        // The small-strain and total Lagrangian responses take the same arguments.
+        let c = self.coords;
+        // One pass for all three formulations (the incompatible-mode element forms all
+        // node blocks).
+        let pass = PointsPass {
+            thickness: self.thickness,
+            mat: self.material,
+            committed,
+            u,
+            f: into.f,
+            k: into.k,
+            trial,
+            out,
+            time: self.time,
+            imposed: self.imposed,
+            blocks: self.blocks,
+        };
         let (kind, integration, tl) = match self.formulation {
             Formulation::SmallStrain { kind, integration } => (kind, integration, false),
             Formulation::TotalLagrangian { kind, integration } => (kind, integration, true),
             Formulation::IncompatibleModes => {
-                super::incompatible::response_at(
-                    c,
-                    PointsPass {
-                        thickness: t,
-                        mat: m,
-                        committed,
-                        u,
-                        f,
-                        k,
-                        trial,
-                        out,
-                        time: self.time,
-                        imposed: self.imposed,
-                        blocks: NodeBlocks::ALL,
-                    },
-                )?;
+                super::incompatible::response_at(c, pass)?;
                 return Ok(true);
             }
         };
@@ -185,23 +183,7 @@ impl super::ElementResponse for ContinuumElement<'_> {
                 }
                 None => gauss_geometry(kind, integration, c),
             };
-            super::total_lagrangian::response_tl(
-                kind,
-                &computed,
-                PointsPass {
-                    thickness: t,
-                    mat: m,
-                    committed,
-                    u,
-                    f,
-                    k,
-                    trial,
-                    out,
-                    time: self.time,
-                    imposed: self.imposed,
-                    blocks: self.blocks,
-                },
-            )?;
+            super::total_lagrangian::response_tl(kind, &computed, pass)?;
         } else {
             let mut buf = [0.0; PACKED_MAX];
             let packed = match self.geometry {
@@ -212,24 +194,7 @@ impl super::ElementResponse for ContinuumElement<'_> {
                     &buf[..len]
                 }
             };
-            small_strain(
-                kind,
-                packed,
-                PointsPass {
-                    thickness: t,
-                    mat: m,
-                    committed,
-                    u,
-                    f,
-                    k,
-                    trial,
-                    out,
-                    time: self.time,
-                    imposed: self.imposed,
-                    blocks: self.blocks,
-                },
-                (self.memo, self.localised, self.bars),
-            )?;
+            small_strain(kind, packed, pass, (self.memo, self.localised, self.bars))?;
         }
         Ok(true)
     }
