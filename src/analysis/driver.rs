@@ -34,7 +34,7 @@ pub struct Snapshot<'a, 's> {
     /// Force [N] the displacement control applies at its dof (displacement steps).
     pub control_force: Option<f64>,
     /// The increment's IMPL-EX path error in the energy norm [-]
-    /// ([`implex_energy_error`], docs/theory-concrete.md §5.2 "How sure the path is"):
+    /// ([`implex_energy_error`], docs/theory-concrete.md §5.2 "How sure the peak is"):
     /// measured at every converged increment of a load, displacement or arc-length step
     /// of a model with IMPL-EX concrete; None where it is not measured.
     pub implex_error: Option<f64>,
