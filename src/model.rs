@@ -407,13 +407,26 @@ pub struct Step {
     pub factors: Vec<f64>,
     /// Number of equal increments.
     pub increments: usize,
-    /// Write field output (VTU) at every increment, not only at the end of the step.
-    pub output_every_increment: bool,
+    /// Which increments write field output (.vtu).
+    pub field_output: FieldOutput,
     /// Path-following control (displacement and arc-length steps).
     pub path: Option<PathControl>,
     /// Time interval of a [`StepKind::Time`] step (None for load steps, which act
     /// instantaneously at the current time).
     pub time: Option<TimeSpan>,
+}
+
+/// Which increments of a step write field files (`steps.output`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum FieldOutput {
+    /// The step's last increment only (`"end"`).
+    #[default]
+    End,
+    /// Every converged increment (`"increments"`).
+    Increments,
+    /// None (`"none"`): the history, the summary and the checkpoint only, for runs whose
+    /// answers are their monitors (parameter sweeps, benchmarks).
+    None,
 }
 
 /// Kinematics of the concrete continuum and the embedded bars (`[analysis] geometry`).

@@ -562,7 +562,7 @@ fn unknown_output_value() {
     rejects(
         &model,
         "steps[0].output",
-        &["unknown value 'every'", "end or increments"],
+        &["unknown value 'every'", "end, increments or none"],
     );
 }
 

@@ -768,6 +768,53 @@ fn box_beam_vtu_files_are_complete() {
 }
 
 #[test]
+fn steps_without_field_output_give_the_same_history() {
+    // output = "none" on every step: history and monitors bit for bit those of the run
+    // with field files (the fields are written after each increment, never read back), and
+    // no .vtu or results.pvd; the report still builds from the history.
+    let tmp = TempDir::new("nofields");
+    let (text, _) = run_box_beam(&tmp);
+    let n_steps = steps_of(&text).len();
+    let mut none = String::new();
+    for line in text.lines() {
+        if !line.trim_start().starts_with("output") {
+            none.push_str(line);
+            none.push('\n');
+        }
+        if line.trim() == "[[steps]]" {
+            none.push_str("output = \"none\"\n");
+        }
+    }
+    std::fs::write(tmp.join("none.toml"), none).unwrap();
+    let o = segfem(tmp.path(), &["run", "none.toml", "-o", "none"]);
+    assert_eq!(code(&o), 0, "run failed: {}", stderr(&o));
+    let (with, without) = (tmp.join("out"), tmp.join("none"));
+    assert_eq!(
+        read(&with.join("history.csv")),
+        read(&without.join("history.csv"))
+    );
+    let monitors = |d: &Path| {
+        let s: serde_json::Value = serde_json::from_str(&read(&d.join("summary.json"))).unwrap();
+        s["final_monitors"].clone()
+    };
+    assert_eq!(monitors(&with), monitors(&without));
+    let mut have: Vec<String> = std::fs::read_dir(&without)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    have.sort();
+    assert_eq!(have, ["checkpoint.bin", "history.csv", "summary.json"]);
+    assert!(n_steps > 1, "the example has several steps");
+    let o = segfem(tmp.path(), &["report", "none", "-o", "r.html"]);
+    assert_eq!(code(&o), 0, "report failed: {}", stderr(&o));
+    let html = read(&tmp.join("r.html"));
+    assert!(
+        html.contains("output = &quot;none&quot;"),
+        "the report says why it has no drawings"
+    );
+}
+
+#[test]
 fn cantilever_matches_beam_theory() {
     let tmp = TempDir::new("cantilever");
     assert_eq!(

@@ -89,7 +89,7 @@ fn model_from_mesh(
             kind: StepKind::Linear,
             factors: vec![1.0],
             increments: 1,
-            output_every_increment: false,
+            field_output: Default::default(),
             path: None,
             time: None,
         }],

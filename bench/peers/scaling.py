@@ -68,7 +68,7 @@ def main():
                 files = peers.write_linear(kind, n, d)
                 nodes = (n + 1) ** 2 if kind == "Q4" else (2 * n + 1) ** 2 - n * n
                 reps = args.reps if dofs < 1e5 else 1
-                runs = [run_segfem(files["segfem"])[:3] for _ in range(reps)]
+                runs = [run_segfem(files["segfem + .vtu"])[:3] for _ in range(reps)]
                 row = dict(kind=kind, dofs=2 * nodes, wall=statistics.median(r[0] for r in runs),
                            cpu=statistics.median(r[1] for r in runs), rss=max(r[2] for r in runs), runs=reps)
                 data["linear"].append(row)

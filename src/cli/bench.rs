@@ -88,7 +88,7 @@ pub fn banded_beam(kind: ElementKind, target_dofs: usize) -> Model {
             kind: StepKind::Linear,
             factors: vec![1.0],
             increments: 1,
-            output_every_increment: false,
+            field_output: Default::default(),
             path: None,
             time: None,
         }],

@@ -11,7 +11,7 @@ use super::prepare::{Prepared, TempFile, PREPARE_MIN_BYTES};
 use super::vtu::{render, render_into, render_pvd, Array, Grid};
 use crate::analysis::steps::{IdleWork, Observer, Snapshot};
 use crate::analysis::system::System;
-use crate::model::{Model, MonitorKind};
+use crate::model::{FieldOutput, Model, MonitorKind};
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -162,7 +162,12 @@ impl<'m> Recorder<'m> {
             lifted: Vec::new(),
             pvd: Vec::new(),
             step_end_u: Default::default(),
-            write_fields,
+            // A model whose every step has `output = "none"` prepares no .vtu memory either.
+            write_fields: write_fields
+                && model
+                    .steps
+                    .iter()
+                    .any(|s| s.field_output != FieldOutput::None),
             history: None,
             unwritten: None,
             writing: None,
@@ -517,11 +522,13 @@ impl Observer for Recorder<'_> {
         }
         // The history first: results.pvd never lists an increment history.csv lacks.
         self.flush_history()?;
-        let step = &self.model.steps[snap.step];
-        if self.write_fields && (snap.end_of_step || step.output_every_increment) {
+        let fields = self.model.steps[snap.step].field_output;
+        if !self.write_fields || fields == FieldOutput::None {
+            self.unwritten = None;
+        } else if snap.end_of_step || fields == FieldOutput::Increments {
             self.unwritten = None;
             self.write_vtu(snap)?;
-        } else if self.write_fields {
+        } else {
             self.unwritten = Some(Unwritten {
                 step: snap.step,
                 increment: snap.increment,

@@ -279,8 +279,18 @@ fn attr<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
 /// Read the `.pvd` collection in `dir` (`results.pvd`).
 pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
     let path = dir.join("results.pvd");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| ViewError::Usage(format!("{}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        // A run whose every step has `output = "none"` writes no field files.
+        let why = if e.kind() == std::io::ErrorKind::NotFound && dir.join("summary.json").is_file()
+        {
+            " (the run wrote no field files: its steps have output = \"none\", or it stopped \
+             before its first field output)"
+                .to_string()
+        } else {
+            String::new()
+        };
+        ViewError::Usage(format!("{}: {e}{why}", path.display()))
+    })?;
     let mut out: Vec<Output> = Vec::new();
     let mut lines: Vec<(f64, PathBuf)> = Vec::new();
     let mut joint_points: Vec<(f64, PathBuf)> = Vec::new();

@@ -33,6 +33,10 @@ pub fn erection_figure(dir: &Path, out: &Path) -> Result<Vec<PathBuf>, ViewError
         .map(|k| placing[k * (placing.len() - 1) / (MAX_CURVES.min(placing.len()) - 1).max(1)])
         .collect();
     chosen.dedup_by_key(|s| s.step);
+    // Steps with `output = "none"` leave no fields to draw (the plot notes the skip).
+    if !dir.join("results.pvd").is_file() {
+        return Ok(Vec::new());
+    }
     let outputs = read_pvd(dir)?;
     let mut series = Vec::new();
     for s in chosen {

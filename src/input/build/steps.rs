@@ -11,7 +11,9 @@ use super::R;
 use crate::input::error::Ctx;
 use crate::input::limits;
 use crate::input::schema::{ControlIn, StepIn};
-use crate::model::{ArcLengthControl, Dir, Geometry, Model, PathControl, Step, StepKind, TimeSpan};
+use crate::model::{
+    ArcLengthControl, Dir, FieldOutput, Geometry, Model, PathControl, Step, StepKind, TimeSpan,
+};
 
 /// The steps, with the load factors of each (totals) and their path controls.
 pub(super) fn build(ctx: &Ctx, list: &[StepIn], model: &mut Model, used: &[bool]) -> R<()> {
@@ -83,13 +85,14 @@ fn step(
         factors[c] = *f;
     }
     let increments = increments_of(ctx, &key, s, kind, time.as_ref())?;
-    let output_every_increment = match s.output.as_deref() {
-        None | Some("end") => false,
-        Some("increments") => true,
+    let field_output = match s.output.as_deref() {
+        None | Some("end") => FieldOutput::End,
+        Some("increments") => FieldOutput::Increments,
+        Some("none") => FieldOutput::None,
         Some(o) => {
             return Err(ctx.err(
                 format!("{key}.output"),
-                format!("unknown value '{o}' (expected end or increments)"),
+                format!("unknown value '{o}' (expected end, increments or none)"),
             ))
         }
     };
@@ -118,7 +121,7 @@ fn step(
         kind,
         factors: factors.clone(),
         increments,
-        output_every_increment,
+        field_output,
         path,
         time,
     })
