@@ -466,8 +466,8 @@ impl Observer for Progress<'_, '_> {
         self.rec.write_last_fields(system)
     }
 
-    fn idle_work(&mut self) -> Option<crate::analysis::steps::IdleWork> {
-        self.rec.idle_work()
+    fn idle_work(&mut self, step: usize) -> Option<crate::analysis::steps::IdleWork> {
+        self.rec.idle_work(step)
     }
 
     fn stop_requested(&self) -> Option<StopReason> {

@@ -81,8 +81,9 @@ pub trait Observer {
     /// preparing the memory of the next field output), run on a thread of its own while
     /// the next numeric factorisation runs, which is sequential and leaves the other cores
     /// idle. It may never run (no factorisation follows); the observer must not wait for
-    /// it without a way to call it off. Default: none.
-    fn idle_work(&mut self) -> Option<IdleWork> {
+    /// it without a way to call it off. `step`: the index of the step the increment
+    /// belongs to. Default: none.
+    fn idle_work(&mut self, _step: usize) -> Option<IdleWork> {
         None
     }
 }

@@ -16,13 +16,23 @@ use super::state::SystemState;
 /// (each over all dofs, at factor 1) at the factors `factors` [-]. Cases at factor 0 are
 /// skipped.
 pub(super) fn external_forces(n_dofs: usize, cases: &[Vec<f64>], factors: &[f64]) -> Vec<f64> {
-    let mut f = vec![0.0; n_dofs];
-    for (c, l) in cases.iter().zip(factors) {
-        if *l != 0.0 {
-            f.iter_mut().zip(c).for_each(|(a, v)| *a += l * v);
+    let mut f: Option<Vec<f64>> = None;
+    for (c, l) in cases.iter().zip(factors).filter(|(_, l)| **l != 0.0) {
+        match &mut f {
+            // The first case written, not added into zeros: a fresh zeroed vector read
+            // before it is written is faulted in twice per page, the second time with a TLB
+            // flush on every core (10 ms of a 5e5-dof linear run). `0.0 +` keeps the sum's
+            // bits (a −0.0 term gives +0.0).
+            None if c.len() == n_dofs => f = Some(c.iter().map(|v| 0.0 + l * v).collect()),
+            None => {
+                let mut z = vec![0.0; n_dofs];
+                z.iter_mut().zip(c).for_each(|(a, v)| *a += l * v);
+                f = Some(z);
+            }
+            Some(f) => f.iter_mut().zip(c).for_each(|(a, v)| *a += l * v),
         }
     }
-    f
+    f.unwrap_or_else(|| vec![0.0; n_dofs])
 }
 
 /// `base + λ reference` over all dofs [N]: the external forces of an arc-length step at its

@@ -393,7 +393,7 @@ impl increments::Stepper<Controller> for LoadStepper<'_> {
         ) {
             ctx.sys.extrapolate((target - ctl.level) / p);
         }
-        if let Some(work) = obs.idle_work() {
+        if let Some(work) = obs.idle_work(self.si) {
             ctx.solver.beside_next_factorisation(work);
         }
         newton(

@@ -419,9 +419,11 @@ impl<'m> Recorder<'m> {
     }
 
     /// Work preparing the next continuum .vtu's buffer and file beside the factorisation
-    /// ([`super::prepare`]), for large documents, one at a time.
-    pub fn idle_work(&mut self) -> Option<IdleWork> {
-        if !self.write_fields || self.prepared.is_some() {
+    /// ([`super::prepare`]), for large documents, one at a time; none in a step (index
+    /// `step`) that writes no fields.
+    pub fn idle_work(&mut self, step: usize) -> Option<IdleWork> {
+        let none = self.model.steps[step].field_output == FieldOutput::None;
+        if !self.write_fields || none || self.prepared.is_some() {
             return None;
         }
         let len = vtu_len(self.model);
