@@ -729,8 +729,13 @@ def report(name, unit, rows, tol, modes):
     # "segfem + .vtu" (the same run writing its field file too) is segfem, not a peer.
     peers_ = [p for p in progs if not p.startswith(seg)]
     best = {p: tuple(min(med[(p, m)][k] for m in modes) for k in (0, 1)) for p in progs}
-    ratio_wall = min(best[p][0] for p in peers_) / best[seg][0] if peers_ else float("nan")
-    ratio_cpu = min(best[p][1] for p in peers_) / best[seg][1] if peers_ else float("nan")
+
+    def over(a, b):
+        # CPU times come in 10 ms steps (the kernel's accounting): a run below that reads 0.
+        return "–" if b <= 0.0 else f"{a / b:.1f}"
+
+    ratio_wall = over(min(best[p][0] for p in peers_), best[seg][0]) if peers_ else "–"
+    ratio_cpu = over(min(best[p][1] for p in peers_), best[seg][1]) if peers_ else "–"
     lines = []
     for prog in progs:
         times = " | ".join(f"{med[(prog, m)][0]:.3f} | {med[(prog, m)][1]:.3f}" for m in modes)
@@ -739,13 +744,13 @@ def report(name, unit, rows, tol, modes):
         base = prog.split(" (")[0]
         agree = "ref" if prog == seg else ("yes" if rel <= tol.get(base.split(" + ")[0], tol["*"]) else "NO")
         if prog == seg:
-            speed = f"**{ratio_wall:.1f}× wall, {ratio_cpu:.1f}× CPU (each at its best mode)**"
+            speed = f"**{ratio_wall}× wall, {ratio_cpu}× CPU (each at its best mode)**"
         elif prog.startswith(seg) and peers_:
-            fw = min(best[p][0] for p in peers_) / best[prog][0]
-            fc = min(best[p][1] for p in peers_) / best[prog][1]
-            speed = f"{fw:.1f}× wall, {fc:.1f}× CPU with its .vtu"
+            fw = over(min(best[p][0] for p in peers_), best[prog][0])
+            fc = over(min(best[p][1] for p in peers_), best[prog][1])
+            speed = f"{fw}× wall, {fc}× CPU with its .vtu"
         else:
-            speed = f"{best[prog][0] / best[seg][0]:.1f} / {best[prog][1] / best[seg][1]:.1f}"
+            speed = f"{over(best[prog][0], best[seg][0])} / {over(best[prog][1], best[seg][1])}"
         runs = min(len(rows[(prog, m)]["wall"]) for m in modes)
         rss = max(max(rows[(prog, m)]["rss"]) for m in modes)
         lines.append(
