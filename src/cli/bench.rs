@@ -696,6 +696,12 @@ pub struct BareRow {
     pub ldlt_split_s: f64,
     pub ldlt_split_next_s: f64,
     pub ldlt_rel_diff: f64,
+    /// Medians of [`BARE_ROUNDS`]: fresh memory of the factor's size (segfem's ordering,
+    /// 8 bytes a value) faulted in on two threads, and given back [s]
+    /// ([`segfem::linalg::solver::fresh_pages_s`]): with the numeric factorisation by halves,
+    /// the least a whole run's factorisation costs on this machine.
+    pub factor_pages_fault_s: f64,
+    pub factor_pages_free_s: f64,
 }
 
 /// Shift σ of the indefinite matrix K − σ diag(K) of [`BareRow`]: a few negative
@@ -816,7 +822,15 @@ pub fn bare_factorisation(path: &std::path::Path) -> Result<BareRow, String> {
         split.solve_in_place(&mut xs);
         ldlt_rel_diff = rel_diff(&xw, &xs);
     }
+    let (mut pf, mut pu) = (vec![], vec![]);
+    for _ in 0..BARE_ROUNDS {
+        let (f, u) = segfem::linalg::solver::fresh_pages_s(8 * whole.stats.factor_nnz);
+        pf.push(f);
+        pu.push(u);
+    }
     Ok(BareRow {
+        factor_pages_fault_s: median(&mut pf),
+        factor_pages_free_s: median(&mut pu),
         equations: pattern.n,
         amd_symbolic_s,
         amd_numeric_s,

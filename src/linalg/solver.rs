@@ -291,6 +291,25 @@ pub(crate) fn populate(_ptr: *mut u8, _len: usize) -> bool {
     false
 }
 
+/// Seconds to fault in `bytes` of fresh memory on two threads (each half by [`fault_in`],
+/// as a factor's storage is) and then to give them back: what memory of a factor's size
+/// costs a run on this machine before any value is computed (a benchmark figure,
+/// docs/performance.md).
+pub fn fresh_pages_s(bytes: usize) -> (f64, f64) {
+    let t = std::time::Instant::now();
+    // Zeroed: fresh pages from the kernel, not yet faulted in.
+    let mut buf = vec![0u8; bytes];
+    let (first, second) = buf.split_at_mut(bytes / 2);
+    std::thread::scope(|s| {
+        s.spawn(|| fault_in(second.as_mut_ptr(), second.len()));
+        fault_in(first.as_mut_ptr(), first.len());
+    });
+    let fault = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    drop(buf);
+    (fault, t.elapsed().as_secs_f64())
+}
+
 /// Fault in every page of the `len` bytes at `ptr` for writing, their contents unchanged:
 /// by [`populate`] where the kernel can, else by reading and writing back one byte of each
 /// page.
