@@ -178,6 +178,10 @@ enum Command {
         /// Stop after step K (1-based) once its checkpoint is written (exit status 4).
         #[arg(long, value_name = "K")]
         stop_after_step: Option<usize>,
+        /// Write no field files (.vtu, results.pvd), whatever the steps' `output`: the
+        /// history, summary and checkpoint only, with the same numbers.
+        #[arg(long, conflicts_with = "restart")]
+        no_fields: bool,
         /// Worker threads of the element loops (default: all cores; results are
         /// bit-identical whatever the number).
         #[arg(long, value_name = "N")]
@@ -331,6 +335,7 @@ fn main() -> ExitCode {
             continue_on_failure,
             restart,
             stop_after_step,
+            no_fields,
             threads,
         } => {
             if stop_after_step == Some(0) {
@@ -357,6 +362,7 @@ fn main() -> ExitCode {
                 signal: Some(stop_on_signals()),
                 restart: restart.is_some(),
                 caller_stop: None,
+                no_fields,
             };
             let out = match (&restart, &output, &model) {
                 (Some(d), _, _) => d.clone(),

@@ -101,6 +101,10 @@ pub struct RunOptions {
     /// current increment at the request of the program running the analysis: status
     /// "stopped", exit 4, that reason in the message.
     pub caller_stop: Option<Arc<std::sync::Mutex<Option<String>>>>,
+    /// Write no field files (.vtu, results.pvd): history.csv, summary.json and the
+    /// checkpoint only, with the same numbers, as if every step had `output = "none"`
+    /// (sweeps keeping only their summaries; `segfem run --no-fields`).
+    pub no_fields: bool,
 }
 
 /// The reason a caller asked to stop with, if it did ([`RunOptions::caller_stop`]).
@@ -527,7 +531,7 @@ pub fn run_file_opts(
     } = open(path, out, opts, t0)?;
     let path = path.as_path();
     let model = built.model;
-    let mut rec = Recorder::new(&model, PathBuf::from(out), true).map_err(|e| {
+    let mut rec = Recorder::new(&model, PathBuf::from(out), !opts.no_fields).map_err(|e| {
         RunError::Io(format!(
             "{}: cannot create the output directory: {e}",
             out.display()

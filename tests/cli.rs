@@ -769,7 +769,7 @@ fn box_beam_vtu_files_are_complete() {
 
 #[test]
 fn steps_without_field_output_give_the_same_history() {
-    // output = "none" on every step: history and monitors bit for bit those of the run
+    // output = "none" on every step (and --no-fields): history and monitors bit for bit those of the run
     // with field files (the fields are written after each increment, never read back), and
     // no .vtu or results.pvd; the report still builds from the history.
     let tmp = TempDir::new("nofields");
@@ -805,6 +805,14 @@ fn steps_without_field_output_give_the_same_history() {
     have.sort();
     assert_eq!(have, ["checkpoint.bin", "history.csv", "summary.json"]);
     assert!(n_steps > 1, "the example has several steps");
+    // --no-fields on the model as given: the same.
+    let o = segfem(tmp.path(), &["run", "f.toml", "-o", "nf", "--no-fields"]);
+    assert_eq!(code(&o), 0, "run failed: {}", stderr(&o));
+    assert_eq!(
+        read(&with.join("history.csv")),
+        read(&tmp.join("nf").join("history.csv"))
+    );
+    assert!(!tmp.join("nf").join("results.pvd").exists());
     let o = segfem(tmp.path(), &["report", "none", "-o", "r.html"]);
     assert_eq!(code(&o), 0, "report failed: {}", stderr(&o));
     let html = read(&tmp.join("r.html"));

@@ -14,6 +14,7 @@ def run(
     continue_on_failure: bool = False,
     stop_after_step: Optional[int] = None,
     restart: bool = False,
+    no_fields: bool = False,
 ) -> Tuple[Outcome, Optional[BaseException]]:
     """Run a model file into out_dir as `segfem run`, without the GIL; returns
     ((exit status, kind, message, summary JSON), exception raised in progress or None)."""

@@ -162,6 +162,7 @@ class Model:
         verbose: bool = False,
         continue_on_failure: bool = False,
         stop_after_step: Optional[int] = None,
+        fields: bool = True,
     ) -> Result:
         """Run the model as ``segfem run`` does and return its :class:`~segfem.Result`.
 
@@ -169,6 +170,9 @@ class Model:
         go (files of an earlier run there are replaced); None: a temporary directory that
         lives as long as the Result. A model given as data is written there first as
         ``name`` (default model.toml), the file the run reads and the checkpoint names.
+        ``fields=False`` writes no field files (.vtu, results.pvd) whatever the steps'
+        ``output``, as ``segfem run --no-fields``: the history, summary and checkpoint
+        only, with the same numbers.
 
         ``progress(p)`` is called after every converged increment with a dict: ``step``
         (1-based), ``step_name``, ``steps``, ``increment``, ``end_of_step``,
@@ -206,6 +210,7 @@ class Model:
             stop_after_step=stop_after_step,
             restart=False,
             tmp=tmp,
+            no_fields=not fields,
         )
 
     def _text_for(self, out: Path) -> str:
@@ -274,6 +279,7 @@ def _run(
     stop_after_step: Optional[int],
     restart: bool,
     tmp: Optional[tempfile.TemporaryDirectory],
+    no_fields: bool = False,
 ) -> Result:
     (code, kind, message, summary), raised = _native.run(
         model,
@@ -283,6 +289,7 @@ def _run(
         continue_on_failure=continue_on_failure,
         stop_after_step=stop_after_step,
         restart=restart,
+        no_fields=no_fields,
     )
     if kind == "input":
         raise InputError(message)

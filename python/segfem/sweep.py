@@ -568,7 +568,8 @@ def run_case(task: Dict[str, Any]) -> Dict[str, Any]:
             case_dir = Path(tmp.name)
         else:
             case_dir = Path(task["case_dir"])
-        r = model.run(case_dir)
+        # Cases that keep only their summaries write no field files at all.
+        r = model.run(case_dir, fields=task["keep"] == "all")
         u = r.ultimate or {}
         s = r.summary
         res.update(

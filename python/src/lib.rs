@@ -79,7 +79,7 @@ fn snapshot_dict<'py>(py: Python<'py>, s: &Snapshot) -> PyResult<Bound<'py, PyDi
 // The keyword arguments of the Python call, one per `segfem run` option.
 #[allow(clippy::too_many_arguments)]
 #[pyfunction]
-#[pyo3(signature = (model, out_dir, progress=None, verbose=false, continue_on_failure=false, stop_after_step=None, restart=false))]
+#[pyo3(signature = (model, out_dir, progress=None, verbose=false, continue_on_failure=false, stop_after_step=None, restart=false, no_fields=false))]
 fn run(
     py: Python<'_>,
     model: Option<PathBuf>,
@@ -89,6 +89,7 @@ fn run(
     continue_on_failure: bool,
     stop_after_step: Option<usize>,
     restart: bool,
+    no_fields: bool,
 ) -> (Outcome, Option<PyErr>) {
     let flag = Arc::new(AtomicUsize::new(0));
     let stop = Arc::new(std::sync::Mutex::new(None));
@@ -99,6 +100,7 @@ fn run(
         signal: Some(flag.clone()),
         restart,
         caller_stop: Some(stop.clone()),
+        no_fields,
     };
     let mut raised: Option<PyErr> = None;
     let res = {

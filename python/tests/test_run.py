@@ -233,3 +233,16 @@ def test_sigint_from_outside_during_the_solve(seed_beam, tmp_path):
     assert r.status == "interrupted"
     assert r.history["step"].iloc[-1] >= 3
     assert r.summary["resume_step"] in (3, 4)
+
+
+def test_run_without_fields_gives_the_same_history(cli, seed_beam, tmp_path):
+    # fields=False (segfem run --no-fields): no .vtu or results.pvd, and the history and the
+    # summary's answers bit for bit those of the run that writes its fields.
+    assert cli_run(cli, seed_beam, tmp_path / "cli").returncode == 0
+    result = segfem.load(seed_beam).run(tmp_path / "py", fields=False)
+    assert result.status == "completed"
+    out = tmp_path / "py"
+    assert (out / "history.csv").read_bytes() == (tmp_path / "cli" / "history.csv").read_bytes()
+    assert not list(out.glob("*.vtu")) and not (out / "results.pvd").exists()
+    cli_sum = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert without_timings(result.summary) == without_timings(cli_sum)
