@@ -653,8 +653,11 @@ def wall_rows_segfem(out):
 def run_segfem(path, answers_of):
     out = path.parent / "segfem_out"
     # Exit status 3: the run ended where no equilibrium was found past the peak (the panel's
-    # end); the results up to there are written.
-    wall, rss, _, _ = peers.timed([peers.segfem_bin(), "run", "-q", path.name, "-o", out.name], path.parent, ok=(0, 3))
+    # end); the results up to there are written. No field files (--no-fields): OpenSees
+    # writes its rows only, segfem its history, summary and checkpoint (issue 43 item 1).
+    wall, rss, _, _ = peers.timed(
+        [peers.segfem_bin(), "run", "-q", "--no-fields", path.name, "-o", out.name], path.parent, ok=(0, 3)
+    )
     cpu = peers.CPU_TIMES[-1]
     data, its = answers_of(out)
     return dict(wall=wall, cpu=cpu, rss=rss, iterations=its, increments=len(data), data=data)
