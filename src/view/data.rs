@@ -280,11 +280,12 @@ fn attr<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
 pub fn read_pvd(dir: &Path) -> Result<Vec<Output>, ViewError> {
     let path = dir.join("results.pvd");
     let text = std::fs::read_to_string(&path).map_err(|e| {
-        // A run whose every step has `output = "none"` writes no field files.
+        // A run whose every step has `output = "none"`, or run with --no-fields, writes no
+        // field files.
         let why = if e.kind() == std::io::ErrorKind::NotFound && dir.join("summary.json").is_file()
         {
-            " (the run wrote no field files: its steps have output = \"none\", or it stopped \
-             before its first field output)"
+            " (the run wrote no field files: its steps have output = \"none\" or it ran with \
+             --no-fields, or it stopped before its first field output)"
                 .to_string()
         } else {
             String::new()
