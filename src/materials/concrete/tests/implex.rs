@@ -617,15 +617,18 @@ fn implex_compression_error_of_an_uncracked_point_is_its_extrapolated_flow() {
 }
 
 /// The same for a cracked point (docs/theory-concrete.md §4): cracked along x (opened to
-/// 3 ε0 and held), compressed along y — a crack axis, the 1-D crush-band law of
-/// [`crack_axis_law`] — past the peak in equal increments Δ, then one increment of r Δ
-/// with ratio r. The direction's implicit stress is −σ_c(ε̄) = E (e + p(ε̄)), ε̄ = −e,
-/// p = ε̄ − σ_c(ε̄)/E, its IMPL-EX one E (e + p̃), so Δσ_y = E (p̃ − p(ε̄_k)) from the
-/// closed-form law; the crack (held at its largest strain, no extrapolation) adds nothing,
-/// and with the crack at 0° Δσ = (0, Δσ_y, 0). The point error is |Δσ_y|/f_cm. Tolerance
-/// 1e-6 of the difference (the 1-D return is closed form; the law is checked at 1e-6 f_cm
-/// in `implex_compression_of_a_crack_direction_is_linear_in_the_increment`, against
-/// differences of 1e-3 to 0.06 f_cm here). None with the option off or in a time increment.
+/// 3 ε0), then compressed along a crack axis — y, parallel to the crack (the crack held
+/// open), or x, the crack's normal (the crack closed) — the 1-D crush-band law of
+/// [`crack_axis_law`] in both, past the peak in equal increments Δ, then one increment of
+/// r Δ with ratio r. The direction's implicit stress is −σ_c(ε̄) = E (e + p(ε̄)), ε̄ = −e,
+/// p = ε̄ − σ_c(ε̄)/E, its IMPL-EX one E (e + p̃), so its difference is E (p̃ − p(ε̄_k))
+/// from the closed-form law; the crack adds nothing (held at its largest strain, or closed),
+/// nor does the other direction (unstrained, elastic), and with the crack at 0° Δσ is that
+/// difference on the compressed axis alone. The point error is its magnitude over f_cm.
+/// Tolerance 1e-6 of the difference (the 1-D return is closed form; the law is checked at
+/// 1e-6 f_cm in `implex_compression_of_a_crack_direction_is_linear_in_the_increment`,
+/// against differences of 1e-3 to 0.06 f_cm here). None with the option off or in a time
+/// increment.
 #[test]
 fn implex_compression_error_of_a_crack_direction_is_its_extrapolated_flow() {
     let h = 0.1;
@@ -642,42 +645,55 @@ fn implex_compression_error_of_a_crack_direction_is_its_extrapolated_flow() {
         1.5 * p.eps_c1 + 2.0 * step.abs() < 0.9 * eu,
         "short of crushing"
     );
-    let mut st = update_extrapolated(&q, &ConcreteState::new(), &[ex, 0.0, 0.0], h, 0.0)
-        .unwrap()
-        .0;
-    assert_eq!((st.n_cracks, st.crack_angle), (1, 0.0));
-    for k in 1..n {
-        let ratio = if k == 1 { 0.0 } else { 1.0 };
-        st = update_extrapolated(&q, &st, &[ex, step * k as f64, 0.0], h, ratio)
+    for axis in [1, 0] {
+        // The strain with `e` on the compressed axis: y with the crack open at 3 ε0, or
+        // x (the crack closed) with y unstrained.
+        let strain = |e: f64| {
+            if axis == 1 {
+                [ex, e, 0.0]
+            } else {
+                [e, 0.0, 0.0]
+            }
+        };
+        let mut st = update_extrapolated(&q, &ConcreteState::new(), &[ex, 0.0, 0.0], h, 0.0)
             .unwrap()
             .0;
-    }
-    let k = n - 1;
-    assert!(-step * (k - 1) as f64 > p.eps_c1, "past the peak");
-    let (pn, po) = (plastic(-step * k as f64), plastic(-step * (k - 1) as f64));
-    for r in [0.0f64, 0.5, 1.0, 2.0] {
-        let e = step * (k as f64 + r.max(0.25));
-        let strain = [ex, e, 0.0];
-        let t = update_extrapolated(&q, &st, &strain, h, r).unwrap().0;
-        assert!(t.n_cracks == 1 && !t.is_crushed());
-        let want = p.ec * (pn + r * (pn - po) - plastic(-e));
-        let got = point_stress_error(&q, &st, &t, h, r, 0.0);
-        assert!(got[0].abs() <= 1e-9 * p.fcm, "r = {r}: Δσx {}", got[0]);
-        assert!(
-            (got[1] - want).abs() <= 1e-6 * want.abs(),
-            "r = {r}: Δσy {} want {want}",
-            got[1]
-        );
-        assert!(got[2].abs() <= 1e-9 * p.fcm, "r = {r}: τ {}", got[2]);
-        let err = point_error(&q, &st, &t, h, r, 0.0);
-        assert!(
-            (err - want.abs() / p.fcm).abs() <= 1e-6 * want.abs() / p.fcm,
-            "r = {r}: {err} f_cm, want {}",
-            want.abs() / p.fcm
-        );
-        let ti = update_extrapolated(&p, &st, &strain, h, r).unwrap().0;
-        assert_eq!(point_stress_error(&p, &st, &ti, h, r, 0.0), [0.0; 3]);
-        assert_eq!(point_stress_error(&q, &st, &t, h, r, 1.0), [0.0; 3]);
-        assert_eq!(point_error(&q, &st, &t, h, r, 1.0), 0.0);
+        assert_eq!((st.n_cracks, st.crack_angle), (1, 0.0));
+        for k in 1..n {
+            let ratio = if k == 1 { 0.0 } else { 1.0 };
+            st = update_extrapolated(&q, &st, &strain(step * k as f64), h, ratio)
+                .unwrap()
+                .0;
+        }
+        let k = n - 1;
+        assert!(-step * (k - 1) as f64 > p.eps_c1, "past the peak");
+        let (pn, po) = (plastic(-step * k as f64), plastic(-step * (k - 1) as f64));
+        for r in [0.0f64, 0.5, 1.0, 2.0] {
+            let e = step * (k as f64 + r.max(0.25));
+            let t = update_extrapolated(&q, &st, &strain(e), h, r).unwrap().0;
+            assert!(t.n_cracks == 1 && !t.is_crushed());
+            let want = p.ec * (pn + r * (pn - po) - plastic(-e));
+            let got = point_stress_error(&q, &st, &t, h, r, 0.0);
+            assert!(
+                got[1 - axis].abs() <= 1e-9 * p.fcm,
+                "axis {axis}, r = {r}: the other direction {got:?}"
+            );
+            assert!(
+                (got[axis] - want).abs() <= 1e-6 * want.abs(),
+                "axis {axis}, r = {r}: Δσ {} want {want}",
+                got[axis]
+            );
+            assert!(got[2].abs() <= 1e-9 * p.fcm, "r = {r}: τ {}", got[2]);
+            let err = point_error(&q, &st, &t, h, r, 0.0);
+            assert!(
+                (err - want.abs() / p.fcm).abs() <= 1e-6 * want.abs() / p.fcm,
+                "axis {axis}, r = {r}: {err} f_cm, want {}",
+                want.abs() / p.fcm
+            );
+            let ti = update_extrapolated(&p, &st, &strain(e), h, r).unwrap().0;
+            assert_eq!(point_stress_error(&p, &st, &ti, h, r, 0.0), [0.0; 3]);
+            assert_eq!(point_stress_error(&q, &st, &t, h, r, 1.0), [0.0; 3]);
+            assert_eq!(point_error(&q, &st, &t, h, r, 1.0), 0.0);
+        }
     }
 }
