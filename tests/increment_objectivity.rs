@@ -327,8 +327,10 @@ fn summary_and_report_state_the_path_error_at_the_peak() {
 /// `SEGFEM_PUSH_MM` (20), `SEGFEM_OPTION` (the bench's model option, "fixed, seed β"),
 /// `SEGFEM_TOL` (`increment_tolerance`), `SEGFEM_IMPLEX_TOL` (`implex_tolerance`),
 /// `SEGFEM_IMPLEX_FORCE_TOL` (`implex_force_tolerance`), `SEGFEM_IMPLEX_NORM`
-/// (`implex_force_norm`) (each none: off / the default); prints its peak, increments, CPU
-/// time and the controls' counts.
+/// (`implex_force_norm`), `SEGFEM_COMPRESSION` (`compression_integration`) (each none: off
+/// / the default); prints its peak, increments, CPU time and the controls' counts. With
+/// `SEGFEM_DUMP` set to a file it writes the model text there instead of running (for
+/// `segfem run` with two binaries on the same input).
 #[test]
 #[ignore = "measurement, run by hand"]
 fn measure_shear_beam() {
@@ -346,6 +348,11 @@ fn measure_shear_beam() {
         .ok()
         .map(|v| format!("\"{v}\""));
     let (beam, keys) = shear_beam(&id, &option);
+    let keys = match std::env::var("SEGFEM_COMPRESSION") {
+        Ok(v) => format!("{keys}compression_integration = \"{v}\"\n"),
+        Err(_) => keys.to_string(),
+    };
+    let keys = keys.as_str();
     let mut solver = String::new();
     for (key, v) in [
         ("increment_tolerance", &tol),
@@ -356,6 +363,11 @@ fn measure_shear_beam() {
         if let Some(v) = v {
             solver.push_str(&format!("{key} = {v}\n"));
         }
+    }
+    if let Ok(path) = std::env::var("SEGFEM_DUMP") {
+        let text = crate::beam_bench::beam_toml(&beam, keys, rows, -push * 1e-3, inc * 1e-3);
+        std::fs::write(path, text + &solver).unwrap();
+        return;
     }
     let cpu0 = bench::process_cpu_s();
     let r = run_beam_solver(&beam, keys, rows, -push * 1e-3, inc * 1e-3, &solver).unwrap();

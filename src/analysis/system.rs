@@ -995,7 +995,7 @@ impl<'m> System<'m> {
         let model = self.model;
         let c = &self.families.continuum;
         let gp_offset = &self.gp_offset;
-        let ratio = self.time.extrapolation;
+        let (ratio, dt) = (self.time.extrapolation, self.time.dt());
         (0..model.elements.len())
             .into_par_iter()
             .map(|e| {
@@ -1013,7 +1013,7 @@ impl<'m> System<'m> {
                     .map(|g| match (&c.points.committed[g], &c.points.trial[g]) {
                         (PointState::Concrete(cs), PointState::Concrete(ts)) => {
                             crate::materials::concrete::implex::point_error(
-                                params, cs, ts, h, ratio,
+                                params, cs, ts, h, ratio, dt,
                             )
                         }
                         _ => 0.0,
@@ -1050,7 +1050,7 @@ impl<'m> System<'m> {
         use crate::materials::point::Material;
         let model = self.model;
         let c = &self.families.continuum;
-        let ratio = self.time.extrapolation;
+        let (ratio, dt) = (self.time.extrapolation, self.time.dt());
         let stages = self.stages.as_ref();
         // Each element's nodal forces, in parallel; summed into the dofs in element order.
         let forces: Vec<Option<Vec<f64>>> = (0..model.elements.len())
@@ -1072,7 +1072,7 @@ impl<'m> System<'m> {
                     .map(|gp| match (&c.points.committed[gp], &c.points.trial[gp]) {
                         (PointState::Concrete(cs), PointState::Concrete(ts)) => {
                             crate::materials::concrete::implex::point_stress_error(
-                                params, cs, ts, h, ratio,
+                                params, cs, ts, h, ratio, dt,
                             )
                         }
                         _ => [0.0; 3],

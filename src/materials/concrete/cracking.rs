@@ -417,6 +417,112 @@ fn implex_direction(
     (r.sigma, r.k)
 }
 
+/// What a cracked point's crack-axis laws share within one update: the crack band's
+/// softening parameter, the hardening law, the crack axes and the strains in them, and each
+/// direction's compression reduction from the other's tensile strain.
+struct Axes {
+    /// Softening parameter of the tension envelope [-].
+    alpha: f64,
+    /// The hardening law of the 1-D compression laws.
+    law: compression::HardeningLaw,
+    /// Strain transformation into the crack axes ([`strain_transform`]).
+    t: [[f64; 3]; 3],
+    /// Elastic strain (strain less the plastic strain of the uncracked state) in the crack
+    /// axes [-]: (e_n, e_t, γ_nt).
+    el: [f64; 3],
+    /// Compression reduction β_d [-] and dβ_d/dε_lat [-] of each direction.
+    red: [(f64, f64); 2],
+}
+
+impl Axes {
+    /// The crack axes of `committed` at `strain` [-] on an element of crack band width
+    /// `char_length` [m].
+    fn new(
+        p: &ConcreteParams,
+        committed: &ConcreteState,
+        strain: &[f64; 3],
+        char_length: f64,
+    ) -> Self {
+        let t = strain_transform(committed.crack_angle);
+        let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
+        let el: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * ee[j]).sum());
+        // Compression softening of each direction by the other one's tensile strain.
+        let lateral = |j: usize| (el[j] + committed.dir_plastic[j]).max(0.0);
+        Self {
+            alpha: p.softening_alpha(char_length),
+            law: compression::HardeningLaw::new(p),
+            t,
+            el,
+            red: [
+                super::reduction::factor(p, lateral(1), char_length),
+                super::reduction::factor(p, lateral(0), char_length),
+            ],
+        }
+    }
+
+    /// The committed history of direction `i` with `n_cracks` cracks and largest crack
+    /// strains `crack_max` [-] (IMPL-EX cracks: e_max extrapolated with `ratio` [-]).
+    fn history(
+        &self,
+        p: &ConcreteParams,
+        committed: &ConcreteState,
+        ratio: f64,
+        i: usize,
+        n_cracks: u8,
+        crack_max: &[f64; 2],
+    ) -> DirHistory {
+        let cracked = (i as u8) < n_cracks;
+        DirHistory {
+            cracked,
+            emax: crack_max[i],
+            ebar: committed.dir_ebar[i],
+            plastic: committed.dir_plastic[i],
+            frozen: committed.frozen[i],
+            extrapolated: (p.implex && cracked)
+                .then(|| super::implex::extrapolated_max(committed, i, ratio)),
+            reduction: self.red[i],
+        }
+    }
+}
+
+/// The IMPL-EX compression's stress differences σ_implex − σ_implicit [Pa] of a cracked
+/// point's two crack-axis directions at `strain` [-] (`compression_integration = "implex"`,
+/// docs/theory-concrete.md §4): per direction, the stress of [`implex_direction`] at the
+/// plastic strain extrapolated with `ratio` [-] ([`implex_plastic`]) minus the implicit
+/// law's ([`direction`]) at the same direction strain, both from the committed history and
+/// with the same (IMPL-EX or implicit) crack law in tension, so that the crack laws'
+/// own difference is not counted here. Zero where both laws give no stress (two open
+/// cracks with `double_crack = "zero"`, decided on the committed state as in the update).
+/// `p` must be the element's parameters (the crush band's ε_u set), `committed` cracked.
+pub(super) fn implex_compression_differences(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    strain: &[f64; 3],
+    char_length: f64,
+    ratio: f64,
+) -> [f64; 2] {
+    let both_open = committed.n_cracks >= 2
+        && committed.crack_strain[0] > 0.0
+        && committed.crack_strain[1] > 0.0;
+    if both_open && p.zero_double_crack {
+        return [0.0; 2];
+    }
+    let axes = Axes::new(p, committed, strain, char_length);
+    std::array::from_fn(|i| {
+        let h = axes.history(
+            p,
+            committed,
+            ratio,
+            i,
+            committed.n_cracks,
+            &committed.crack_max,
+        );
+        let pt = implex_plastic(committed, i, ratio);
+        let (s, _) = implex_direction(p, &axes.law, axes.alpha, h, pt, axes.el[i]);
+        s - direction(p, &axes.law, axes.alpha, h, axes.el[i]).sigma
+    })
+}
+
 /// Stress update of a cracked point (`committed.n_cracks` ≥ 1); `implex_c`: IMPL-EX
 /// compression in the crack-axis directions (see [`update_cracked_into`]).
 pub fn update_cracked(
@@ -459,35 +565,23 @@ pub fn update_cracked_into(
             "crack band needs a positive characteristic length, got {char_length}"
         )));
     }
-    let alpha = p.softening_alpha(char_length);
-    let law = compression::HardeningLaw::new(p);
-    let t = strain_transform(committed.crack_angle);
-    let ee: [f64; 3] = std::array::from_fn(|i| strain[i] - committed.plastic_strain[i]);
-    let el: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * ee[j]).sum());
+    let axes = Axes::new(p, committed, strain, char_length);
+    let Axes {
+        alpha,
+        ref law,
+        t,
+        el,
+        ..
+    } = axes;
     let mut n_cracks = committed.n_cracks;
     let mut crack_max = committed.crack_max;
     // IMPL-EX: e_max extrapolated linearly from the last two committed states.
     let extrapolate = |i: usize| super::implex::extrapolated_max(committed, i, ratio);
-    // Compression softening of each direction by the other one's tensile strain.
-    let lateral = |j: usize| (el[j] + committed.dir_plastic[j]).max(0.0);
-    let red = [
-        super::reduction::factor(p, lateral(1), char_length),
-        super::reduction::factor(p, lateral(0), char_length),
-    ];
     let history = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
-        let cracked = (i as u8) < n_cracks;
-        DirHistory {
-            cracked,
-            emax: crack_max[i],
-            ebar: committed.dir_ebar[i],
-            plastic: committed.dir_plastic[i],
-            frozen: committed.frozen[i],
-            extrapolated: (p.implex && cracked).then(|| extrapolate(i)),
-            reduction: red[i],
-        }
+        axes.history(p, committed, ratio, i, n_cracks, crack_max)
     };
     let eval = |i: usize, n_cracks: u8, crack_max: &[f64; 2]| {
-        direction(p, &law, alpha, history(i, n_cracks, crack_max), el[i])
+        direction(p, law, alpha, history(i, n_cracks, crack_max), el[i])
     };
     let r0 = eval(0, n_cracks, &crack_max);
     let mut r1 = eval(1, n_cracks, &crack_max);
@@ -526,7 +620,7 @@ pub fn update_cracked_into(
         for (i, r) in [&mut r0, &mut r1].into_iter().enumerate() {
             let h = history(i, committed.n_cracks, &committed.crack_max);
             let pt = implex_plastic(committed, i, ratio);
-            (r.sigma, r.k) = implex_direction(p, &law, alpha, h, pt, el[i]);
+            (r.sigma, r.k) = implex_direction(p, law, alpha, h, pt, el[i]);
             r.d_lateral = 0.0;
         }
     }

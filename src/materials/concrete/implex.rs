@@ -162,20 +162,108 @@ pub fn direction_differences(
     (d, trial.crack_angle)
 }
 
+/// The IMPL-EX compression's part of a point's stress error (docs/theory-concrete.md §4):
+/// where the compression extrapolation acted in the increment, σ_implex − σ_implicit at the
+/// converged strain from the compressive plastic strain's extrapolation alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CompressionDifference {
+    /// The option did not act (off, a time increment, a crushed point, or a point that
+    /// cracks in the increment): no difference.
+    None,
+    /// An uncracked point: Δσ = D (εᵖ_impl − ε̃ᵖ) [Pa] (σ_xx, σ_yy, τ_xy), εᵖ_impl the
+    /// implicit update's plastic strain, ε̃ᵖ = εᵖ_n + r (εᵖ_n − εᵖ_n−1) the extrapolation.
+    Uncracked([f64; 3]),
+    /// A cracked point: per crack-axis direction the IMPL-EX compression law's stress minus
+    /// the implicit 1-D law's [Pa], in the axes of the point's first crack.
+    Cracked([f64; 2]),
+}
+
+/// The IMPL-EX compression's stress difference of a concrete point at the end of an
+/// increment of `dt` [d] (only load-type increments, `dt` = 0, extrapolate; arguments as
+/// [`point_error`]): [`CompressionDifference::None`] unless `compression_integration =
+/// "implex"` acted — a point uncracked in its committed and trial states (not crushed), or
+/// a point cracked in its committed state whose trial is not crushed.
+pub fn compression_difference(
+    p: &ConcreteParams,
+    committed: &ConcreteState,
+    trial: &ConcreteState,
+    char_length: f64,
+    ratio: f64,
+    dt: f64,
+) -> CompressionDifference {
+    if !(p.implex && p.compression_implex && dt == 0.0)
+        || p.crack_model != CrackModel::Fixed
+        || trial.crushed
+        || committed.crushed
+    {
+        return CompressionDifference::None;
+    }
+    if committed.n_cracks == 0 {
+        if trial.n_cracks > 0 {
+            return CompressionDifference::None;
+        }
+        let dp: [f64; 3] = std::array::from_fn(|i| {
+            let c = committed.plastic_strain[i];
+            trial.plastic_strain[i] - (c + ratio * (c - committed.plastic_strain_old[i]))
+        });
+        if dp == [0.0; 3] {
+            return CompressionDifference::Uncracked([0.0; 3]);
+        }
+        let d = super::d_matrix(p.ec, p.nu);
+        return CompressionDifference::Uncracked(std::array::from_fn(|i| {
+            (0..3).map(|j| d[i][j] * dp[j]).sum()
+        }));
+    }
+    // The element's parameters, as in the update (the crush band's ε_u).
+    let local;
+    let p = if p.crush_eu.is_none() && p.compression_softening != super::CompressionSoftening::Mc90
+    {
+        match p.for_element(char_length) {
+            Ok(q) => {
+                local = q;
+                &local
+            }
+            Err(_) => return CompressionDifference::None,
+        }
+    } else {
+        p
+    };
+    CompressionDifference::Cracked(super::cracking::implex_compression_differences(
+        p,
+        committed,
+        &trial.strain,
+        char_length,
+        ratio,
+    ))
+}
+
 /// The IMPL-EX stress error of a concrete point as a stress [Pa] (σ_xx, σ_yy, τ_xy):
 /// Δσ = Σ_i (σ_implex,i − σ_implicit,i) n_i ⊗ n_i over its two crack directions
 /// ([`direction_differences`], n_1 at φ from x, n_2 at φ + 90°). In the crack axes the two
 /// integrations differ only in the crack-normal stresses at the same strain (the shear
 /// retention's β(ε̃) is not compared, as in [`point_error`]), so this is the stress the
-/// implicit law would remove from (add to) the point at the converged strain.
+/// implicit law would remove from (add to) the point at the converged strain. With
+/// `compression_integration = "implex"` in a load-type increment (`dt` = 0 [d]) the
+/// compression extrapolation's difference ([`compression_difference`]) is included: a
+/// cracked point's is added to each direction's crack difference before the rotation, an
+/// uncracked point's Δσ = D (εᵖ_impl − ε̃ᵖ) is the whole error.
 pub fn point_stress_error(
     p: &ConcreteParams,
     committed: &ConcreteState,
     trial: &ConcreteState,
     char_length: f64,
     ratio: f64,
+    dt: f64,
 ) -> [f64; 3] {
-    let ([d1, d2], phi) = direction_differences(p, committed, trial, char_length, ratio);
+    let ([mut d1, mut d2], phi) = direction_differences(p, committed, trial, char_length, ratio);
+    match compression_difference(p, committed, trial, char_length, ratio, dt) {
+        CompressionDifference::None => {}
+        CompressionDifference::Uncracked(ds) => return ds,
+        CompressionDifference::Cracked([c1, c2]) => {
+            d1 += c1;
+            d2 += c2;
+        }
+    }
     let (s, c) = phi.sin_cos();
     // n_1 = (c, s), n_2 = (−s, c): n n = [[c², cs], [cs, s²]] and [[s², −cs], [−cs, c²]].
     [
@@ -185,22 +273,38 @@ pub fn point_stress_error(
     ]
 }
 
-/// IMPL-EX error of a concrete point at the end of an increment [-]: the largest
+/// IMPL-EX error of a concrete point at the end of an increment of `dt` [d]: the largest
 /// |σ_implex − σ_implicit| / f_tm over its crack directions (docs/theory-concrete.md §5.2,
 /// "Error control"), `committed` the state the increment started from, `trial` its converged
 /// state, `char_length` [m] the crack band width and `ratio` [-] the extrapolation ratio the
 /// increment used. σ_implicit is the stress the implicit crack law would give at the same
 /// crack strain from the committed history. Only the directions cracked in the committed
 /// state are measured (a fixed crack forming in the increment, elastic in it, is not; a
-/// rotating point's first increment past ε0 is, against the envelope). 0 without IMPL-EX,
-/// for crushed points and for uncracked ones.
+/// rotating point's first increment past ε0 is, against the envelope). With
+/// `compression_integration = "implex"` in a load-type increment (`dt` = 0) the compression
+/// extrapolation's difference ([`compression_difference`]) is measured as well, relative to
+/// f_cm (docs/theory-concrete.md §4): a cracked point's per crack-axis direction, an
+/// uncracked point's as the largest absolute principal value of its Δσ; the point's error
+/// is the larger of the two parts [-]. 0 without IMPL-EX and for crushed points.
 pub fn point_error(
     p: &ConcreteParams,
     committed: &ConcreteState,
     trial: &ConcreteState,
     char_length: f64,
     ratio: f64,
+    dt: f64,
 ) -> f64 {
     let (d, _) = direction_differences(p, committed, trial, char_length, ratio);
-    d[0].abs().max(d[1].abs()) / p.ftm
+    let cracks = d[0].abs().max(d[1].abs()) / p.ftm;
+    let compression = match compression_difference(p, committed, trial, char_length, ratio, dt) {
+        CompressionDifference::None => return cracks,
+        CompressionDifference::Uncracked(ds) => {
+            // Largest |principal value| of the symmetric Δσ.
+            let m = 0.5 * (ds[0] + ds[1]);
+            let r = (0.25 * (ds[0] - ds[1]).powi(2) + ds[2] * ds[2]).sqrt();
+            m.abs() + r
+        }
+        CompressionDifference::Cracked(c) => c[0].abs().max(c[1].abs()),
+    };
+    cracks.max(compression / p.fcm)
 }

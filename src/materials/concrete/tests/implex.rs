@@ -1,6 +1,6 @@
 //! The IMPL-EX tension law within an increment (`implex.rs`, docs/theory-concrete.md §5.2).
 
-use super::super::implex::{exp_e1, point_error, secant_integral, tension};
+use super::super::implex::{exp_e1, point_error, point_stress_error, secant_integral, tension};
 use super::*;
 
 /// E₁(x) against the exponential integral tabulated to 17 digits (mpmath `e1`), on both
@@ -165,7 +165,7 @@ fn implex_error_measure_matches_hand_values() {
         let t = update_extrapolated(&p, &c, &[e, 0.0, 0.0], 0.1, ratio)
             .unwrap()
             .0;
-        point_error(&p, &c, &t, 0.1, ratio)
+        point_error(&p, &c, &t, 0.1, ratio, 0.0)
     };
     let want = [
         (
@@ -203,14 +203,14 @@ fn implex_error_measure_matches_hand_values() {
         .0;
     assert_eq!(t.n_cracks, 1);
     assert_eq!(
-        point_error(&p, &v, &t, 0.1, 0.0),
+        point_error(&p, &v, &t, 0.1, 0.0, 0.0),
         0.0,
         "formation not measured"
     );
     let n = update_extrapolated(&p, &t, &[5.0 * e0, 0.0, 0.0], 0.1, 1.0)
         .unwrap()
         .0;
-    let got = point_error(&p, &t, &n, 0.1, 1.0);
+    let got = point_error(&p, &t, &n, 0.1, 1.0, 0.0);
     let (a, b) = (3.0 * e0, 5.0 * e0);
     let w = (env(a) + simpson(&p, alpha, a, b, 4000) - env(b)) / ft;
     assert!(
@@ -220,7 +220,7 @@ fn implex_error_measure_matches_hand_values() {
     // Off without IMPL-EX.
     let mut q = p.clone();
     q.implex = false;
-    assert_eq!(point_error(&q, &v, &t, 0.1, 0.0), 0.0);
+    assert_eq!(point_error(&q, &v, &t, 0.1, 0.0, 0.0), 0.0);
 }
 
 /// IMPL-EX in compression (`compression_integration = "implex"`, docs/theory-concrete.md
@@ -508,4 +508,192 @@ fn implex_compression_crushes_a_cracked_point_at_the_end_of_the_increment() {
         k == reach || k == reach + 1,
         "crushed at {k}, ε_u reached at {reach}"
     );
+}
+
+/// The MC90 curve σ_c(ε̄) [Pa] up to and past the peak, in closed form:
+/// f_cm (k η − η²)/(1 + (k − 2) η), η = ε̄/ε_c1, k = E ε_c1/f_cm; and its compressive
+/// plastic strain magnitude in uniaxial compression with zero initial yield,
+/// p = ε̄ − σ_c(ε̄)/E (docs/theory-concrete.md §4: κ = ε̄ − σ_c/E − κ0, κ0 = 0).
+fn mc90_plastic(p: &ConcreteParams, eb: f64) -> f64 {
+    let (k, eta) = (p.ec * p.eps_c1 / p.fcm, eb / p.eps_c1);
+    let s = p.fcm * (k * eta - eta * eta) / (1.0 + (k - 2.0) * eta);
+    eb - s / p.ec
+}
+
+/// The IMPL-EX error measures see the compression extrapolation (docs/theory-concrete.md
+/// §4, "IMPL-EX in compression"): an uncracked point in uniaxial compression past
+/// the MC90 peak (ν = 0, so σ_x = E (ε_x − εᵖ_x) whatever the lateral strain), two committed
+/// increments of equal size Δ, then one of size r Δ with extrapolation ratio r. In 1-D
+/// ε̄ = −ε_x and the plastic strain is −p(ε̄), p = ε̄ − σ_c(ε̄)/E ([`mc90_plastic`]), so the
+/// stress difference at the converged strain is Δσ_x = E (p̃ − p(ε̄_k)),
+/// p̃ = p_n + r (p_n − p_n−1) — computed here from the curve's formula. Δσ_y = E (ε_y,k −
+/// ε̃_y) (σ_y = 0 makes the lateral plastic strain the lateral strain of the path), τ 0.
+/// The point error is the largest of |Δσ_x|, |Δσ_y| over f_cm. Tolerance 1e-6 of the
+/// difference: the return mapping's tolerance (1e-11 scaled) and the path's σ_y = 0 to
+/// 1e-10 f_cm, against differences of 9e-4 to 0.05 f_cm (Δσ_y, the Ottosen flow's
+/// dilatancy, is 3.3× Δσ_x here).
+/// No difference with the option off, in a time increment (dt > 0) and in an elastic
+/// increment (a point that flowed in neither).
+#[test]
+fn implex_compression_error_of_an_uncracked_point_is_its_extrapolated_flow() {
+    let mut p = ConcreteParams::from_mc90(FCM, 0.0);
+    p.implex = true;
+    let mut q = p.clone();
+    q.compression_implex = true;
+    // To 1.09 ε_c1 in 39 increments; the last one measured reaches 1.15 ε_c1 at most.
+    let n = 40;
+    let step = -1.12 * p.eps_c1 / n as f64;
+    // The implicit uniaxial path (the state under the option is the same bit for bit).
+    let mut states = vec![ConcreteState::new()];
+    let mut lateral = vec![0.0];
+    let mut y = [0.0; 2];
+    for k in 1..n {
+        let ((st, _, _), yk) = uniaxial_x(&p, &states[k - 1], step * k as f64, y);
+        y = yk;
+        states.push(st);
+        lateral.push(y[0]);
+    }
+    let k = n - 1;
+    let eb = |ex: f64| -ex;
+    // Past the peak and short of the softening limit's straight line (tangent −E/3).
+    let slope = |e: f64| {
+        let de = 1e-7;
+        let s = |x: f64| (x - mc90_plastic(&p, x)) * p.ec;
+        (s(e + de) - s(e - de)) / (2.0 * de)
+    };
+    assert!(eb(step * (k - 1) as f64) > p.eps_c1);
+    assert!(slope(eb(step * (k as f64 + 2.0))) > -p.ec / 3.0);
+    let c = &states[k];
+    let (pn, po) = (
+        mc90_plastic(&p, eb(step * k as f64)),
+        mc90_plastic(&p, eb(step * (k - 1) as f64)),
+    );
+    for r in [0.0f64, 0.5, 1.0, 2.0] {
+        let ex = step * (k as f64 + r.max(0.25));
+        let ((_, sig_impl, _), yk) = uniaxial_x(&p, c, ex, [lateral[k], 0.0]);
+        assert!(sig_impl[1].abs() < 1e-9 * p.fcm);
+        let strain = [ex, yk[0], yk[1]];
+        let t = update_extrapolated(&q, c, &strain, 0.1, r).unwrap().0;
+        assert!(t.n_cracks == 0 && !t.is_crushed());
+        let want_x = p.ec * (pn + r * (pn - po) - mc90_plastic(&p, eb(ex)));
+        let want_y = p.ec * (yk[0] - (lateral[k] + r * (lateral[k] - lateral[k - 1])));
+        let got = point_stress_error(&q, c, &t, 0.1, r, 0.0);
+        assert!(
+            (got[0] - want_x).abs() <= 1e-6 * want_x.abs(),
+            "r = {r}: Δσx {} want {want_x}",
+            got[0]
+        );
+        assert!(
+            (got[1] - want_y).abs() <= 1e-6 * want_x.abs().max(want_y.abs()),
+            "r = {r}: Δσy {} want {want_y}",
+            got[1]
+        );
+        assert!(got[2].abs() <= 1e-9 * p.fcm, "r = {r}: τ {}", got[2]);
+        let err = point_error(&q, c, &t, 0.1, r, 0.0);
+        let want = want_x.abs().max(want_y.abs()) / p.fcm;
+        assert!(
+            (err - want).abs() <= 1e-6 * want,
+            "r = {r}: {err} f_cm, want {want}"
+        );
+        assert!(err > 1e-4, "r = {r}: a real difference ({err} f_cm)");
+        // Off, and in a time increment: the crack measure alone (no crack: 0).
+        let ti = update_extrapolated(&p, c, &strain, 0.1, r).unwrap().0;
+        assert_eq!(point_stress_error(&p, c, &ti, 0.1, r, 0.0), [0.0; 3]);
+        assert_eq!(point_error(&p, c, &ti, 0.1, r, 0.0), 0.0);
+        assert_eq!(point_stress_error(&q, c, &t, 0.1, r, 1.0), [0.0; 3]);
+        assert_eq!(point_error(&q, c, &t, 0.1, r, 1.0), 0.0);
+    }
+    // An elastic increment: a virgin point stretched below the tensile strength twice.
+    let e0 = p.eps0();
+    let a = update_extrapolated(&q, &ConcreteState::new(), &[0.3 * e0, 0.0, 0.0], 0.1, 0.0)
+        .unwrap()
+        .0;
+    let b = update_extrapolated(&q, &a, &[0.6 * e0, 0.0, 0.0], 0.1, 1.0)
+        .unwrap()
+        .0;
+    assert_eq!(b.n_cracks, 0);
+    assert_eq!(point_stress_error(&q, &a, &b, 0.1, 1.0, 0.0), [0.0; 3]);
+    assert_eq!(point_error(&q, &a, &b, 0.1, 1.0, 0.0), 0.0);
+}
+
+/// The same for a cracked point (docs/theory-concrete.md §4): cracked along x (opened to
+/// 3 ε0), then compressed along a crack axis — y, parallel to the crack (the crack held
+/// open), or x, the crack's normal (the crack closed) — the 1-D crush-band law of
+/// [`crack_axis_law`] in both, past the peak in equal increments Δ, then one increment of
+/// r Δ with ratio r. The direction's implicit stress is −σ_c(ε̄) = E (e + p(ε̄)), ε̄ = −e,
+/// p = ε̄ − σ_c(ε̄)/E, its IMPL-EX one E (e + p̃), so its difference is E (p̃ − p(ε̄_k))
+/// from the closed-form law; the crack adds nothing (held at its largest strain, or closed),
+/// nor does the other direction (unstrained, elastic), and with the crack at 0° Δσ is that
+/// difference on the compressed axis alone. The point error is its magnitude over f_cm.
+/// Tolerance 1e-6 of the difference (the 1-D return is closed form; the law is checked at
+/// 1e-6 f_cm in `implex_compression_of_a_crack_direction_is_linear_in_the_increment`,
+/// against differences of 1e-3 to 0.06 f_cm here). None with the option off or in a time
+/// increment.
+#[test]
+fn implex_compression_error_of_a_crack_direction_is_its_extrapolated_flow() {
+    let h = 0.1;
+    let mut p = params().with_crush_band();
+    p.implex = true;
+    let mut q = p.clone();
+    q.compression_implex = true;
+    let (law, eu) = crack_axis_law(&p, h);
+    let plastic = |eb: f64| eb - law(eb) / p.ec;
+    let ex = 3.0 * p.eps0();
+    let n = 12;
+    let step = -1.5 * p.eps_c1 / n as f64;
+    assert!(
+        1.5 * p.eps_c1 + 2.0 * step.abs() < 0.9 * eu,
+        "short of crushing"
+    );
+    for axis in [1, 0] {
+        // The strain with `e` on the compressed axis: y with the crack open at 3 ε0, or
+        // x (the crack closed) with y unstrained.
+        let strain = |e: f64| {
+            if axis == 1 {
+                [ex, e, 0.0]
+            } else {
+                [e, 0.0, 0.0]
+            }
+        };
+        let mut st = update_extrapolated(&q, &ConcreteState::new(), &[ex, 0.0, 0.0], h, 0.0)
+            .unwrap()
+            .0;
+        assert_eq!((st.n_cracks, st.crack_angle), (1, 0.0));
+        for k in 1..n {
+            let ratio = if k == 1 { 0.0 } else { 1.0 };
+            st = update_extrapolated(&q, &st, &strain(step * k as f64), h, ratio)
+                .unwrap()
+                .0;
+        }
+        let k = n - 1;
+        assert!(-step * (k - 1) as f64 > p.eps_c1, "past the peak");
+        let (pn, po) = (plastic(-step * k as f64), plastic(-step * (k - 1) as f64));
+        for r in [0.0f64, 0.5, 1.0, 2.0] {
+            let e = step * (k as f64 + r.max(0.25));
+            let t = update_extrapolated(&q, &st, &strain(e), h, r).unwrap().0;
+            assert!(t.n_cracks == 1 && !t.is_crushed());
+            let want = p.ec * (pn + r * (pn - po) - plastic(-e));
+            let got = point_stress_error(&q, &st, &t, h, r, 0.0);
+            assert!(
+                got[1 - axis].abs() <= 1e-9 * p.fcm,
+                "axis {axis}, r = {r}: the other direction {got:?}"
+            );
+            assert!(
+                (got[axis] - want).abs() <= 1e-6 * want.abs(),
+                "axis {axis}, r = {r}: Δσ {} want {want}",
+                got[axis]
+            );
+            assert!(got[2].abs() <= 1e-9 * p.fcm, "r = {r}: τ {}", got[2]);
+            let err = point_error(&q, &st, &t, h, r, 0.0);
+            assert!(
+                (err - want.abs() / p.fcm).abs() <= 1e-6 * want.abs() / p.fcm,
+                "axis {axis}, r = {r}: {err} f_cm, want {}",
+                want.abs() / p.fcm
+            );
+            let ti = update_extrapolated(&p, &st, &strain(e), h, r).unwrap().0;
+            assert_eq!(point_stress_error(&p, &st, &ti, h, r, 0.0), [0.0; 3]);
+            assert_eq!(point_stress_error(&q, &st, &t, h, r, 1.0), [0.0; 3]);
+            assert_eq!(point_error(&q, &st, &t, h, r, 1.0), 0.0);
+        }
+    }
 }
