@@ -360,6 +360,16 @@ pub(super) fn implex_retry(
         };
         (e, tol)
     });
+    // The point measure's compression part (IMPL-EX compression) is over f_cm.
+    let compression = sys.model.materials.iter().any(|m| {
+        matches!(&m.law, crate::materials::point::Material::Concrete { params, .. }
+            if params.compression_implex)
+    });
+    let point_unit = if compression {
+        "of f_tm (cracks) or f_cm (compression)"
+    } else {
+        "of f_tm"
+    };
     let force_unit = match controls.implex_force_norm {
         crate::model::ImplexForceNorm::Force => "of the force scale",
         crate::model::ImplexForceNorm::Energy => "in the energy norm",
@@ -380,7 +390,7 @@ pub(super) fn implex_retry(
         if controls.verbose {
             eprintln!(
                 "    IMPL-EX error {} {}: increment halved",
-                describe(point, "f_tm"),
+                describe(point, point_unit),
                 describe(force, force_unit)
             );
         }
@@ -392,7 +402,7 @@ pub(super) fn implex_retry(
     if ratio > 1.0 && controls.verbose {
         eprintln!(
             "    IMPL-EX error {} {} kept (smallest increment, or not reduced by halving)",
-            describe(point, "f_tm"),
+            describe(point, point_unit),
             describe(force, force_unit)
         );
     }

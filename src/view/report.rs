@@ -385,7 +385,8 @@ fn summary_section(dir: &Path) -> (String, String) {
         row(
             "IMPL-EX error (implex_tolerance)",
             format!(
-                "largest kept {e:.3} f_tm; {} increments cut for it",
+                "largest kept {e:.3} f_tm (of f_cm for IMPL-EX compression); {} increments cut \
+                 for it",
                 t["implex_cuts"].as_u64().unwrap_or(0)
             ),
         );
