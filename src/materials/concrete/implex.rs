@@ -215,21 +215,11 @@ pub fn compression_difference(
         }));
     }
     // The element's parameters, as in the update (the crush band's ε_u).
-    let local;
-    let p = if p.crush_eu.is_none() && p.compression_softening != super::CompressionSoftening::Mc90
-    {
-        match p.for_element(char_length) {
-            Ok(q) => {
-                local = q;
-                &local
-            }
-            Err(_) => return CompressionDifference::None,
-        }
-    } else {
-        p
+    let Ok(local) = p.resolved_for(char_length) else {
+        return CompressionDifference::None;
     };
     CompressionDifference::Cracked(super::cracking::implex_compression_differences(
-        p,
+        &local,
         committed,
         &trial.strain,
         char_length,

@@ -475,6 +475,20 @@ impl ConcreteParams {
         Ok(p)
     }
 
+    /// These parameters as an element's update uses them: [`ConcreteParams::for_element`]
+    /// unless the crush band's ε_u is resolved already or the law has none (MC90), else
+    /// these themselves (borrowed).
+    pub fn resolved_for(
+        &self,
+        char_length: f64,
+    ) -> Result<std::borrow::Cow<'_, Self>, MaterialError> {
+        if self.crush_eu.is_none() && self.compression_softening != CompressionSoftening::Mc90 {
+            Ok(std::borrow::Cow::Owned(self.for_element(char_length)?))
+        } else {
+            Ok(std::borrow::Cow::Borrowed(self))
+        }
+    }
+
     /// Decay strain α [-] of the tension-softening law for an element of characteristic
     /// length `char_length` [m] (ignored for [`TensionSoftening::Hinton`]).
     pub fn softening_alpha(&self, char_length: f64) -> f64 {
@@ -746,13 +760,8 @@ pub fn update_full_into(
         return Err(MaterialError::NonFiniteStrain(*strain));
     }
     // Crush band: the post-peak law depends on the element size.
-    let local;
-    let p = if p.crush_eu.is_none() && p.compression_softening != CompressionSoftening::Mc90 {
-        local = p.for_element(char_length)?;
-        &local
-    } else {
-        p
-    };
+    let local = p.resolved_for(char_length)?;
+    let p: &ConcreteParams = &local;
     if committed.crushed {
         return moved(out, Ok(crushed(p, committed, strain)));
     }
